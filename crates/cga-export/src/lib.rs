@@ -1,0 +1,1 @@
+//! Model export: GLB, glTF, OBJ+MTL.

@@ -1,1 +1,22 @@
-//! The CGA interpreter.
+//! The CGA interpreter: resolves rule files into a program, derives initial
+//! shapes with it, and hands leaf geometry to the exporters.
+
+pub mod assets;
+pub mod derive;
+mod eval;
+pub mod expr;
+pub mod generate;
+mod geom_shim;
+pub mod lot;
+pub mod material_attr;
+pub mod ops;
+pub mod program;
+pub mod resolve;
+pub mod shape;
+pub mod shape_fns;
+mod value_shim;
+
+pub use generate::{generate_lot, GenerateOptions};
+pub use derive::{InitialInfo, Interp, Limits, LotOutput, RtError};
+pub use program::Program;
+pub use resolve::{load, Loaded};

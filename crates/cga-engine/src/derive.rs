@@ -1,0 +1,448 @@
+//! Derivation: applying rules to shapes, depth first, in the order the rule
+//! text gives.
+//!
+//! A shape that invokes a rule, a leaf (`X.`), a push block or an operation
+//! that creates shapes (split, comp, ...) gets *successors*; a shape that ends
+//! its rule without successors and without `NIL` is a *leaf* of the shape tree
+//! and its geometry is part of the model. A rule call in the middle of an
+//! operation sequence gives the successor a copy of the current shape and the
+//! sequence goes on with the current shape (`extrude(15) r(..) X. r(..) X.`).
+
+use std::collections::HashSet;
+
+use cga_geometry::Mesh;
+use cga_syntax::{Diagnostic, Span};
+use cga_value::Value;
+
+use crate::assets::Assets;
+use crate::expr::{RBody, RExpr, RExprKind, RStmt};
+use crate::ops;
+use crate::program::{Program, RuleId};
+use crate::shape::Shape;
+
+/// Limits that stop runaway grammars with a clear message.
+#[derive(Clone, Copy, Debug)]
+pub struct Limits {
+    /// Maximum nesting of rule and function invocations.
+    pub max_depth: usize,
+    /// Maximum number of shapes created for one initial shape.
+    pub max_shapes: usize,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            max_depth: 1000,
+            max_shapes: 5_000_000,
+        }
+    }
+}
+
+/// An error that stops the derivation of one initial shape.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RtError {
+    pub message: String,
+    pub span: Option<Span>,
+}
+
+impl RtError {
+    pub fn new(message: impl Into<String>, span: Span) -> RtError {
+        RtError {
+            message: message.into(),
+            span: Some(span),
+        }
+    }
+
+    pub fn to_diagnostic(&self) -> Diagnostic {
+        match self.span {
+            Some(span) => Diagnostic::error(self.message.clone(), span),
+            None => Diagnostic {
+                severity: cga_syntax::Severity::Error,
+                message: self.message.clone(),
+                span: None,
+                label: None,
+                notes: Vec::new(),
+            },
+        }
+    }
+}
+
+/// How an operation argument was written: `3`, `'0.5` or `~1`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SizeKind {
+    Absolute,
+    Relative,
+    Floating,
+}
+
+/// An evaluated operation argument.
+#[derive(Clone, Debug)]
+pub struct Arg {
+    pub value: Value,
+    pub kind: SizeKind,
+    pub span: Span,
+}
+
+impl Arg {
+    pub fn num(&self) -> Result<f64, RtError> {
+        match &self.value {
+            Value::Float(x) => Ok(*x),
+            Value::Bool(b) => Ok(if *b { 1.0 } else { 0.0 }),
+            other => Err(RtError::new(
+                format!(
+                    "expected a float, found {}",
+                    crate::value_shim::type_name(other)
+                ),
+                self.span,
+            )),
+        }
+    }
+
+    /// A float that may be relative to `base` (`'0.5` = half of `base`).
+    pub fn size(&self, base: f64) -> Result<f64, RtError> {
+        let x = self.num()?;
+        Ok(match self.kind {
+            SizeKind::Relative => x * base,
+            _ => x,
+        })
+    }
+
+    pub fn text(&self) -> Result<&str, RtError> {
+        match &self.value {
+            Value::Str(s) => Ok(s),
+            other => Err(RtError::new(
+                format!(
+                    "expected a string, found {}",
+                    crate::value_shim::type_name(other)
+                ),
+                self.span,
+            )),
+        }
+    }
+
+    pub fn boolean(&self) -> Result<bool, RtError> {
+        match &self.value {
+            Value::Bool(b) => Ok(*b),
+            other => Err(RtError::new(
+                format!(
+                    "expected a bool, found {}",
+                    crate::value_shim::type_name(other)
+                ),
+                self.span,
+            )),
+        }
+    }
+}
+
+/// The shape an operation sequence works on, and what became of it.
+pub struct ShapeState {
+    pub shape: Shape,
+    pub has_successor: bool,
+    pub deleted: bool,
+}
+
+impl ShapeState {
+    pub fn new(shape: Shape) -> ShapeState {
+        ShapeState {
+            shape,
+            has_successor: false,
+            deleted: false,
+        }
+    }
+}
+
+/// What the derivation of one initial shape produced.
+#[derive(Default)]
+pub struct LotOutput {
+    /// Leaf geometry in object coordinates, with final materials.
+    pub meshes: Vec<Mesh>,
+    pub prints: Vec<String>,
+    pub reports: Vec<(String, Value)>,
+    pub warnings: Vec<Diagnostic>,
+    /// Number of shapes created.
+    pub shapes: usize,
+}
+
+/// Facts about the initial shape that rules can read.
+#[derive(Clone, Debug)]
+pub struct InitialInfo {
+    pub name: String,
+    pub start_rule: String,
+}
+
+pub(crate) enum AttrSlot {
+    Unevaluated,
+    InProgress,
+    Done(Value),
+}
+
+/// The interpreter for one initial shape.
+pub struct Interp<'a> {
+    pub program: &'a Program,
+    pub assets: &'a Assets,
+    pub limits: Limits,
+    pub info: InitialInfo,
+    pub initial: Shape,
+    pub out: LotOutput,
+    pub(crate) attr_values: Vec<AttrSlot>,
+    pub(crate) const_values: Vec<Option<Value>>,
+    pub(crate) depth: usize,
+    warned: HashSet<(u32, u32, u32)>,
+}
+
+impl<'a> Interp<'a> {
+    pub fn new(
+        program: &'a Program,
+        assets: &'a Assets,
+        limits: Limits,
+        info: InitialInfo,
+        initial: Shape,
+        attr_values: &[(u32, Value)],
+    ) -> Interp<'a> {
+        let mut slots: Vec<AttrSlot> = (0..program.attrs.len())
+            .map(|_| AttrSlot::Unevaluated)
+            .collect();
+        for (id, v) in attr_values {
+            slots[*id as usize] = AttrSlot::Done(v.clone());
+        }
+        Interp {
+            program,
+            assets,
+            limits,
+            info,
+            initial,
+            out: LotOutput::default(),
+            attr_values: slots,
+            const_values: vec![None; program.functions.len()],
+            depth: 0,
+            warned: HashSet::new(),
+        }
+    }
+
+    /// Replaces an attribute's value for this initial shape (outside values).
+    pub fn set_attr_default(&mut self, id: crate::program::AttrId, v: Value) {
+        self.attr_values[id as usize] = AttrSlot::Done(v);
+    }
+
+    /// Derives the initial shape with `rule`. Whatever was generated before
+    /// an error is kept in `self.out`.
+    pub fn run(&mut self, rule: RuleId) -> Result<(), RtError> {
+        let shape = self.initial.clone();
+        self.out.shapes += 1;
+        self.run_rule(rule, Vec::new(), shape, self.program.rules[rule as usize].span)
+    }
+
+    pub fn warn_once(&mut self, span: Span, message: impl FnOnce() -> String) {
+        if self.warned.insert((span.file.0, span.start, span.end)) {
+            self.out.warnings.push(Diagnostic::warning(message(), span));
+        }
+    }
+
+    /// Invokes `rule` with `args` on `shape`.
+    pub fn run_rule(
+        &mut self,
+        rule: RuleId,
+        mut frame: Vec<Value>,
+        mut shape: Shape,
+        call_span: Span,
+    ) -> Result<(), RtError> {
+        let program = self.program;
+        let def = &program.rules[rule as usize];
+        if self.depth >= self.limits.max_depth {
+            return Err(RtError::new(
+                format!(
+                    "derivation depth limit ({}) reached in rule `{}`: the rules recurse without end (raise the limit with --max-depth)",
+                    self.limits.max_depth, def.name
+                ),
+                call_span,
+            ));
+        }
+        self.depth += 1;
+        shape.name = program.rule_symbol(rule);
+        for local in &def.locals {
+            let v = self.eval(local, &frame, &shape)?;
+            frame.push(v);
+        }
+        let mut st = ShapeState::new(shape);
+        let r = self.exec_body(&def.body, &frame, &mut st);
+        self.depth -= 1;
+        r?;
+        self.finish(st);
+        Ok(())
+    }
+
+    /// A shape ends its operations: a leaf if it created nothing.
+    pub fn finish(&mut self, st: ShapeState) {
+        if !st.deleted && !st.has_successor {
+            self.emit(&st.shape);
+        }
+    }
+
+    /// A successor of `parent`: a copy with its own random stream and the
+    /// parent's scope remembered for `center`.
+    pub fn child(&mut self, parent: &Shape, span: Span) -> Result<Shape, RtError> {
+        self.count_shape(span)?;
+        let mut c = parent.clone();
+        c.parent_scope = parent.scope;
+        c.rng.set(parent.child_rng(parent.next_random().to_bits()));
+        Ok(c)
+    }
+
+    pub fn count_shape(&mut self, span: Span) -> Result<(), RtError> {
+        self.out.shapes += 1;
+        if self.out.shapes > self.limits.max_shapes {
+            return Err(RtError::new(
+                format!(
+                    "shape limit ({}) reached for one initial shape: the rules create shapes without end (raise the limit with --max-shapes)",
+                    self.limits.max_shapes
+                ),
+                span,
+            ));
+        }
+        Ok(())
+    }
+
+    /// Adds a leaf shape's geometry to the model.
+    pub fn emit(&mut self, shape: &Shape) {
+        if shape.geometry.is_empty() {
+            return;
+        }
+        let mut mesh = shape.object_mesh();
+        if !shape.material.is_empty() {
+            for m in &mut mesh.materials {
+                *m = shape.material.apply(m);
+            }
+        }
+        self.out.meshes.push(mesh);
+    }
+
+    pub fn exec_body(
+        &mut self,
+        body: &RBody,
+        frame: &[Value],
+        st: &mut ShapeState,
+    ) -> Result<(), RtError> {
+        match body {
+            RBody::Ops(stmts) => {
+                for s in stmts {
+                    if st.deleted {
+                        break;
+                    }
+                    self.exec_stmt(s, frame, st)?;
+                }
+                Ok(())
+            }
+            RBody::Case {
+                branches,
+                otherwise,
+            } => {
+                for (cond, b) in branches {
+                    if self.eval_condition(cond, frame, &st.shape)? {
+                        return self.exec_body(b, frame, st);
+                    }
+                }
+                match otherwise {
+                    Some(b) => self.exec_body(b, frame, st),
+                    None => Ok(()),
+                }
+            }
+            RBody::Stochastic {
+                branches,
+                otherwise,
+            } => {
+                let pick = self.stochastic_pick(branches.iter().map(|(p, _)| p), frame, &st.shape)?;
+                match pick {
+                    Some(i) => self.exec_body(&branches[i].1, frame, st),
+                    None => match otherwise {
+                        Some(b) => self.exec_body(b, frame, st),
+                        None => Ok(()),
+                    },
+                }
+            }
+        }
+    }
+
+    /// Chooses a stochastic branch: the index whose cumulative percentage
+    /// covers a random draw, or `None` for `else`.
+    pub fn stochastic_pick<'e>(
+        &mut self,
+        percents: impl Iterator<Item = &'e RExpr>,
+        frame: &[Value],
+        shape: &Shape,
+    ) -> Result<Option<usize>, RtError> {
+        let r = shape.next_random() * 100.0;
+        let mut acc = 0.0;
+        for (i, p) in percents.enumerate() {
+            acc += self.eval_num(p, frame, shape)?;
+            if r < acc {
+                return Ok(Some(i));
+            }
+        }
+        Ok(None)
+    }
+
+    fn exec_stmt(&mut self, s: &RStmt, frame: &[Value], st: &mut ShapeState) -> Result<(), RtError> {
+        match s {
+            RStmt::Op(call) => {
+                let mut args = Vec::with_capacity(call.args.len());
+                for a in &call.args {
+                    args.push(self.eval_arg(a, frame, &st.shape)?);
+                }
+                ops::exec(self, st, call, &args, frame)
+            }
+            RStmt::Rule(rc) => {
+                let mut args = Vec::with_capacity(rc.args.len());
+                for a in &rc.args {
+                    args.push(self.eval(a, frame, &st.shape)?);
+                }
+                let mut child = self.child(&st.shape, rc.span)?;
+                for (id, e) in &rc.attr_overrides {
+                    let v = self.eval(e, frame, &st.shape)?;
+                    child.set_attr(*id, v);
+                }
+                st.has_successor = true;
+                self.run_rule(rc.rule, args, child, rc.span)
+            }
+            RStmt::Leaf(sym) => {
+                let mut child = self.child(&st.shape, Span::default())?;
+                child.name = *sym;
+                st.has_successor = true;
+                self.emit(&child);
+                Ok(())
+            }
+            RStmt::Nil => {
+                st.deleted = true;
+                Ok(())
+            }
+            RStmt::Push(body) => {
+                let child = self.child(&st.shape, Span::default())?;
+                let mut cst = ShapeState::new(child);
+                self.exec_body(body, frame, &mut cst)?;
+                self.finish(cst);
+                st.has_successor = true;
+                Ok(())
+            }
+            RStmt::Unsupported { name, span } => {
+                let name = name.clone();
+                self.warn_once(*span, || {
+                    format!("operation `{name}` is not supported yet; the shape is left unchanged")
+                });
+                Ok(())
+            }
+        }
+    }
+
+    /// Evaluates an operation argument, noting a `'` or `~` prefix.
+    pub fn eval_arg(&mut self, e: &RExpr, frame: &[Value], shape: &Shape) -> Result<Arg, RtError> {
+        let (inner, kind) = match &e.kind {
+            RExprKind::Relative(inner) => (&**inner, SizeKind::Relative),
+            RExprKind::Floating(inner) => (&**inner, SizeKind::Floating),
+            _ => (e, SizeKind::Absolute),
+        };
+        Ok(Arg {
+            value: self.eval(inner, frame, shape)?,
+            kind,
+            span: e.span,
+        })
+    }
+}

@@ -1,0 +1,286 @@
+//! Expression evaluation.
+
+use cga_syntax::ast::BinaryOp;
+use cga_value::Value;
+
+use crate::derive::{AttrSlot, Interp, RtError};
+use crate::expr::{RExpr, RExprKind};
+use crate::program::{AttrId, FuncId};
+use crate::shape::Shape;
+use crate::value_shim as vs;
+
+impl Interp<'_> {
+    pub fn eval(&mut self, e: &RExpr, frame: &[Value], shape: &Shape) -> Result<Value, RtError> {
+        match &e.kind {
+            RExprKind::Const(v) => Ok(v.clone()),
+            RExprKind::Local(i) => Ok(frame[*i as usize].clone()),
+            RExprKind::Attr(id) => self.attr_value(*id, shape, e),
+            RExprKind::Func(f, args) => {
+                let mut values = Vec::with_capacity(args.len());
+                for a in args {
+                    values.push(self.eval(a, frame, shape)?);
+                }
+                self.call_function(*f, values, shape, e)
+            }
+            RExprKind::Pure(b, args) => {
+                let mut values = Vec::with_capacity(args.len());
+                for a in args {
+                    values.push(self.eval(a, frame, shape)?);
+                }
+                (b.f)(&values).map_err(|m| RtError::new(format!("{}: {m}", b.name), e.span))
+            }
+            RExprKind::Shape(f, args) => {
+                let mut values = Vec::with_capacity(args.len());
+                for a in args {
+                    values.push(self.eval(a, frame, shape)?);
+                }
+                self.shape_fn(*f, &values, shape, e)
+            }
+            RExprKind::Unary {
+                op,
+                elementwise,
+                operand,
+            } => {
+                let v = self.eval(operand, frame, shape)?;
+                vs::unary(*op, *elementwise, &v).map_err(|m| RtError::new(m, e.span))
+            }
+            RExprKind::Binary {
+                op,
+                elementwise,
+                lhs,
+                rhs,
+            } => {
+                let a = self.eval(lhs, frame, shape)?;
+                // `&&` and `||` on bools evaluate their right side only when needed.
+                if !elementwise {
+                    match (op, &a) {
+                        (BinaryOp::And, Value::Bool(false)) => return Ok(Value::Bool(false)),
+                        (BinaryOp::Or, Value::Bool(true)) => return Ok(Value::Bool(true)),
+                        (BinaryOp::And | BinaryOp::Or, Value::Bool(_)) => {
+                            let b = self.eval(rhs, frame, shape)?;
+                            return match b {
+                                Value::Bool(b) => Ok(Value::Bool(b)),
+                                other => Err(RtError::new(
+                                    format!("expected a bool, found {}", vs::type_name(&other)),
+                                    rhs.span,
+                                )),
+                            };
+                        }
+                        _ => {}
+                    }
+                }
+                let b = self.eval(rhs, frame, shape)?;
+                vs::binary(*op, *elementwise, &a, &b).map_err(|m| RtError::new(m, e.span))
+            }
+            RExprKind::Array(rows) => {
+                let mut out = Vec::with_capacity(rows.len());
+                for row in rows {
+                    let mut r = Vec::with_capacity(row.len());
+                    for x in row {
+                        r.push(self.eval(x, frame, shape)?);
+                    }
+                    out.push(r);
+                }
+                vs::build_array(out).map_err(|m| RtError::new(m, e.span))
+            }
+            RExprKind::Range { base, step, limit } => {
+                let b = self.eval_num(base, frame, shape)?;
+                let s = match step {
+                    Some(s) => Some(self.eval_num(s, frame, shape)?),
+                    None => None,
+                };
+                let l = self.eval_num(limit, frame, shape)?;
+                vs::range(b, s, l).map_err(|m| RtError::new(m, e.span))
+            }
+            RExprKind::Index { base, indices } => {
+                let b = self.eval(base, frame, shape)?;
+                let mut idx = Vec::with_capacity(indices.len());
+                for i in indices {
+                    idx.push(self.eval(i, frame, shape)?);
+                }
+                vs::index(&b, &idx).map_err(|m| RtError::new(m, e.span))
+            }
+            RExprKind::Case {
+                branches,
+                otherwise,
+            } => {
+                for (c, v) in branches {
+                    if self.eval_condition(c, frame, shape)? {
+                        return self.eval(v, frame, shape);
+                    }
+                }
+                match otherwise {
+                    Some(v) => self.eval(v, frame, shape),
+                    None => Err(RtError::new("no case matched and there is no else", e.span)),
+                }
+            }
+            RExprKind::Stochastic {
+                branches,
+                otherwise,
+            } => {
+                let pick = self.stochastic_pick(branches.iter().map(|(p, _)| p), frame, shape)?;
+                match (pick, otherwise) {
+                    (Some(i), _) => self.eval(&branches[i].1, frame, shape),
+                    (None, Some(v)) => self.eval(v, frame, shape),
+                    (None, None) => Err(RtError::new(
+                        "no stochastic branch was chosen and there is no else",
+                        e.span,
+                    )),
+                }
+            }
+            RExprKind::Relative(inner) | RExprKind::Floating(inner) => {
+                // A size prefix outside an operation argument: the plain value.
+                self.eval(inner, frame, shape)
+            }
+            RExprKind::WithLocals { locals, body } => {
+                let mut inner = frame.to_vec();
+                for l in locals {
+                    let v = self.eval(l, &inner, shape)?;
+                    inner.push(v);
+                }
+                self.eval(body, &inner, shape)
+            }
+            RExprKind::CompFn { .. } => Err(RtError::new(
+                "the comp function is not supported yet",
+                e.span,
+            )),
+        }
+    }
+
+    pub fn eval_num(&mut self, e: &RExpr, frame: &[Value], shape: &Shape) -> Result<f64, RtError> {
+        match self.eval(e, frame, shape)? {
+            Value::Float(x) => Ok(x),
+            Value::Bool(b) => Ok(if b { 1.0 } else { 0.0 }),
+            other => Err(RtError::new(
+                format!("expected a float, found {}", vs::type_name(&other)),
+                e.span,
+            )),
+        }
+    }
+
+    pub fn eval_condition(
+        &mut self,
+        e: &RExpr,
+        frame: &[Value],
+        shape: &Shape,
+    ) -> Result<bool, RtError> {
+        match self.eval(e, frame, shape)? {
+            Value::Bool(b) => Ok(b),
+            Value::Float(x) => Ok(x != 0.0),
+            other => Err(RtError::new(
+                format!("a condition must be a bool, found {}", vs::type_name(&other)),
+                e.span,
+            )),
+        }
+    }
+
+    /// The value of an attribute for `shape`: set on the shape, else the
+    /// initial shape's (evaluated once, on first use).
+    pub(crate) fn attr_value(
+        &mut self,
+        id: AttrId,
+        shape: &Shape,
+        at: &RExpr,
+    ) -> Result<Value, RtError> {
+        if let Some(v) = shape.attr_override(id) {
+            return Ok(v.clone());
+        }
+        self.attr_default(id, at)
+    }
+
+    pub(crate) fn attr_default(&mut self, id: AttrId, at: &RExpr) -> Result<Value, RtError> {
+        match &self.attr_values[id as usize] {
+            AttrSlot::Done(v) => return Ok(v.clone()),
+            AttrSlot::InProgress => {
+                let name = &self.program.attrs[id as usize].name;
+                return Err(RtError::new(
+                    format!("attribute `{name}` depends on itself"),
+                    at.span,
+                ));
+            }
+            AttrSlot::Unevaluated => {}
+        }
+        self.attr_values[id as usize] = AttrSlot::InProgress;
+        let program = self.program;
+        let def = &program.attrs[id as usize];
+        let initial = self.initial.clone();
+        let r = self.eval_with_locals(&[], &def.default, &initial);
+        match r {
+            Ok(v) => {
+                self.attr_values[id as usize] = AttrSlot::Done(v.clone());
+                Ok(v)
+            }
+            Err(err) => {
+                self.attr_values[id as usize] = AttrSlot::Unevaluated;
+                Err(err)
+            }
+        }
+    }
+
+    fn eval_with_locals(
+        &mut self,
+        locals: &[RExpr],
+        body: &RExpr,
+        shape: &Shape,
+    ) -> Result<Value, RtError> {
+        let mut frame = Vec::with_capacity(locals.len());
+        for l in locals {
+            let v = self.eval(l, &frame, shape)?;
+            frame.push(v);
+        }
+        self.eval(body, &frame, shape)
+    }
+
+    pub(crate) fn call_function(
+        &mut self,
+        f: FuncId,
+        mut frame: Vec<Value>,
+        shape: &Shape,
+        at: &RExpr,
+    ) -> Result<Value, RtError> {
+        let program = self.program;
+        let def = &program.functions[f as usize];
+        if def.is_const && def.arity == 0 {
+            if let Some(v) = &self.const_values[f as usize] {
+                return Ok(v.clone());
+            }
+            let initial = self.initial.clone();
+            self.enter(at, &def.name)?;
+            let r = self.eval_with_locals(&def.locals, &def.body, &initial);
+            self.depth -= 1;
+            let v = r?;
+            self.const_values[f as usize] = Some(v.clone());
+            return Ok(v);
+        }
+        self.enter(at, &def.name)?;
+        let mut r = Ok(Value::Bool(false));
+        for l in &def.locals {
+            match self.eval(l, &frame, shape) {
+                Ok(v) => frame.push(v),
+                Err(e) => {
+                    r = Err(e);
+                    break;
+                }
+            }
+        }
+        if r.is_ok() {
+            r = self.eval(&def.body, &frame, shape);
+        }
+        self.depth -= 1;
+        r
+    }
+
+    fn enter(&mut self, at: &RExpr, name: &str) -> Result<(), RtError> {
+        if self.depth >= self.limits.max_depth {
+            return Err(RtError::new(
+                format!(
+                    "evaluation depth limit ({}) reached in function `{name}`: it recurses without end",
+                    self.limits.max_depth
+                ),
+                at.span,
+            ));
+        }
+        self.depth += 1;
+        Ok(())
+    }
+}

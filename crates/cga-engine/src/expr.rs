@@ -1,0 +1,148 @@
+//! Resolved expressions and rule bodies: the syntax tree with every name
+//! replaced by what it refers to (a frame slot, an attribute, a function, a
+//! built-in, an operation), ready to be evaluated without lookups.
+
+use cga_syntax::ast::{BinaryOp, BlockOp, UnaryOp};
+use cga_syntax::Span;
+use cga_value::Value;
+
+use crate::ops::Op;
+use crate::program::{AttrId, FuncId, RuleId};
+use crate::shape_fns::ShapeFn;
+
+#[derive(Debug, Clone)]
+pub struct RExpr {
+    pub kind: RExprKind,
+    pub span: Span,
+}
+
+#[derive(Debug, Clone)]
+pub enum RExprKind {
+    Const(Value),
+    /// A parameter or `with` local of the enclosing rule/function.
+    Local(u16),
+    Attr(AttrId),
+    /// A user function or const (constness is on the definition).
+    Func(FuncId, Vec<RExpr>),
+    /// A built-in that depends on its arguments only.
+    Pure(&'static crate::value_shim::Builtin, Vec<RExpr>),
+    /// A built-in that reads (or, for `rand`/`p`, advances) the current shape.
+    Shape(ShapeFn, Vec<RExpr>),
+    Unary {
+        op: UnaryOp,
+        elementwise: bool,
+        operand: Box<RExpr>,
+    },
+    Binary {
+        op: BinaryOp,
+        elementwise: bool,
+        lhs: Box<RExpr>,
+        rhs: Box<RExpr>,
+    },
+    Array(Vec<Vec<RExpr>>),
+    Range {
+        base: Box<RExpr>,
+        step: Option<Box<RExpr>>,
+        limit: Box<RExpr>,
+    },
+    Index {
+        base: Box<RExpr>,
+        indices: Vec<RExpr>,
+    },
+    Case {
+        branches: Vec<(RExpr, RExpr)>,
+        otherwise: Option<Box<RExpr>>,
+    },
+    Stochastic {
+        branches: Vec<(RExpr, RExpr)>,
+        otherwise: Option<Box<RExpr>>,
+    },
+    /// `'e`: only meaningful as an operation argument or a split size.
+    Relative(Box<RExpr>),
+    /// `~e`: only meaningful as a split size.
+    Floating(Box<RExpr>),
+    /// `with ( x := e ... )` locals of an attribute default: evaluated in
+    /// order into new frame slots, then the body.
+    WithLocals {
+        locals: Vec<RExpr>,
+        body: Box<RExpr>,
+    },
+    /// The comp function `comp(f) { sel : expr | ... }`.
+    CompFn {
+        args: Vec<RExpr>,
+        block: RBlock<RExpr>,
+    },
+}
+
+impl RExpr {
+    pub fn constant(value: Value, span: Span) -> RExpr {
+        RExpr {
+            kind: RExprKind::Const(value),
+            span,
+        }
+    }
+}
+
+/// What a rule body, a branch, a block entry or a push block does.
+#[derive(Debug, Clone)]
+pub enum RBody {
+    Ops(Vec<RStmt>),
+    Case {
+        branches: Vec<(RExpr, RBody)>,
+        otherwise: Option<Box<RBody>>,
+    },
+    Stochastic {
+        branches: Vec<(RExpr, RBody)>,
+        otherwise: Option<Box<RBody>>,
+    },
+}
+
+#[derive(Debug, Clone)]
+pub enum RStmt {
+    Op(OpCall),
+    Rule(RuleCall),
+    /// `Name.`, or a call of a rule name that has no rule: a leaf shape.
+    Leaf(u32),
+    Nil,
+    Push(RBody),
+    /// A CGA operation this engine does not run yet: a warning, the shape unchanged.
+    Unsupported {
+        name: String,
+        span: Span,
+    },
+}
+
+#[derive(Debug, Clone)]
+pub struct OpCall {
+    pub op: Op,
+    pub args: Vec<RExpr>,
+    pub block: Option<RBlock<RBody>>,
+    pub span: Span,
+}
+
+#[derive(Debug, Clone)]
+pub struct RuleCall {
+    pub rule: RuleId,
+    pub args: Vec<RExpr>,
+    /// Attribute values set for this call only (dynamic import `imp(h = 2).Lot`).
+    pub attr_overrides: Vec<(AttrId, RExpr)>,
+    pub span: Span,
+}
+
+#[derive(Debug, Clone)]
+pub struct RBlock<T> {
+    pub parts: Vec<RPart<T>>,
+    pub repeat: bool,
+    pub span: Span,
+}
+
+#[derive(Debug, Clone)]
+pub enum RPart<T> {
+    Entry {
+        head: RExpr,
+        op: BlockOp,
+        body: T,
+        span: Span,
+    },
+    Group(RBlock<T>),
+}

@@ -1,0 +1,101 @@
+//! The entry point for generating one lot: attribute values, seed, start
+//! rule, limits, and the derivation itself.
+
+use std::sync::Arc;
+
+use cga_value::Value;
+
+use crate::assets::Assets;
+use crate::derive::{InitialInfo, Interp, Limits, LotOutput, RtError};
+use crate::expr::RExpr;
+use crate::lot::{initial_shape, Lot};
+use crate::program::{AttrId, Program, RuleId};
+use crate::value_shim::to_text;
+
+#[derive(Clone, Debug, Default)]
+pub struct GenerateOptions {
+    /// `--attr NAME=VALUE` values (resolved to attribute ids).
+    pub attrs: Vec<(AttrId, Value)>,
+    pub seed: u64,
+    pub limits: Limits,
+}
+
+/// Derives one lot with `rule`. The output holds everything generated,
+/// also when an error stopped the derivation part way.
+pub fn generate_lot(
+    program: &Program,
+    assets: &Assets,
+    rule: RuleId,
+    lot: &Lot,
+    lot_index: usize,
+    options: &GenerateOptions,
+) -> (LotOutput, Option<RtError>) {
+    let seed = options
+        .seed
+        .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        .wrapping_add(lot_index as u64);
+    let shape = initial_shape(lot, seed, program.rule_symbol(rule));
+    let info = InitialInfo {
+        name: lot.name.clone(),
+        start_rule: program.rules[rule as usize].name.clone(),
+    };
+    let mut interp = Interp::new(program, assets, options.limits, info, shape, &[]);
+    let mut error = None;
+    // Lot attributes (GeoJSON properties) first, command-line values win.
+    let lot_attrs = lot
+        .attrs
+        .iter()
+        .filter_map(|(name, v)| program.main_attr(name).map(|id| (id, v.clone())));
+    for (id, raw) in lot_attrs.chain(options.attrs.iter().cloned()) {
+        let def = &program.attrs[id as usize];
+        match interp.attr_default(id, &RExpr::constant(raw.clone(), def.span)) {
+            Ok(default) => interp.set_attr_default(id, coerce(&raw, &default)),
+            Err(e) => {
+                error = Some(e);
+                break;
+            }
+        }
+    }
+    if error.is_none() {
+        if let Err(e) = interp.run(rule) {
+            error = Some(e);
+        }
+    }
+    (std::mem::take(&mut interp.out), error)
+}
+
+/// A value given from outside (command line, GIS properties) in the type of
+/// the attribute's default: `--attr height=20` for a string attribute is "20".
+pub fn coerce(raw: &Value, like: &Value) -> Value {
+    match (raw, like) {
+        (Value::Float(_), Value::Float(_))
+        | (Value::Bool(_), Value::Bool(_))
+        | (Value::Str(_), Value::Str(_)) => raw.clone(),
+        (_, Value::Str(_)) => Value::Str(Arc::from(to_text(raw).as_str())),
+        (Value::Str(s), Value::Float(_)) => s
+            .trim()
+            .parse::<f64>()
+            .map(Value::Float)
+            .unwrap_or_else(|_| raw.clone()),
+        (Value::Bool(b), Value::Float(_)) => Value::Float(if *b { 1.0 } else { 0.0 }),
+        (Value::Float(x), Value::Bool(_)) => Value::Bool(*x != 0.0),
+        (Value::Str(s), Value::Bool(_)) => match &**s {
+            "true" => Value::Bool(true),
+            "false" => Value::Bool(false),
+            _ => raw.clone(),
+        },
+        _ => raw.clone(),
+    }
+}
+
+/// Parses a command-line value: a number, `true`/`false`, else a string.
+pub fn parse_value(text: &str) -> Value {
+    match text {
+        "true" => Value::Bool(true),
+        "false" => Value::Bool(false),
+        _ => match text.trim().parse::<f64>() {
+            Ok(x) => Value::Float(x),
+            Err(_) => Value::Str(Arc::from(text)),
+        },
+    }
+}

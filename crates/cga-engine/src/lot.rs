@@ -1,0 +1,207 @@
+//! Initial shapes: lots from a `W,D` rectangle, OBJ faces or GeoJSON polygons.
+//!
+//! Conventions: y is up, lots lie in the x-z plane, counter-clockwise seen
+//! from above (a lot given clockwise is reversed), and the first edge is the
+//! street front. The initial pivot sits on the first vertex with its x axis
+//! along the first edge and its y axis along the lot's normal; the scope is
+//! the lot's bounding box in that frame.
+
+use std::sync::Arc;
+
+use cga_geometry::{DMat3, DVec3, Mesh};
+use cga_value::Value;
+
+use crate::material_attr::MaterialOverrides;
+use crate::shape::{Frame, Geometry, Scope, Shape, TrimFlags};
+
+/// One lot: its polygon (object coordinates) and per-lot attribute values.
+#[derive(Clone, Debug)]
+pub struct Lot {
+    pub name: String,
+    pub mesh: Mesh,
+    /// Values for rule attributes of the same name (GeoJSON properties).
+    pub attrs: Vec<(String, Value)>,
+}
+
+/// The lot `(0,0,0) (W,0,0) (W,0,-D) (0,0,-D)`.
+pub fn rect(w: f64, d: f64) -> Lot {
+    Lot {
+        name: format!("rect {w}x{d}"),
+        mesh: Mesh::polygon(&[
+            DVec3::ZERO,
+            DVec3::new(w, 0.0, 0.0),
+            DVec3::new(w, 0.0, -d),
+            DVec3::new(0.0, 0.0, -d),
+        ]),
+        attrs: Vec::new(),
+    }
+}
+
+/// Parses `W,D` (as in `--lot rect:20,30`).
+pub fn parse_rect(spec: &str) -> Result<Lot, String> {
+    let (w, d) = spec
+        .split_once(',')
+        .ok_or_else(|| format!("expected `rect:W,D`, found `rect:{spec}`"))?;
+    let parse = |s: &str| {
+        s.trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite() && *x > 0.0)
+            .ok_or_else(|| format!("`{s}` is not a positive size in `rect:{spec}`"))
+    };
+    Ok(rect(parse(w)?, parse(d)?))
+}
+
+/// Each face of an OBJ file is one lot.
+pub fn from_obj(path: &std::path::Path) -> Result<Vec<Lot>, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("cannot read lot file {}: {e}", path.display()))?;
+    let mut positions: Vec<DVec3> = Vec::new();
+    let mut lots = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("v") => {
+                let c: Vec<f64> = it.take(3).filter_map(|t| t.parse().ok()).collect();
+                if c.len() != 3 || c.iter().any(|x| !x.is_finite()) {
+                    return Err(format!("{}:{}: bad vertex line", path.display(), n + 1));
+                }
+                positions.push(DVec3::new(c[0], c[1], c[2]));
+            }
+            Some("f") => {
+                let mut pts = Vec::new();
+                for t in it {
+                    let i: i64 = t
+                        .split('/')
+                        .next()
+                        .and_then(|s| s.parse().ok())
+                        .ok_or_else(|| format!("{}:{}: bad face index", path.display(), n + 1))?;
+                    let idx = if i < 0 {
+                        positions.len() as i64 + i
+                    } else {
+                        i - 1
+                    };
+                    let p = usize::try_from(idx)
+                        .ok()
+                        .and_then(|i| positions.get(i))
+                        .ok_or_else(|| {
+                            format!("{}:{}: face index {i} out of range", path.display(), n + 1)
+                        })?;
+                    pts.push(*p);
+                }
+                if pts.len() >= 3 {
+                    lots.push(Lot {
+                        name: format!("{} face {}", path.display(), lots.len()),
+                        mesh: Mesh::polygon(&pts),
+                        attrs: Vec::new(),
+                    });
+                }
+            }
+            _ => {}
+        }
+    }
+    if lots.is_empty() {
+        return Err(format!("{} has no faces to use as lots", path.display()));
+    }
+    Ok(lots)
+}
+
+/// The initial shape of a lot, ready for derivation.
+pub fn initial_shape(lot: &Lot, seed: u64, name: u32) -> Shape {
+    let mut mesh = lot.mesh.clone();
+    let (mut normal, mut x) = first_edge_frame(&mesh);
+    if normal.y < -1e-9 {
+        crate::shape::reverse_faces(&mut mesh);
+        (normal, x) = first_edge_frame(&mesh);
+    }
+    let y = normal;
+    let x = (x - y * x.dot(y)).normalize_or(DVec3::X);
+    let z = x.cross(y);
+    let axes = DMat3::from_cols(x, y, z);
+    let origin = mesh
+        .corners
+        .first()
+        .map(|&c| mesh.positions[c as usize])
+        .unwrap_or(DVec3::ZERO);
+    let pivot = Frame { origin, axes };
+    let local: Vec<DVec3> = mesh.positions.iter().map(|&p| pivot.to_local(p)).collect();
+    let (lo, hi) = local.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    );
+    let (lo, hi) = if lo.x.is_finite() {
+        (lo, hi)
+    } else {
+        (DVec3::ZERO, DVec3::ZERO)
+    };
+    let scope = Scope {
+        frame: Frame {
+            origin: pivot.to_object(lo),
+            axes,
+        },
+        size: hi - lo,
+        rot: DVec3::ZERO,
+    };
+    for (p, l) in mesh.positions.iter_mut().zip(local) {
+        *p = l - lo;
+    }
+    Shape {
+        scope,
+        pivot,
+        geometry: Geometry::new(Arc::new(mesh)),
+        parent_scope: scope,
+        material: Arc::new(MaterialOverrides::default()),
+        attrs: None,
+        split_index: 0.0,
+        split_total: 0.0,
+        comp: None,
+        trim: TrimFlags::default(),
+        projections: None,
+        rng: std::cell::Cell::new(seed ^ 0x5EED_0F_C6A_u64),
+        name,
+    }
+}
+
+/// The normal of the first face and the direction of its first edge.
+fn first_edge_frame(mesh: &Mesh) -> (DVec3, DVec3) {
+    if mesh.faces.is_empty() {
+        return (DVec3::Y, DVec3::X);
+    }
+    let pts: Vec<DVec3> = mesh.loop_points(mesh.outer_loop(0)).collect();
+    let mut n = DVec3::ZERO;
+    for i in 0..pts.len() {
+        n += pts[i].cross(pts[(i + 1) % pts.len()]);
+    }
+    let n = n.normalize_or(DVec3::Y);
+    // The first edge of non-zero length.
+    let x = (0..pts.len())
+        .map(|i| pts[(i + 1) % pts.len()] - pts[i])
+        .find(|e| e.length() > 1e-12)
+        .unwrap_or(DVec3::X);
+    (n, x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rect_lot_scope_is_w_0_d() {
+        let s = initial_shape(&rect(20.0, 30.0), 0, 0);
+        assert!((s.scope.size - DVec3::new(20.0, 0.0, 30.0)).length() < 1e-12);
+        // x along the first edge, y up, z towards the street (+z).
+        assert!((s.scope.frame.axes.x_axis - DVec3::X).length() < 1e-12);
+        assert!((s.scope.frame.axes.y_axis - DVec3::Y).length() < 1e-12);
+        assert!((s.scope.frame.origin - DVec3::new(0.0, 0.0, -30.0)).length() < 1e-12);
+        let m = s.object_mesh();
+        assert!(m.positions.iter().any(|p| (*p - DVec3::new(20.0, 0.0, -30.0)).length() < 1e-12));
+    }
+
+    #[test]
+    fn clockwise_lot_is_turned_up() {
+        let mut lot = rect(4.0, 2.0);
+        lot.mesh.corners.reverse();
+        let s = initial_shape(&lot, 0, 0);
+        assert!((s.scope.frame.axes.y_axis - DVec3::Y).length() < 1e-12);
+    }
+}

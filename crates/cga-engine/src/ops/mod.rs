@@ -1,0 +1,262 @@
+//! CGA operations: the table the resolver reads (names, arities, which
+//! arguments are selector keywords) and the dispatcher the interpreter calls.
+//! Each family of operations lives in its own module.
+
+mod attrs;
+mod create;
+mod scope_ops;
+mod transform;
+
+use cga_value::Value;
+
+use crate::derive::{Arg, Interp, RtError, ShapeState};
+use crate::expr::OpCall;
+use crate::program::AttrId;
+use crate::shape_fns::ShapeFn;
+
+/// What `set(target, value)` writes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SetTarget {
+    Attr(AttrId),
+    Shape(ShapeFn),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Op {
+    Extrude,
+    T,
+    Translate,
+    S,
+    R,
+    Rotate,
+    Center,
+    PrimitiveQuad,
+    PrimitiveDisk,
+    PrimitiveCube,
+    PrimitiveSphere,
+    PrimitiveCylinder,
+    PrimitiveCone,
+    Insert,
+    Color,
+    Set(SetTarget),
+    SetMaterial,
+    ResetMaterial,
+    Texture,
+    Print,
+    Report,
+    AlignScopeToAxes,
+    AlignScopeToGeometry,
+    SetPivot,
+    RotateScope,
+    MirrorScope,
+    ResetGeometry,
+    ReverseNormals,
+}
+
+/// How an operation's arguments are read by the resolver.
+pub struct OpInfo {
+    pub op: Op,
+    pub min_args: usize,
+    pub max_args: usize,
+    /// Whether the operation takes a `{ ... }` block.
+    pub block: bool,
+}
+
+/// Whether argument `pos` of `name` called with `arity` arguments is a
+/// selector keyword (`x`, `world.up`, `scopeCenter`, ...). `Maybe` means a
+/// name there is a selector if it is a known selector word, else an expression.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ArgMode {
+    Expr,
+    Selector,
+    Maybe,
+}
+
+pub fn arg_mode(name: &str, arity: usize, pos: usize) -> ArgMode {
+    use ArgMode::*;
+    match (name, arity, pos) {
+        ("split" | "splitArea" | "comp" | "center" | "alignScopeToAxes", _, _) => Selector,
+        ("extrude", 2, 0) => Selector,
+        ("r", 4, 0) => Selector,
+        ("translate" | "rotate", _, 0 | 1) => Selector,
+        ("alignScopeToGeometry", _, 0) => Selector,
+        ("alignScopeToGeometry", _, 1 | 2) => Maybe,
+        ("setPivot", _, 0) => Selector,
+        ("i", _, 1..) => Selector,
+        ("setupProjection", _, 1) => Selector,
+        ("offset", 2, 1) => Selector,
+        ("envelope", _, 0) => Selector,
+        ("setback" | "setbackPerEdge" | "setbackToArea" | "shapeL" | "shapeU" | "shapeO", _, _) => {
+            Maybe
+        }
+        ("innerRectangle" | "innerRect" | "footprint" | "convexify", _, _) => Maybe,
+        ("roofGable" | "roofHip" | "roofShed" | "roofPyramid" | "roofRidge", _, 0) => Maybe,
+        ("scatter" | "rectify" | "cleanupGeometry" | "setNormals" | "mirror", _, _) => Maybe,
+        ("trim" | "taper" | "reduceGeometry" | "insertAlongUV", _, _) => Maybe,
+        _ => Expr,
+    }
+}
+
+pub fn lookup(name: &str) -> Option<OpInfo> {
+    let info = |op, min_args, max_args| {
+        Some(OpInfo {
+            op,
+            min_args,
+            max_args,
+            block: false,
+        })
+    };
+    match name {
+        "extrude" => info(Op::Extrude, 1, 2),
+        "t" => info(Op::T, 3, 3),
+        "translate" => info(Op::Translate, 5, 5),
+        "s" => info(Op::S, 3, 3),
+        "r" => info(Op::R, 3, 4),
+        "rotate" => info(Op::Rotate, 5, 5),
+        "center" => info(Op::Center, 1, 1),
+        "primitiveQuad" => info(Op::PrimitiveQuad, 0, 2),
+        "primitiveDisk" => info(Op::PrimitiveDisk, 0, 2),
+        "primitiveCube" => info(Op::PrimitiveCube, 0, 3),
+        "primitiveSphere" => info(Op::PrimitiveSphere, 0, 3),
+        "primitiveCylinder" => info(Op::PrimitiveCylinder, 0, 3),
+        "primitiveCone" => info(Op::PrimitiveCone, 0, 3),
+        "i" | "insert" => info(Op::Insert, 1, 4),
+        "color" => info(Op::Color, 1, 4),
+        "setMaterial" => info(Op::SetMaterial, 1, 1),
+        "resetMaterial" => info(Op::ResetMaterial, 0, 0),
+        "texture" => info(Op::Texture, 1, 1),
+        "print" => info(Op::Print, 1, 1),
+        "report" => info(Op::Report, 2, 2),
+        "alignScopeToAxes" => info(Op::AlignScopeToAxes, 0, 1),
+        "alignScopeToGeometry" => info(Op::AlignScopeToGeometry, 2, 3),
+        "setPivot" => info(Op::SetPivot, 2, 2),
+        "rotateScope" => info(Op::RotateScope, 3, 3),
+        "mirrorScope" => info(Op::MirrorScope, 3, 3),
+        "resetGeometry" => info(Op::ResetGeometry, 0, 0),
+        "reverseNormals" => info(Op::ReverseNormals, 0, 0),
+        _ => None,
+    }
+}
+
+/// Every operation of CGA, implemented here or not: a call of one of these
+/// that the engine does not run yet is a warning, not an error.
+pub const ALL_OPERATIONS: &[&str] = &[
+    "alignScopeToAxes",
+    "alignScopeToGeometry",
+    "alignScopeToGeometryBBox",
+    "center",
+    "cleanupGeometry",
+    "color",
+    "comp",
+    "convexify",
+    "copyUV",
+    "deleteHoles",
+    "deleteTags",
+    "deleteUV",
+    "envelope",
+    "extrude",
+    "footprint",
+    "i",
+    "inline",
+    "innerRect",
+    "innerRectangle",
+    "insert",
+    "insertAlongUV",
+    "intersect",
+    "label",
+    "mirror",
+    "mirrorScope",
+    "modify",
+    "normalizeUV",
+    "offset",
+    "primitiveCone",
+    "primitiveCube",
+    "primitiveCylinder",
+    "primitiveDisk",
+    "primitiveQuad",
+    "primitiveSphere",
+    "print",
+    "projectUV",
+    "r",
+    "rectify",
+    "reduceGeometry",
+    "report",
+    "resetGeometry",
+    "resetMaterial",
+    "reverseNormals",
+    "roofGable",
+    "roofHip",
+    "roofPyramid",
+    "roofRidge",
+    "roofShed",
+    "rotate",
+    "rotateScope",
+    "rotateUV",
+    "s",
+    "scaleUV",
+    "scatter",
+    "set",
+    "setMaterial",
+    "setNormals",
+    "setPivot",
+    "setTagsFromEdgeAttrs",
+    "setback",
+    "setbackPerEdge",
+    "setbackToArea",
+    "setupProjection",
+    "shapeL",
+    "shapeO",
+    "shapeU",
+    "softenNormals",
+    "split",
+    "splitAndSetbackPerimeter",
+    "splitArea",
+    "subtract",
+    "t",
+    "tag",
+    "taper",
+    "texture",
+    "tileUV",
+    "translate",
+    "translateUV",
+    "trim",
+    "union",
+];
+
+/// Runs one operation on the current shape.
+pub fn exec(
+    cx: &mut Interp,
+    st: &mut ShapeState,
+    call: &OpCall,
+    args: &[Arg],
+    frame: &[Value],
+) -> Result<(), RtError> {
+    let _ = frame;
+    match call.op {
+        Op::T | Op::Translate | Op::S | Op::R | Op::Rotate | Op::Center => {
+            transform::exec(cx, st, call, args)
+        }
+        Op::Extrude
+        | Op::PrimitiveQuad
+        | Op::PrimitiveDisk
+        | Op::PrimitiveCube
+        | Op::PrimitiveSphere
+        | Op::PrimitiveCylinder
+        | Op::PrimitiveCone
+        | Op::Insert
+        | Op::ReverseNormals => create::exec(cx, st, call, args),
+        Op::Color
+        | Op::Set(_)
+        | Op::SetMaterial
+        | Op::ResetMaterial
+        | Op::Texture
+        | Op::Print
+        | Op::Report => attrs::exec(cx, st, call, args),
+        Op::AlignScopeToAxes
+        | Op::AlignScopeToGeometry
+        | Op::SetPivot
+        | Op::RotateScope
+        | Op::MirrorScope
+        | Op::ResetGeometry => scope_ops::exec(cx, st, call, args),
+    }
+}

@@ -1,0 +1,1124 @@
+//! Loading and resolving rule files: parse the main file and its imports,
+//! give every attribute, function and rule an index, and turn the syntax
+//! trees into resolved bodies and expressions (`expr.rs`).
+//!
+//! Imports: each `import` statement instantiates the imported file as a rule
+//! set of its own. An attribute of an imported file takes the value of the
+//! importing file's attribute of the same name (propagation) unless it is
+//! protected (`import x : "f.cga" (height)` or `( )`) or set explicitly
+//! (`( height = 20 )`, evaluated in the importing file). Extension rules can
+//! be redefined by the importer (`( Roof --> roofHip(30) )`).
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use cga_syntax::ast::{self, Body, BlockPart, Expr, ExprKind, Item, Stmt};
+use cga_syntax::{Diagnostic, FileId, SourceMap, Span};
+use cga_value::Value;
+
+use crate::expr::{OpCall, RBlock, RBody, RExpr, RExprKind, RPart, RStmt, RuleCall};
+use crate::ops::{self, ArgMode, Op, SetTarget};
+use crate::program::{
+    AnnotationInfo, AttrDef, AttrId, FuncId, FunctionDef, Program, RuleDef, RuleId, RuleSet,
+    RuleSetId,
+};
+use crate::shape_fns;
+use crate::value_shim;
+
+/// The result of loading a rule file: the program (if it resolved without
+/// errors) and every diagnostic found.
+pub struct Loaded {
+    pub program: Option<Program>,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+/// Loads `path` and everything it imports into `sources`, parses and resolves.
+pub fn load(path: &Path, sources: &mut SourceMap) -> Loaded {
+    let mut r = Resolver {
+        sources,
+        program: Program::default(),
+        diags: Vec::new(),
+        tables: Vec::new(),
+        parsed: HashMap::new(),
+        parsed_files: Vec::new(),
+        stack: Vec::new(),
+        pending: Vec::new(),
+        symbols: HashMap::new(),
+    };
+    let text = match std::fs::read_to_string(path) {
+        Ok(t) => t,
+        Err(e) => {
+            return Loaded {
+                program: None,
+                diagnostics: vec![plain_error(format!(
+                    "cannot read rule file {}: {e}",
+                    path.display()
+                ))],
+            }
+        }
+    };
+    let main = r.parse_file(path, text);
+    r.instantiate(main, String::new(), None);
+    r.resolve_pending();
+    if let Some(t) = r.tables.first() {
+        let mut attrs: Vec<_> = t.attrs.iter().map(|(n, &id)| (n.clone(), id)).collect();
+        attrs.sort();
+        r.program.main_attrs = attrs;
+        let mut rules: Vec<_> = t
+            .rules
+            .iter()
+            .flat_map(|(n, ids)| ids.iter().map(move |&id| (n.clone(), id)))
+            .collect();
+        rules.sort_by_key(|&(_, id)| id);
+        r.program.main_rules = rules;
+    }
+    let has_errors = r.diags.iter().any(|d| d.is_error());
+    let mut program = r.program;
+    program.symbols = {
+        let mut v = vec![Arc::<str>::from(""); r.symbols.len()];
+        for (name, id) in r.symbols {
+            v[id as usize] = name;
+        }
+        v
+    };
+    Loaded {
+        program: if has_errors { None } else { Some(program) },
+        diagnostics: r.diags,
+    }
+}
+
+fn plain_error(message: String) -> Diagnostic {
+    Diagnostic {
+        severity: cga_syntax::Severity::Error,
+        message,
+        span: None,
+        label: None,
+        notes: Vec::new(),
+    }
+}
+
+struct ParsedFile {
+    file: FileId,
+    path: PathBuf,
+    module: Arc<ast::Module>,
+}
+
+/// Names visible in one rule set.
+#[derive(Default)]
+struct Tables {
+    file: usize,
+    attrs: HashMap<String, AttrId>,
+    funcs: HashMap<String, Vec<FuncId>>,
+    rules: HashMap<String, Vec<RuleId>>,
+    imports: HashMap<String, RuleSetId>,
+    start_rule: Option<RuleId>,
+}
+
+/// Work left for after every rule set is declared (bodies may reference
+/// rules of any rule set).
+enum Pending {
+    Attr {
+        id: AttrId,
+        ruleset: RuleSetId,
+        decl: ast::AttrDecl,
+    },
+    /// An attribute value set by an importer, resolved in the importer.
+    AttrOverride {
+        id: AttrId,
+        importer: RuleSetId,
+        expr: Expr,
+    },
+    Function {
+        id: FuncId,
+        ruleset: RuleSetId,
+        decl: ast::FunctionDecl,
+    },
+    Rule {
+        id: RuleId,
+        ruleset: RuleSetId,
+        params: Vec<ast::Param>,
+        locals: Vec<ast::LocalVar>,
+        body: Body,
+    },
+}
+
+struct Resolver<'s> {
+    sources: &'s mut SourceMap,
+    program: Program,
+    diags: Vec<Diagnostic>,
+    tables: Vec<Tables>,
+    parsed: HashMap<PathBuf, usize>,
+    parsed_files: Vec<ParsedFile>,
+    /// Files being instantiated (import cycle detection).
+    stack: Vec<PathBuf>,
+    pending: Vec<Pending>,
+    symbols: HashMap<Arc<str>, u32>,
+}
+
+/// Which items of a module are in the default style (those before the first
+/// `style` statement, and those after `style Default`).
+fn default_style_items(module: &ast::Module) -> impl Iterator<Item = &Item> {
+    let mut in_default = true;
+    module.items.iter().filter(move |item| {
+        if let Item::Style { name, .. } = item {
+            in_default = name.name == "Default";
+            return false;
+        }
+        in_default || matches!(item, Item::Import(_) | Item::Version { .. })
+    })
+}
+
+/// Names in scope inside one definition: parameters, then `with` locals.
+struct Cx {
+    rs: RuleSetId,
+    locals: Vec<String>,
+}
+
+impl Cx {
+    fn local(&self, name: &str) -> Option<u16> {
+        self.locals.iter().rposition(|l| l == name).map(|i| i as u16)
+    }
+}
+
+fn placeholder(span: Span) -> RExpr {
+    RExpr::constant(Value::Float(0.0), span)
+}
+
+impl Resolver<'_> {
+    fn error(&mut self, message: impl Into<String>, span: Span) {
+        self.diags.push(Diagnostic::error(message, span));
+    }
+
+    fn symbol(&mut self, name: &str) -> u32 {
+        if let Some(&id) = self.symbols.get(name) {
+            return id;
+        }
+        let id = self.symbols.len() as u32;
+        self.symbols.insert(Arc::from(name), id);
+        id
+    }
+
+    fn parse_file(&mut self, path: &Path, text: String) -> usize {
+        let key = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
+        if let Some(&idx) = self.parsed.get(&key) {
+            return idx;
+        }
+        let file = self.sources.add(path, text);
+        let (module, diags) = cga_syntax::parse(file, &self.sources.get(file).text);
+        self.diags.extend(diags);
+        let idx = self.parsed_files.len();
+        self.parsed_files.push(ParsedFile {
+            file,
+            path: key.clone(),
+            module: Arc::new(module),
+        });
+        self.parsed.insert(key, idx);
+        idx
+    }
+
+    /// Creates the rule set for one instance of a parsed file and declares
+    /// its names; bodies are resolved later (`resolve_pending`).
+    fn instantiate(
+        &mut self,
+        file_idx: usize,
+        prefix: String,
+        importer: Option<(RuleSetId, ast::ImportDecl)>,
+    ) -> RuleSetId {
+        let module = self.parsed_files[file_idx].module.clone();
+        let path = self.parsed_files[file_idx].path.clone();
+        let rs = self.program.rulesets.len() as RuleSetId;
+        self.program.rulesets.push(RuleSet {
+            prefix: prefix.clone(),
+            path: path.clone(),
+        });
+        self.tables.push(Tables {
+            file: file_idx,
+            ..Tables::default()
+        });
+        let overrides: Option<Vec<ast::ImportOverride>> =
+            importer.as_ref().and_then(|(_, d)| d.overrides.clone());
+
+        for item in default_style_items(&module) {
+            match item {
+                Item::Attr(decl) => self.declare_attr(rs, decl, importer.as_ref().map(|i| i.0), &overrides),
+                Item::Function(decl) => {
+                    let id = self.program.functions.len() as FuncId;
+                    self.program.functions.push(FunctionDef {
+                        name: decl.name.name.clone(),
+                        ruleset: rs,
+                        arity: decl.params.len(),
+                        is_const: decl.is_const,
+                        frame_size: decl.params.len() + decl.locals.len(),
+                        locals: Vec::new(),
+                        body: placeholder(decl.span),
+                        span: decl.name.span,
+                    });
+                    let same = self.tables[rs as usize]
+                        .funcs
+                        .entry(decl.name.name.clone())
+                        .or_default();
+                    let dup = same
+                        .iter()
+                        .any(|&f| self.program.functions[f as usize].arity == decl.params.len());
+                    same.push(id);
+                    if dup {
+                        self.error(
+                            format!(
+                                "function `{}` with {} parameters is defined twice",
+                                decl.name.name,
+                                decl.params.len()
+                            ),
+                            decl.name.span,
+                        );
+                    }
+                    self.pending.push(Pending::Function {
+                        id,
+                        ruleset: rs,
+                        decl: decl.clone(),
+                    });
+                }
+                Item::Rule(decl) => self.declare_rule(rs, decl, importer.as_ref().map(|i| i.0), &overrides),
+                _ => {}
+            }
+        }
+
+        for item in &module.items {
+            let Item::Import(decl) = item else { continue };
+            let Some(target) = self.find_import(&path, &decl.path) else {
+                self.diags.push(
+                    Diagnostic::error(
+                        format!("cannot find the imported rule file \"{}\"", decl.path),
+                        decl.path_span,
+                    )
+                    .with_label("not found relative to this rule file or its project"),
+                );
+                continue;
+            };
+            if self.stack.contains(&target) || target == path {
+                self.error(
+                    format!("import cycle: \"{}\" imports itself", decl.path),
+                    decl.path_span,
+                );
+                continue;
+            }
+            let text = match std::fs::read_to_string(&target) {
+                Ok(t) => t,
+                Err(e) => {
+                    self.error(
+                        format!("cannot read imported rule file {}: {e}", target.display()),
+                        decl.path_span,
+                    );
+                    continue;
+                }
+            };
+            let child_file = self.parse_file(&target, text);
+            let alias = decl.alias.as_ref().map(|a| a.name.clone());
+            let child_prefix = match (&alias, prefix.is_empty()) {
+                (Some(a), true) => a.clone(),
+                (Some(a), false) => format!("{prefix}.{a}"),
+                (None, _) => prefix.clone(),
+            };
+            self.stack.push(path.clone());
+            let child = self.instantiate(child_file, child_prefix, Some((rs, decl.clone())));
+            self.stack.pop();
+            if let Some(a) = alias {
+                self.tables[rs as usize].imports.insert(a, child);
+            }
+        }
+        rs
+    }
+
+    fn declare_attr(
+        &mut self,
+        rs: RuleSetId,
+        decl: &ast::AttrDecl,
+        importer: Option<RuleSetId>,
+        overrides: &Option<Vec<ast::ImportOverride>>,
+    ) {
+        let name = &decl.name.name;
+        if self.tables[rs as usize].attrs.contains_key(name) {
+            self.error(format!("attribute `{name}` is defined twice"), decl.name.span);
+            return;
+        }
+        let explicit = overrides.as_ref().and_then(|list| {
+            list.iter().find_map(|o| match o {
+                ast::ImportOverride::Attr(n, e) if &n.name == name => Some(e.clone()),
+                _ => None,
+            })
+        });
+        let protected = overrides.as_ref().is_some_and(|list| {
+            list.is_empty()
+                || list
+                    .iter()
+                    .any(|o| matches!(o, ast::ImportOverride::Protect(n) if &n.name == name))
+        });
+        if let (Some(imp), None, false) = (importer, &explicit, protected) {
+            if let Some(&slot) = self.tables[imp as usize].attrs.get(name) {
+                // Propagation: the importer's attribute of the same name.
+                self.tables[rs as usize].attrs.insert(name.clone(), slot);
+                return;
+            }
+        }
+        let id = self.program.attrs.len() as AttrId;
+        self.program.attrs.push(AttrDef {
+            name: name.clone(),
+            ruleset: rs,
+            default: placeholder(decl.span),
+            frame_size: decl.locals.len(),
+            annotations: annotations(&decl.annotations),
+            span: decl.name.span,
+        });
+        self.tables[rs as usize].attrs.insert(name.clone(), id);
+        match (explicit, importer) {
+            (Some(expr), Some(imp)) => self.pending.push(Pending::AttrOverride {
+                id,
+                importer: imp,
+                expr,
+            }),
+            _ => self.pending.push(Pending::Attr {
+                id,
+                ruleset: rs,
+                decl: decl.clone(),
+            }),
+        }
+    }
+
+    fn declare_rule(
+        &mut self,
+        rs: RuleSetId,
+        decl: &ast::RuleDecl,
+        importer: Option<RuleSetId>,
+        overrides: &Option<Vec<ast::ImportOverride>>,
+    ) {
+        let name = &decl.name.name;
+        let id = self.program.rules.len() as RuleId;
+        let symbol = self.symbol(name);
+        self.program.rules.push(RuleDef {
+            name: name.clone(),
+            ruleset: rs,
+            arity: decl.params.len(),
+            frame_size: decl.params.len() + decl.locals.len(),
+            locals: Vec::new(),
+            body: RBody::Ops(Vec::new()),
+            annotations: annotations(&decl.annotations),
+            is_start: decl.kind == ast::RuleKind::Start,
+            symbol,
+            span: decl.name.span,
+        });
+        let same = self.tables[rs as usize].rules.entry(name.clone()).or_default();
+        let dup = same
+            .iter()
+            .any(|&r| self.program.rules[r as usize].arity == decl.params.len());
+        same.push(id);
+        if dup {
+            self.error(
+                format!(
+                    "rule `{name}` with {} parameters is defined twice",
+                    decl.params.len()
+                ),
+                decl.name.span,
+            );
+        }
+        if decl.kind == ast::RuleKind::Start {
+            self.tables[rs as usize].start_rule = Some(id);
+        }
+        // An importer may redefine an extension rule; its body is then
+        // resolved in the importer's rule set.
+        let redefined = (decl.kind == ast::RuleKind::Extension)
+            .then(|| {
+                overrides.as_ref().and_then(|list| {
+                    list.iter().find_map(|o| match o {
+                        ast::ImportOverride::Rule { name: n, params, body } if &n.name == name => {
+                            Some((params.clone(), body.clone()))
+                        }
+                        _ => None,
+                    })
+                })
+            })
+            .flatten();
+        match (redefined, importer) {
+            (Some((params, body)), Some(imp)) => self.pending.push(Pending::Rule {
+                id,
+                ruleset: imp,
+                params,
+                locals: Vec::new(),
+                body,
+            }),
+            _ => self.pending.push(Pending::Rule {
+                id,
+                ruleset: rs,
+                params: decl.params.clone(),
+                locals: decl.locals.clone(),
+                body: decl.body.clone(),
+            }),
+        }
+    }
+
+    /// Finds an imported file: relative to the importing file, then to each
+    /// of its ancestor folders (project roots: `rules/x.cga` from inside
+    /// `rules/`), and for absolute workspace paths (`/ESRI.lib/...`) inside an
+    /// ancestor or its `.ws` workspace folder.
+    fn find_import(&self, importer: &Path, target: &str) -> Option<PathBuf> {
+        find_relative(importer, target)
+    }
+
+    fn resolve_pending(&mut self) {
+        let pending = std::mem::take(&mut self.pending);
+        for p in pending {
+            match p {
+                Pending::Attr { id, ruleset, decl } => {
+                    let mut cx = Cx {
+                        rs: ruleset,
+                        locals: Vec::new(),
+                    };
+                    let locals = self.resolve_locals(&mut cx, &decl.locals);
+                    let value = self.expr(&cx, &decl.value);
+                    let default = if locals.is_empty() {
+                        value
+                    } else {
+                        wrap_locals(locals, value)
+                    };
+                    self.program.attrs[id as usize].default = default;
+                }
+                Pending::AttrOverride { id, importer, expr } => {
+                    let cx = Cx {
+                        rs: importer,
+                        locals: Vec::new(),
+                    };
+                    self.program.attrs[id as usize].default = self.expr(&cx, &expr);
+                }
+                Pending::Function { id, ruleset, decl } => {
+                    let mut cx = Cx {
+                        rs: ruleset,
+                        locals: decl.params.iter().map(|p| p.name.name.clone()).collect(),
+                    };
+                    let locals = self.resolve_locals(&mut cx, &decl.locals);
+                    let body = self.expr(&cx, &decl.value);
+                    let f = &mut self.program.functions[id as usize];
+                    f.locals = locals;
+                    f.body = body;
+                }
+                Pending::Rule {
+                    id,
+                    ruleset,
+                    params,
+                    locals,
+                    body,
+                } => {
+                    let mut cx = Cx {
+                        rs: ruleset,
+                        locals: params.iter().map(|p| p.name.name.clone()).collect(),
+                    };
+                    let locals = self.resolve_locals(&mut cx, &locals);
+                    let body = self.body(&cx, &body);
+                    let r = &mut self.program.rules[id as usize];
+                    r.locals = locals;
+                    r.frame_size = params.len() + r.locals.len();
+                    r.body = body;
+                }
+            }
+        }
+    }
+
+    fn resolve_locals(&mut self, cx: &mut Cx, locals: &[ast::LocalVar]) -> Vec<RExpr> {
+        let mut out = Vec::with_capacity(locals.len());
+        for l in locals {
+            out.push(self.expr(cx, &l.value));
+            cx.locals.push(l.name.name.clone());
+        }
+        out
+    }
+
+    // ----- names -----
+
+    /// Follows `alias.rest` through imports: the rule set and the rest of the name.
+    fn through_alias<'n>(&self, rs: RuleSetId, name: &'n str) -> Option<(RuleSetId, &'n str)> {
+        let (alias, rest) = name.split_once('.')?;
+        let child = *self.tables[rs as usize].imports.get(alias)?;
+        Some((child, rest))
+    }
+
+    fn find_attr(&self, rs: RuleSetId, name: &str) -> Option<AttrId> {
+        if let Some(&id) = self.tables[rs as usize].attrs.get(name) {
+            return Some(id);
+        }
+        let (child, rest) = self.through_alias(rs, name)?;
+        self.find_attr(child, rest)
+    }
+
+    fn find_func(&self, rs: RuleSetId, name: &str, arity: usize) -> Option<FuncId> {
+        if let Some(ids) = self.tables[rs as usize].funcs.get(name) {
+            if let Some(&id) = ids
+                .iter()
+                .find(|&&f| self.program.functions[f as usize].arity == arity)
+            {
+                return Some(id);
+            }
+        }
+        let (child, rest) = self.through_alias(rs, name)?;
+        self.find_func(child, rest, arity)
+    }
+
+    fn find_rule(&self, rs: RuleSetId, name: &str, arity: usize) -> Option<RuleId> {
+        let t = &self.tables[rs as usize];
+        if name == "start" {
+            if let Some(id) = t.start_rule {
+                if self.program.rules[id as usize].arity == arity {
+                    return Some(id);
+                }
+            }
+        }
+        if let Some(ids) = t.rules.get(name) {
+            if let Some(&id) = ids
+                .iter()
+                .find(|&&r| self.program.rules[r as usize].arity == arity)
+            {
+                return Some(id);
+            }
+        }
+        let (child, rest) = self.through_alias(rs, name)?;
+        self.find_rule(child, rest, arity)
+    }
+
+    /// Arities of the rules called `name` (for an arity mismatch message).
+    fn rule_arities(&self, rs: RuleSetId, name: &str) -> Vec<usize> {
+        if let Some(ids) = self.tables[rs as usize].rules.get(name) {
+            return ids
+                .iter()
+                .map(|&r| self.program.rules[r as usize].arity)
+                .collect();
+        }
+        match self.through_alias(rs, name) {
+            Some((child, rest)) => self.rule_arities(child, rest),
+            None => Vec::new(),
+        }
+    }
+
+    /// The closest known name to `name`, for "did you mean" hints.
+    fn suggest(&self, rs: RuleSetId, name: &str, kind: NameKind) -> Option<String> {
+        let t = &self.tables[rs as usize];
+        let mut candidates: Vec<&str> = Vec::new();
+        match kind {
+            NameKind::Value => {
+                candidates.extend(t.attrs.keys().map(|s| s.as_str()));
+                candidates.extend(t.funcs.keys().map(|s| s.as_str()));
+                candidates.extend(KNOWN_FUNCTIONS);
+            }
+            NameKind::Statement => {
+                candidates.extend(t.rules.keys().map(|s| s.as_str()));
+                candidates.extend(ops::ALL_OPERATIONS);
+            }
+        }
+        candidates
+            .into_iter()
+            .map(|c| (strsim::damerau_levenshtein(name, c), c))
+            .filter(|&(d, c)| d <= 2.max(name.len() / 4) && d < c.len())
+            .min()
+            .map(|(_, c)| c.to_string())
+    }
+
+    fn unknown(&mut self, what: &str, ident: &ast::Ident, rs: RuleSetId, kind: NameKind) {
+        let mut d = Diagnostic::error(format!("unknown {what} `{}`", ident.name), ident.span)
+            .with_label(format!("not a known {what}"));
+        if let Some(s) = self.suggest(rs, &ident.name, kind) {
+            d = d.with_note(format!("help: did you mean `{s}`?"));
+        }
+        self.diags.push(d);
+    }
+
+    // ----- expressions -----
+
+    fn expr(&mut self, cx: &Cx, e: &Expr) -> RExpr {
+        let span = e.span;
+        let kind = match &e.kind {
+            ExprKind::Float(x) => RExprKind::Const(Value::Float(*x)),
+            ExprKind::Bool(b) => RExprKind::Const(Value::Bool(*b)),
+            ExprKind::Str(s) => RExprKind::Const(Value::Str(Arc::from(s.as_str()))),
+            ExprKind::Name(ident) => return self.name(cx, ident, false),
+            ExprKind::Call { name, args } => {
+                let args: Vec<RExpr> = args.iter().map(|a| self.expr(cx, a)).collect();
+                return self.call(cx, name, args, span);
+            }
+            ExprKind::Unary {
+                op,
+                elementwise,
+                operand,
+            } => RExprKind::Unary {
+                op: *op,
+                elementwise: *elementwise,
+                operand: Box::new(self.expr(cx, operand)),
+            },
+            ExprKind::Binary {
+                op,
+                elementwise,
+                lhs,
+                rhs,
+            } => RExprKind::Binary {
+                op: *op,
+                elementwise: *elementwise,
+                lhs: Box::new(self.expr(cx, lhs)),
+                rhs: Box::new(self.expr(cx, rhs)),
+            },
+            ExprKind::Array(rows) => RExprKind::Array(
+                rows.iter()
+                    .map(|r| r.iter().map(|x| self.expr(cx, x)).collect())
+                    .collect(),
+            ),
+            ExprKind::Range { base, step, limit } => RExprKind::Range {
+                base: Box::new(self.expr(cx, base)),
+                step: step.as_ref().map(|s| Box::new(self.expr(cx, s))),
+                limit: Box::new(self.expr(cx, limit)),
+            },
+            ExprKind::Index { base, indices } => RExprKind::Index {
+                base: Box::new(self.expr(cx, base)),
+                indices: indices.iter().map(|i| self.expr(cx, i)).collect(),
+            },
+            ExprKind::Case(chain) => RExprKind::Case {
+                branches: chain
+                    .branches
+                    .iter()
+                    .map(|(c, v)| (self.expr(cx, c), self.expr(cx, v)))
+                    .collect(),
+                otherwise: chain.otherwise.as_ref().map(|v| Box::new(self.expr(cx, v))),
+            },
+            ExprKind::Stochastic(chain) => RExprKind::Stochastic {
+                branches: chain
+                    .branches
+                    .iter()
+                    .map(|(c, v)| (self.expr(cx, c), self.expr(cx, v)))
+                    .collect(),
+                otherwise: chain.otherwise.as_ref().map(|v| Box::new(self.expr(cx, v))),
+            },
+            ExprKind::Relative(inner) => RExprKind::Relative(Box::new(self.expr(cx, inner))),
+            ExprKind::Floating(inner) => RExprKind::Floating(Box::new(self.expr(cx, inner))),
+            ExprKind::CompFn { args, block } => RExprKind::CompFn {
+                args: args.iter().map(|a| self.selector_arg(cx, a)).collect(),
+                block: self.expr_block(cx, block),
+            },
+        };
+        RExpr { kind, span }
+    }
+
+    fn expr_block(&mut self, cx: &Cx, b: &ast::Block<Expr>) -> RBlock<RExpr> {
+        RBlock {
+            parts: b
+                .parts
+                .iter()
+                .map(|p| match p {
+                    BlockPart::Entry(e) => RPart::Entry {
+                        head: self.head(cx, &e.head),
+                        op: e.op,
+                        body: self.expr(cx, &e.body),
+                        span: e.span,
+                    },
+                    BlockPart::Group(g) => RPart::Group(self.expr_block(cx, g)),
+                })
+                .collect(),
+            repeat: b.repeat,
+            span: b.span,
+        }
+    }
+
+    /// A name in value position. `selector_ok`: an unknown name is taken as
+    /// a selector keyword (a string constant) instead of an error.
+    fn name(&mut self, cx: &Cx, ident: &ast::Ident, selector_ok: bool) -> RExpr {
+        let span = ident.span;
+        let name = ident.name.as_str();
+        let kind = if let Some(i) = cx.local(name) {
+            RExprKind::Local(i)
+        } else if let Some(id) = self.find_attr(cx.rs, name) {
+            RExprKind::Attr(id)
+        } else if let Some(f) = self.find_func(cx.rs, name, 0) {
+            RExprKind::Func(f, Vec::new())
+        } else if let Some(f) = shape_fns::lookup(name, 0) {
+            RExprKind::Shape(f, Vec::new())
+        } else if let Some(b) = value_shim::lookup(name).filter(|b| b.min_args == 0) {
+            RExprKind::Pure(b, Vec::new())
+        } else if selector_ok {
+            RExprKind::Const(Value::Str(Arc::from(name)))
+        } else {
+            self.unknown("name", ident, cx.rs, NameKind::Value);
+            return placeholder(span);
+        };
+        RExpr { kind, span }
+    }
+
+    fn call(&mut self, cx: &Cx, name: &ast::Ident, args: Vec<RExpr>, span: Span) -> RExpr {
+        let n = args.len();
+        let kind = if let Some(f) = self.find_func(cx.rs, &name.name, n) {
+            RExprKind::Func(f, args)
+        } else if let Some(f) = shape_fns::lookup(&name.name, n) {
+            RExprKind::Shape(f, args)
+        } else if let Some(b) = value_shim::lookup(&name.name) {
+            if n < b.min_args || n > b.max_args {
+                self.error(
+                    format!(
+                        "`{}` takes {} arguments, found {n}",
+                        name.name,
+                        arity_text(b.min_args, b.max_args)
+                    ),
+                    span,
+                );
+                return placeholder(span);
+            }
+            RExprKind::Pure(b, args)
+        } else {
+            self.unknown("function", name, cx.rs, NameKind::Value);
+            return placeholder(span);
+        };
+        RExpr { kind, span }
+    }
+
+    /// A block head (split size or comp selector): names that are not values
+    /// are selector keywords.
+    fn head(&mut self, cx: &Cx, e: &Expr) -> RExpr {
+        match &e.kind {
+            ExprKind::Name(ident) => self.name(cx, ident, true),
+            ExprKind::Relative(inner) => RExpr {
+                kind: RExprKind::Relative(Box::new(self.head(cx, inner))),
+                span: e.span,
+            },
+            ExprKind::Floating(inner) => RExpr {
+                kind: RExprKind::Floating(Box::new(self.head(cx, inner))),
+                span: e.span,
+            },
+            _ => self.expr(cx, e),
+        }
+    }
+
+    fn selector_arg(&mut self, _cx: &Cx, e: &Expr) -> RExpr {
+        match &e.kind {
+            ExprKind::Name(ident) => {
+                RExpr::constant(Value::Str(Arc::from(ident.name.as_str())), e.span)
+            }
+            _ => self.expr(_cx, e),
+        }
+    }
+
+    // ----- bodies -----
+
+    fn body(&mut self, cx: &Cx, b: &Body) -> RBody {
+        match b {
+            Body::Ops(stmts) => RBody::Ops(stmts.iter().map(|s| self.stmt(cx, s)).collect()),
+            Body::Case(chain) => RBody::Case {
+                branches: chain
+                    .branches
+                    .iter()
+                    .map(|(c, b)| (self.expr(cx, c), self.body(cx, b)))
+                    .collect(),
+                otherwise: chain.otherwise.as_ref().map(|b| Box::new(self.body(cx, b))),
+            },
+            Body::Stochastic(chain) => RBody::Stochastic {
+                branches: chain
+                    .branches
+                    .iter()
+                    .map(|(c, b)| (self.expr(cx, c), self.body(cx, b)))
+                    .collect(),
+                otherwise: chain.otherwise.as_ref().map(|b| Box::new(self.body(cx, b))),
+            },
+        }
+    }
+
+    fn op_block(&mut self, cx: &Cx, b: &ast::Block<Body>) -> RBlock<RBody> {
+        RBlock {
+            parts: b
+                .parts
+                .iter()
+                .map(|p| match p {
+                    BlockPart::Entry(e) => RPart::Entry {
+                        head: self.head(cx, &e.head),
+                        op: e.op,
+                        body: self.body(cx, &e.body),
+                        span: e.span,
+                    },
+                    BlockPart::Group(g) => RPart::Group(self.op_block(cx, g)),
+                })
+                .collect(),
+            repeat: b.repeat,
+            span: b.span,
+        }
+    }
+
+    fn stmt(&mut self, cx: &Cx, s: &Stmt) -> RStmt {
+        match s {
+            Stmt::Call(call) => self.call_stmt(cx, call),
+            Stmt::Leaf(ident) => RStmt::Leaf(self.symbol(&ident.name)),
+            Stmt::Nil(_) => RStmt::Nil,
+            Stmt::Push(body, _) => RStmt::Push(self.body(cx, body)),
+        }
+    }
+
+    fn call_stmt(&mut self, cx: &Cx, call: &ast::Call) -> RStmt {
+        let name = call.name.name.as_str();
+        let arity = call.args.as_ref().map_or(0, |a| a.len());
+        let span = call.span;
+
+        if name == "set" && call.block.is_none() {
+            return self.set_stmt(cx, call);
+        }
+        if let Some(rule) = self.find_rule(cx.rs, name, arity) {
+            let args = call
+                .args
+                .iter()
+                .flatten()
+                .map(|a| self.expr(cx, a))
+                .collect();
+            let attr_overrides = match &call.import_overrides {
+                Some(list) => self.dynamic_overrides(cx, name, list),
+                None => Vec::new(),
+            };
+            if let Some(b) = &call.block {
+                self.error("a rule call takes no `{ ... }` block", b.span);
+            }
+            return RStmt::Rule(RuleCall {
+                rule,
+                args,
+                attr_overrides,
+                span,
+            });
+        }
+        if let Some(info) = ops::lookup(name) {
+            if arity < info.min_args || arity > info.max_args {
+                self.error(
+                    format!(
+                        "`{name}` takes {} arguments, found {arity}",
+                        arity_text(info.min_args, info.max_args)
+                    ),
+                    span,
+                );
+                return RStmt::Nil;
+            }
+            let args = self.op_args(cx, name, call.args.as_deref().unwrap_or(&[]));
+            let block = call.block.as_ref().map(|b| self.op_block(cx, b));
+            if block.is_some() && !info.block {
+                self.error(format!("`{name}` takes no `{{ ... }}` block"), span);
+            }
+            return RStmt::Op(OpCall {
+                op: info.op,
+                args,
+                block,
+                span,
+            });
+        }
+        if ops::ALL_OPERATIONS.contains(&name) {
+            // Resolve what is inside anyway, so that its errors are reported.
+            let _ = self.op_args(cx, name, call.args.as_deref().unwrap_or(&[]));
+            if let Some(b) = &call.block {
+                let _ = self.op_block(cx, b);
+            }
+            return RStmt::Unsupported {
+                name: name.to_string(),
+                span: call.name.span,
+            };
+        }
+        if call.args.is_none() && call.import_overrides.is_none() {
+            // A rule name without a rule: a leaf shape of that name.
+            return RStmt::Leaf(self.symbol(name));
+        }
+        let arities = self.rule_arities(cx.rs, name);
+        if !arities.is_empty() {
+            self.error(
+                format!(
+                    "rule `{name}` takes {} parameters, called with {arity}",
+                    arities
+                        .iter()
+                        .map(|a| a.to_string())
+                        .collect::<Vec<_>>()
+                        .join(" or ")
+                ),
+                span,
+            );
+        } else {
+            self.unknown("operation or rule", &call.name, cx.rs, NameKind::Statement);
+        }
+        RStmt::Nil
+    }
+
+    fn op_args(&mut self, cx: &Cx, op: &str, args: &[Expr]) -> Vec<RExpr> {
+        let n = args.len();
+        args.iter()
+            .enumerate()
+            .map(|(i, a)| match (ops::arg_mode(op, n, i), &a.kind) {
+                (ArgMode::Selector, _) => self.selector_arg(cx, a),
+                (ArgMode::Maybe, _) => self.head(cx, a),
+                (ArgMode::Expr, _) => self.expr(cx, a),
+            })
+            .collect()
+    }
+
+    fn set_stmt(&mut self, cx: &Cx, call: &ast::Call) -> RStmt {
+        let span = call.span;
+        let args = call.args.as_deref().unwrap_or(&[]);
+        if args.len() != 2 {
+            self.error(
+                format!("`set` takes 2 arguments (attribute, value), found {}", args.len()),
+                span,
+            );
+            return RStmt::Nil;
+        }
+        let ExprKind::Name(target) = &args[0].kind else {
+            self.diags.push(
+                Diagnostic::error("the first argument of `set` must be an attribute name", args[0].span)
+                    .with_label("expected an attribute name"),
+            );
+            return RStmt::Nil;
+        };
+        let t = if let Some(id) = self.find_attr(cx.rs, &target.name) {
+            SetTarget::Attr(id)
+        } else if let Some(f) = shape_fns::lookup(&target.name, 0).filter(|&f| shape_fns::is_settable(f)) {
+            SetTarget::Shape(f)
+        } else {
+            let d = Diagnostic::error(
+                format!("`{}` is not an attribute that `set` can write", target.name),
+                target.span,
+            )
+            .with_label("expected an `attr` of the rule file or a writable shape attribute");
+            self.diags.push(d);
+            return RStmt::Nil;
+        };
+        let value = self.expr(cx, &args[1]);
+        RStmt::Op(OpCall {
+            op: Op::Set(t),
+            args: vec![value],
+            block: None,
+            span,
+        })
+    }
+
+    /// `imp(height = 20).Lot`: attribute values for this call only.
+    fn dynamic_overrides(
+        &mut self,
+        cx: &Cx,
+        rule_name: &str,
+        list: &[ast::ImportOverride],
+    ) -> Vec<(AttrId, RExpr)> {
+        let Some((alias, _)) = rule_name.rsplit_once('.') else {
+            return Vec::new();
+        };
+        let Some(&child) = self.tables[cx.rs as usize].imports.get(alias) else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for o in list {
+            match o {
+                ast::ImportOverride::Attr(n, e) => match self.find_attr(child, &n.name) {
+                    Some(id) => {
+                        let v = self.expr(cx, e);
+                        out.push((id, v));
+                    }
+                    None => self.error(
+                        format!("`{}` is not an attribute of `{alias}`", n.name),
+                        n.span,
+                    ),
+                },
+                ast::ImportOverride::Protect(n) | ast::ImportOverride::Rule { name: n, .. } => {
+                    self.error(
+                        "only attribute values (`name = value`) can be set in a rule call",
+                        n.span,
+                    )
+                }
+            }
+        }
+        out
+    }
+}
+
+#[derive(Clone, Copy)]
+enum NameKind {
+    Value,
+    Statement,
+}
+
+fn arity_text(min: usize, max: usize) -> String {
+    if min == max {
+        min.to_string()
+    } else {
+        format!("{min} to {max}")
+    }
+}
+
+/// Names of built-in functions, for "did you mean" hints.
+const KNOWN_FUNCTIONS: &[&str] = &[
+    "rand", "p", "print", "str", "float", "bool", "abs", "floor", "ceil", "sqrt", "sin", "cos",
+    "tan", "min", "max", "clamp", "len", "size",
+];
+
+/// An attribute default with `with` locals: the locals are evaluated in
+/// order into the frame, then the value.
+fn wrap_locals(locals: Vec<RExpr>, value: RExpr) -> RExpr {
+    RExpr {
+        span: value.span,
+        kind: RExprKind::WithLocals {
+            locals,
+            body: Box::new(value),
+        },
+    }
+}
+
+fn annotations(list: &[ast::Annotation]) -> Vec<AnnotationInfo> {
+    list.iter()
+        .map(|a| AnnotationInfo {
+            name: a.name.name.clone(),
+            args: a
+                .args
+                .iter()
+                .map(|arg| match arg {
+                    ast::AnnotationArg::Positional(e) => (None, literal(e)),
+                    ast::AnnotationArg::Named(n, e) => (Some(n.name.clone()), literal(e)),
+                })
+                .collect(),
+        })
+        .collect()
+}
+
+fn literal(e: &Expr) -> Option<Value> {
+    match &e.kind {
+        ExprKind::Float(x) => Some(Value::Float(*x)),
+        ExprKind::Bool(b) => Some(Value::Bool(*b)),
+        ExprKind::Str(s) => Some(Value::Str(Arc::from(s.as_str()))),
+        ExprKind::Unary {
+            op: ast::UnaryOp::Neg,
+            operand,
+            ..
+        } => match literal(operand) {
+            Some(Value::Float(x)) => Some(Value::Float(-x)),
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
+/// Finds `target` for a file at `from`: relative to its folder, then
+/// relative to each ancestor folder and its `assets/` folder; absolute
+/// workspace paths (`/lib/x.cga`) inside an ancestor or its `.ws` folder.
+pub fn find_relative(from: &Path, target: &str) -> Option<PathBuf> {
+    let start = from.parent()?;
+    let rel = target.trim_start_matches('/');
+    if target.starts_with('/') {
+        let p = Path::new(target);
+        if p.is_file() {
+            return Some(p.to_path_buf());
+        }
+        for dir in start.ancestors() {
+            for c in [dir.join(rel), dir.join(".ws").join(rel)] {
+                if c.is_file() {
+                    return Some(c);
+                }
+            }
+        }
+        return None;
+    }
+    let direct = start.join(rel);
+    if direct.is_file() {
+        return Some(direct);
+    }
+    for dir in start.ancestors() {
+        for c in [dir.join("assets").join(rel), dir.join(rel)] {
+            if c.is_file() {
+                return Some(c);
+            }
+        }
+    }
+    None
+}

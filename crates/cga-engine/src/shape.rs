@@ -1,0 +1,386 @@
+//! The shape: geometry, scope, pivot, material and the attributes operations set.
+//!
+//! Frames are kept in object (lot) coordinates as an origin and a rotation
+//! matrix, so that `t`, `r` and the scope queries never convert Euler angles.
+//! The geometry is stored relative to the scope ("scope-local": a vertex `v`
+//! is at `scope.origin + scope.axes * v`) behind a lazy affine map, so moving,
+//! rotating and scaling a shape are O(1): vertices are only touched when an
+//! operation needs them (a cut, a query, the output).
+
+use std::cell::Cell;
+use std::sync::Arc;
+
+use cga_geometry::{DAffine3, DMat3, DVec3, Mesh};
+use cga_value::Value;
+
+use crate::material_attr::MaterialOverrides;
+use crate::program::AttrId;
+
+/// An orthonormal, right-handed frame in object coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    pub origin: DVec3,
+    /// Columns are the x, y and z axes.
+    pub axes: DMat3,
+}
+
+impl Frame {
+    pub const IDENTITY: Frame = Frame {
+        origin: DVec3::ZERO,
+        axes: DMat3::IDENTITY,
+    };
+
+    /// Object coordinates of a point given in this frame.
+    pub fn to_object(&self, p: DVec3) -> DVec3 {
+        self.origin + self.axes * p
+    }
+
+    /// This frame's coordinates of a point given in object coordinates.
+    pub fn to_local(&self, p: DVec3) -> DVec3 {
+        self.axes.transpose() * (p - self.origin)
+    }
+
+    pub fn affine(&self) -> DAffine3 {
+        DAffine3::from_mat3_translation(self.axes, self.origin)
+    }
+}
+
+/// The scope: an oriented box from `frame.origin` along the frame's axes.
+/// Sizes may be zero (flat shapes) or negative (mirrored by `s`).
+///
+/// `rot` holds the Euler angles relative to the pivot (`scope.r`) as CGA
+/// keeps them: `r()` adds to these angles, which is not the same as
+/// composing rotations, so they are stored rather than recomputed. Invariant:
+/// `frame.axes == pivot.axes * euler_to_mat(rot)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scope {
+    pub frame: Frame,
+    pub size: DVec3,
+    pub rot: DVec3,
+}
+
+impl Scope {
+    /// Sets the scope axes (object coordinates) and the angles relative to `pivot_axes`.
+    pub fn set_axes(&mut self, pivot_axes: &DMat3, axes: DMat3) {
+        self.frame.axes = axes;
+        self.rot = mat_to_euler(&(pivot_axes.transpose() * axes));
+    }
+
+    pub fn center(&self) -> DVec3 {
+        self.frame.to_object(self.size * 0.5)
+    }
+}
+
+/// A shape's geometry: a shared mesh and the map from its coordinates to
+/// scope-local coordinates (`None` = identity).
+#[derive(Clone, Debug)]
+pub struct Geometry {
+    mesh: Arc<Mesh>,
+    to_scope: Option<DAffine3>,
+}
+
+impl Geometry {
+    pub fn new(mesh: Arc<Mesh>) -> Geometry {
+        Geometry {
+            mesh,
+            to_scope: None,
+        }
+    }
+
+    /// Applies `m` (scope-local → scope-local) after the current map.
+    pub fn transform(&mut self, m: DAffine3) {
+        self.to_scope = Some(match self.to_scope {
+            Some(t) => m * t,
+            None => m,
+        });
+    }
+
+    /// The mesh in scope-local coordinates, transforming it if needed (once:
+    /// the result replaces the stored mesh).
+    pub fn local(&mut self) -> &Arc<Mesh> {
+        if let Some(t) = self.to_scope.take() {
+            if t != DAffine3::IDENTITY {
+                self.mesh = Arc::new(transformed(&self.mesh, &t));
+            }
+        }
+        &self.mesh
+    }
+
+    /// The stored mesh and its map, without transforming anything.
+    pub fn raw(&self) -> (&Arc<Mesh>, Option<&DAffine3>) {
+        (&self.mesh, self.to_scope.as_ref())
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.mesh.faces.is_empty()
+    }
+}
+
+/// A copy of `mesh` with positions (and normals) mapped by `t`. A map that
+/// mirrors (negative determinant) also reverses the faces so that they keep
+/// facing outwards.
+pub fn transformed(mesh: &Mesh, t: &DAffine3) -> Mesh {
+    let mut m = mesh.clone();
+    for p in &mut m.positions {
+        *p = t.transform_point3(*p);
+    }
+    let linear = t.matrix3;
+    if let Some(normals) = &mut m.normals {
+        let n_mat = linear.inverse().transpose();
+        for n in normals.iter_mut() {
+            *n = (n_mat * *n).normalize_or_zero();
+        }
+    }
+    if linear.determinant() < 0.0 {
+        reverse_faces(&mut m);
+    }
+    m
+}
+
+/// Reverses the orientation of every loop (outer and holes), keeping each
+/// loop's first corner first so that "the first edge" stays recognisable.
+pub fn reverse_faces(m: &mut Mesh) {
+    for l in m.loops.clone() {
+        let r = m.loop_corners(l);
+        if r.len() < 3 {
+            continue;
+        }
+        let first = r.start;
+        let rest = first + 1..r.end;
+        m.corners[rest.clone()].reverse();
+        for set in m.uvs.iter_mut().flatten() {
+            set[rest.clone()].reverse();
+        }
+        if let Some(n) = &mut m.normals {
+            n[rest.clone()].reverse();
+            for v in &mut n[r] {
+                *v = -*v;
+            }
+        }
+    }
+}
+
+/// Trim state of a shape (`trim.horizontal`, `trim.vertical`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TrimFlags {
+    pub horizontal: bool,
+    pub vertical: bool,
+}
+
+impl Default for TrimFlags {
+    fn default() -> Self {
+        TrimFlags {
+            horizontal: false,
+            vertical: true,
+        }
+    }
+}
+
+/// What the last component split recorded (`comp.sel`, `comp.index`, `comp.total`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CompInfo {
+    pub sel: Arc<str>,
+    pub index: f64,
+    pub total: f64,
+}
+
+/// A texture projection set up by `setupProjection` (for `projectUV`): maps
+/// object coordinates to (u, v).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Projection {
+    /// Object → projection space; u = x / width, v = y / height after the map.
+    pub to_uv: DAffine3,
+}
+
+#[derive(Clone, Debug)]
+pub struct Shape {
+    pub scope: Scope,
+    pub pivot: Frame,
+    pub geometry: Geometry,
+    /// The scope of the shape this one was derived from (for `center`).
+    pub parent_scope: Scope,
+    pub material: Arc<MaterialOverrides>,
+    /// Attribute values set on this shape (or an ancestor) with `set`.
+    pub attrs: Option<Arc<Vec<(AttrId, Value)>>>,
+    pub split_index: f64,
+    pub split_total: f64,
+    pub comp: Option<Arc<CompInfo>>,
+    pub trim: TrimFlags,
+    pub projections: Option<Arc<[Option<Projection>; 10]>>,
+    /// Random stream state (`rand`, `p`, stochastic rules).
+    pub rng: Cell<u64>,
+    /// The shape's symbol (rule or leaf name), an index into `Program::symbols`.
+    pub name: u32,
+}
+
+impl Shape {
+    /// The value of attribute `id` set on this shape, if any.
+    pub fn attr_override(&self, id: AttrId) -> Option<&Value> {
+        self.attrs
+            .as_ref()
+            .and_then(|a| a.iter().rev().find(|(k, _)| *k == id).map(|(_, v)| v))
+    }
+
+    pub fn set_attr(&mut self, id: AttrId, value: Value) {
+        let list = Arc::make_mut(self.attrs.get_or_insert_with(Default::default));
+        if let Some(slot) = list.iter_mut().find(|(k, _)| *k == id) {
+            slot.1 = value;
+        } else {
+            list.push((id, value));
+        }
+    }
+
+    /// Replaces the geometry by `mesh` given in scope-local coordinates.
+    pub fn set_local_mesh(&mut self, mesh: Mesh) {
+        self.geometry = Geometry::new(Arc::new(mesh));
+    }
+
+    /// Next value in [0, 1) of the shape's random stream.
+    pub fn next_random(&self) -> f64 {
+        let mut x = self.rng.get();
+        let r = splitmix64(&mut x);
+        self.rng.set(x);
+        (r >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+
+    /// A child's random state: derived from the parent's state and the
+    /// child's ordinal, so siblings differ and the result does not depend on
+    /// evaluation order elsewhere.
+    pub fn child_rng(&self, ordinal: u64) -> u64 {
+        let mut x = self.rng.get() ^ ordinal.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        splitmix64(&mut x)
+    }
+
+    /// Moves the scope to `scope` while the geometry stays where it is in
+    /// object coordinates.
+    pub fn reframe_scope(&mut self, scope: Scope) {
+        let old = self.scope.frame.affine();
+        let new_inv = scope.frame.affine().inverse();
+        self.geometry.transform(new_inv * old);
+        self.scope = scope;
+    }
+
+    /// Sets the scope size, scaling the geometry along the scope axes (an
+    /// axis with zero size cannot be scaled and keeps its geometry).
+    pub fn resize(&mut self, size: DVec3) {
+        let old = self.scope.size;
+        let factor = |n: f64, o: f64| if o.abs() > 1e-12 { n / o } else { 1.0 };
+        let f = DVec3::new(
+            factor(size.x, old.x),
+            factor(size.y, old.y),
+            factor(size.z, old.z),
+        );
+        if f != DVec3::ONE {
+            self.geometry.transform(DAffine3::from_scale(f));
+        }
+        self.scope.size = size;
+    }
+
+    /// Sets the scope to the bounding box of the geometry in the frame with
+    /// the given axes (object coordinates); the geometry stays in place.
+    pub fn fit_scope(&mut self, axes: DMat3) {
+        let origin = self.scope.frame.origin;
+        let mut target = self.scope;
+        target.frame = Frame { origin, axes };
+        self.reframe_scope(target);
+        let bounds = local_bounds(self.geometry.local());
+        let (lo, hi) = bounds.unwrap_or((DVec3::ZERO, DVec3::ZERO));
+        if lo != DVec3::ZERO {
+            self.geometry.transform(DAffine3::from_translation(-lo));
+        }
+        self.scope.frame.origin = origin + axes * lo;
+        self.scope.size = hi - lo;
+        let pivot_axes = self.pivot.axes;
+        self.scope.set_axes(&pivot_axes, axes);
+    }
+
+    /// The geometry in object coordinates (for output and world queries).
+    pub fn object_mesh(&self) -> Mesh {
+        let (mesh, to_scope) = self.geometry.raw();
+        let frame = self.scope.frame.affine();
+        let t = match to_scope {
+            Some(m) => frame * *m,
+            None => frame,
+        };
+        transformed(mesh, &t)
+    }
+}
+
+/// Bounding box of the positions a mesh's faces use.
+pub fn local_bounds(mesh: &Mesh) -> Option<(DVec3, DVec3)> {
+    let mut it = mesh.corners.iter().map(|&c| mesh.positions[c as usize]);
+    let first = it.next()?;
+    Some(it.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
+}
+
+fn splitmix64(state: &mut u64) -> u64 {
+    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    let mut z = *state;
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// Rotation matrix of CGA Euler angles in degrees: x first, then y, then z
+/// (`R = Rz * Ry * Rx` applied to column vectors).
+pub fn euler_to_mat(angles: DVec3) -> DMat3 {
+    let r = angles * (std::f64::consts::PI / 180.0);
+    DMat3::from_rotation_z(r.z) * DMat3::from_rotation_y(r.y) * DMat3::from_rotation_x(r.x)
+}
+
+/// CGA Euler angles in degrees of a rotation matrix (inverse of [`euler_to_mat`]).
+pub fn mat_to_euler(m: &DMat3) -> DVec3 {
+    // m = Rz*Ry*Rx: m[0][2] (col 0, row 2) = -sin(b).
+    let sb = -m.x_axis.z;
+    let (a, b, g);
+    if sb.abs() < 1.0 - 1e-12 {
+        b = sb.asin();
+        a = m.y_axis.z.atan2(m.z_axis.z);
+        g = m.x_axis.y.atan2(m.x_axis.x);
+    } else {
+        // Gimbal lock: put everything into x.
+        b = if sb > 0.0 {
+            std::f64::consts::FRAC_PI_2
+        } else {
+            -std::f64::consts::FRAC_PI_2
+        };
+        g = 0.0;
+        a = (-m.z_axis.y).atan2(m.y_axis.y);
+    }
+    let deg = |x: f64| {
+        let d = x.to_degrees();
+        if d.abs() < 1e-9 {
+            0.0
+        } else {
+            d
+        }
+    };
+    DVec3::new(deg(a), deg(b), deg(g))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn euler_round_trip() {
+        for angles in [
+            DVec3::new(10.0, 20.0, 30.0),
+            DVec3::new(0.0, 90.0 - 1e-3, 0.0),
+            DVec3::new(-45.0, 0.0, 170.0),
+        ] {
+            let back = mat_to_euler(&euler_to_mat(angles));
+            assert!((back - angles).abs().max_element() < 1e-9, "{back:?}");
+        }
+    }
+
+    #[test]
+    fn euler_matches_reference_matrix() {
+        // cga_eulerAngles.md: R[0][1] = sa*sb*cg - ca*sg (row 0, column 1).
+        let (a, b, g) = (0.3f64, -0.7f64, 1.1f64);
+        let m = euler_to_mat(DVec3::new(a, b, g) * (180.0 / std::f64::consts::PI));
+        let expect = a.sin() * b.sin() * g.cos() - a.cos() * g.sin();
+        assert!((m.y_axis.x - expect).abs() < 1e-12);
+        assert!((m.x_axis.z + b.sin()).abs() < 1e-12);
+    }
+}

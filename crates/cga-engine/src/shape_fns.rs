@@ -1,0 +1,344 @@
+//! Built-in functions and shape attributes that read the current shape
+//! (`scope.sx`, `geometry.area`, `split.index`, `material.color.r`, `rand`, ...).
+//! The resolver maps names to a [`ShapeFn`] once; evaluation is in `eval.rs`.
+
+use crate::material_attr::MatField;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ShapeFn {
+    /// `scope.t{x|y|z}` (0..3), `scope.r{..}` (3..6), `scope.s{..}` (6..9).
+    Scope(u8),
+    ScopeElevation,
+    /// `pivot.p{x|y|z}` (0..3), `pivot.o{..}` (3..6).
+    Pivot(u8),
+    SplitIndex,
+    SplitTotal,
+    CompSel,
+    CompIndex,
+    CompTotal,
+    Seedian,
+    TrimHorizontal,
+    TrimVertical,
+    Material(MatField),
+    InitialShapeName,
+    InitialShapeStartRule,
+    /// `initialShape.origin.p{x|y|z}` (0..3), `initialShape.origin.o{..}` (3..6).
+    InitialShapeOrigin(u8),
+    Geometry(GeometryFn),
+    /// `rand()`, `rand(max)`, `rand(min, max)`.
+    Rand,
+    /// `p(probability)`.
+    P,
+    /// `print(value)` as a function: prints and returns its argument.
+    Print,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GeometryFn {
+    Area,
+    Volume,
+    NVertices,
+    NFaces,
+    NEdges,
+    NHoles,
+    IsClosedSurface,
+    IsPlanar,
+    IsRectangular,
+    IsConcave,
+    BoundaryLength,
+    Height,
+    HasUVs,
+    UMin,
+    UMax,
+    VMin,
+    VMax,
+    Du,
+    Dv,
+}
+
+/// The shape function called `name` with `arity` arguments, if any.
+pub fn lookup(name: &str, arity: usize) -> Option<ShapeFn> {
+    let axis = |s: &str| match s {
+        "x" => Some(0u8),
+        "y" => Some(1),
+        "z" => Some(2),
+        _ => None,
+    };
+    let zero = arity == 0;
+    if let Some(rest) = name.strip_prefix("scope.") {
+        if !zero {
+            return None;
+        }
+        if rest == "elevation" {
+            return Some(ShapeFn::ScopeElevation);
+        }
+        let (kind, ax) = rest.split_at(1);
+        let base = match kind {
+            "t" => 0,
+            "r" => 3,
+            "s" => 6,
+            _ => return None,
+        };
+        return axis(ax).map(|a| ShapeFn::Scope(base + a));
+    }
+    if let Some(rest) = name.strip_prefix("pivot.") {
+        if !zero || rest.len() != 2 {
+            return None;
+        }
+        let (kind, ax) = rest.split_at(1);
+        let base = match kind {
+            "p" => 0,
+            "o" => 3,
+            _ => return None,
+        };
+        return axis(ax).map(|a| ShapeFn::Pivot(base + a));
+    }
+    if let Some(rest) = name.strip_prefix("initialShape.origin.") {
+        if !zero || rest.len() != 2 {
+            return None;
+        }
+        let (kind, ax) = rest.split_at(1);
+        let base = match kind {
+            "p" => 0,
+            "o" => 3,
+            _ => return None,
+        };
+        return axis(ax).map(|a| ShapeFn::InitialShapeOrigin(base + a));
+    }
+    if name.starts_with("material.") {
+        return if zero {
+            MatField::parse(name).map(ShapeFn::Material)
+        } else {
+            None
+        };
+    }
+    if let Some(rest) = name.strip_prefix("geometry.") {
+        use GeometryFn::*;
+        let (f, arities): (GeometryFn, &[usize]) = match rest {
+            "area" => (Area, &[0]),
+            "volume" => (Volume, &[0]),
+            "nVertices" => (NVertices, &[0]),
+            "nFaces" => (NFaces, &[0]),
+            "nEdges" => (NEdges, &[0]),
+            "nHoles" => (NHoles, &[0]),
+            "isClosedSurface" => (IsClosedSurface, &[0]),
+            "isPlanar" => (IsPlanar, &[0, 1]),
+            "isRectangular" => (IsRectangular, &[0, 1]),
+            "isConcave" => (IsConcave, &[0]),
+            "boundaryLength" => (BoundaryLength, &[0]),
+            "height" => (Height, &[0]),
+            "hasUVs" => (HasUVs, &[0, 1]),
+            "uMin" => (UMin, &[0, 1]),
+            "uMax" => (UMax, &[0, 1]),
+            "vMin" => (VMin, &[0, 1]),
+            "vMax" => (VMax, &[0, 1]),
+            "du" => (Du, &[1, 2]),
+            "dv" => (Dv, &[1, 2]),
+            _ => return None,
+        };
+        return arities.contains(&arity).then_some(ShapeFn::Geometry(f));
+    }
+    let f = match (name, arity) {
+        ("split.index", 0) => ShapeFn::SplitIndex,
+        ("split.total", 0) => ShapeFn::SplitTotal,
+        ("comp.sel", 0) => ShapeFn::CompSel,
+        ("comp.index", 0) => ShapeFn::CompIndex,
+        ("comp.total", 0) => ShapeFn::CompTotal,
+        ("seedian", 0) => ShapeFn::Seedian,
+        ("trim.horizontal", 0) => ShapeFn::TrimHorizontal,
+        ("trim.vertical", 0) => ShapeFn::TrimVertical,
+        ("initialShape.name", 0) => ShapeFn::InitialShapeName,
+        ("initialShape.startRule", 0) => ShapeFn::InitialShapeStartRule,
+        ("rand", 0..=2) => ShapeFn::Rand,
+        ("p", 1) => ShapeFn::P,
+        ("print", 1) => ShapeFn::Print,
+        _ => return None,
+    };
+    Some(f)
+}
+
+/// Shape attributes that `set` may write, with the same names as for reading.
+pub fn is_settable(f: ShapeFn) -> bool {
+    matches!(
+        f,
+        ShapeFn::Scope(_)
+            | ShapeFn::Pivot(_)
+            | ShapeFn::Seedian
+            | ShapeFn::TrimHorizontal
+            | ShapeFn::TrimVertical
+            | ShapeFn::Material(_)
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn looks_up_dotted_names() {
+        assert_eq!(lookup("scope.sx", 0), Some(ShapeFn::Scope(6)));
+        assert_eq!(lookup("scope.ry", 0), Some(ShapeFn::Scope(4)));
+        assert_eq!(lookup("pivot.oz", 0), Some(ShapeFn::Pivot(5)));
+        assert_eq!(
+            lookup("geometry.area", 0),
+            Some(ShapeFn::Geometry(GeometryFn::Area))
+        );
+        assert_eq!(lookup("geometry.area", 2), None);
+        assert_eq!(lookup("rand", 2), Some(ShapeFn::Rand));
+        assert_eq!(lookup("scope.qx", 0), None);
+    }
+}
+
+mod eval {
+    use std::sync::Arc;
+
+    use cga_value::Value;
+
+    use super::{GeometryFn, ShapeFn};
+    use crate::derive::{Interp, RtError};
+    use crate::expr::RExpr;
+    use crate::geom_shim as gm;
+    use crate::shape::{mat_to_euler, Shape};
+
+    fn num(v: &Value, at: &RExpr) -> Result<f64, RtError> {
+        match v {
+            Value::Float(x) => Ok(*x),
+            Value::Bool(b) => Ok(if *b { 1.0 } else { 0.0 }),
+            other => Err(RtError::new(
+                format!(
+                    "expected a float, found {}",
+                    crate::value_shim::type_name(other)
+                ),
+                at.span,
+            )),
+        }
+    }
+
+    impl Interp<'_> {
+        pub(crate) fn shape_fn(
+            &mut self,
+            f: ShapeFn,
+            args: &[Value],
+            shape: &Shape,
+            at: &RExpr,
+        ) -> Result<Value, RtError> {
+            let fl = Value::Float;
+            Ok(match f {
+                ShapeFn::Scope(i) => {
+                    let pivot = &shape.pivot;
+                    let v = match i / 3 {
+                        0 => pivot.to_local(shape.scope.frame.origin),
+                        1 => shape.scope.rot,
+                        _ => shape.scope.size,
+                    };
+                    fl(v[(i % 3) as usize])
+                }
+                ShapeFn::ScopeElevation => fl(shape.scope.frame.origin.y),
+                ShapeFn::Pivot(i) => {
+                    let init = &self.initial.pivot;
+                    let v = if i < 3 {
+                        init.to_local(shape.pivot.origin)
+                    } else {
+                        mat_to_euler(&(init.axes.transpose() * shape.pivot.axes))
+                    };
+                    fl(v[(i % 3) as usize])
+                }
+                ShapeFn::InitialShapeOrigin(i) => {
+                    let init = &self.initial.pivot;
+                    let v = if i < 3 {
+                        init.origin
+                    } else {
+                        mat_to_euler(&init.axes)
+                    };
+                    fl(v[(i % 3) as usize])
+                }
+                ShapeFn::SplitIndex => fl(shape.split_index),
+                ShapeFn::SplitTotal => fl(shape.split_total),
+                ShapeFn::CompSel => Value::Str(
+                    shape
+                        .comp
+                        .as_ref()
+                        .map(|c| c.sel.clone())
+                        .unwrap_or_else(|| Arc::from("")),
+                ),
+                ShapeFn::CompIndex => fl(shape.comp.as_ref().map_or(0.0, |c| c.index)),
+                ShapeFn::CompTotal => fl(shape.comp.as_ref().map_or(0.0, |c| c.total)),
+                ShapeFn::Seedian => fl((shape.rng.get() >> 11) as f64),
+                ShapeFn::TrimHorizontal => Value::Bool(shape.trim.horizontal),
+                ShapeFn::TrimVertical => Value::Bool(shape.trim.vertical),
+                ShapeFn::Material(field) => {
+                    let (mesh, _) = shape.geometry.raw();
+                    let geometry_material = mesh
+                        .faces
+                        .first()
+                        .map(|face| &mesh.materials[face.material as usize]);
+                    shape.material.get(field, geometry_material)
+                }
+                ShapeFn::InitialShapeName => Value::Str(Arc::from(self.info.name.as_str())),
+                ShapeFn::InitialShapeStartRule => {
+                    Value::Str(Arc::from(self.info.start_rule.as_str()))
+                }
+                ShapeFn::Rand => {
+                    let r = shape.next_random();
+                    match args {
+                        [] => fl(r),
+                        [max] => fl(r * num(max, at)?),
+                        [min, max] => {
+                            let (a, b) = (num(min, at)?, num(max, at)?);
+                            fl(a + r * (b - a))
+                        }
+                        _ => unreachable!("arity checked by the resolver"),
+                    }
+                }
+                ShapeFn::P => {
+                    let p = num(&args[0], at)?;
+                    Value::Bool(if p <= 0.0 {
+                        false
+                    } else if p >= 1.0 {
+                        true
+                    } else {
+                        shape.next_random() < p
+                    })
+                }
+                ShapeFn::Print => {
+                    self.out.prints.push(crate::value_shim::to_text(&args[0]));
+                    args[0].clone()
+                }
+                ShapeFn::Geometry(g) => self.geometry_fn(g, args, shape, at)?,
+            })
+        }
+
+        fn geometry_fn(
+            &mut self,
+            g: GeometryFn,
+            args: &[Value],
+            shape: &Shape,
+            at: &RExpr,
+        ) -> Result<Value, RtError> {
+            // Measures are taken in object coordinates: scaling is lazy, so the
+            // stored mesh alone would give wrong areas.
+            let mesh = shape.object_mesh();
+            let fl = Value::Float;
+            Ok(match g {
+                GeometryFn::Area => fl(gm::area(&mesh)),
+                GeometryFn::Volume => fl(if gm::is_closed(&mesh) {
+                    gm::volume(&mesh)
+                } else {
+                    0.0
+                }),
+                GeometryFn::NVertices => fl(gm::n_vertices(&mesh) as f64),
+                GeometryFn::NFaces => fl(mesh.faces.len() as f64),
+                GeometryFn::NHoles => fl(gm::n_holes(&mesh) as f64),
+                GeometryFn::IsClosedSurface => Value::Bool(gm::is_closed(&mesh)),
+                GeometryFn::Height => fl(gm::bbox(&mesh).map_or(0.0, |(lo, hi)| hi.y - lo.y)),
+                other => {
+                    let _ = args;
+                    self.warn_once(at.span, || {
+                        format!("geometry function {other:?} is not supported yet; it returns 0")
+                    });
+                    fl(0.0)
+                }
+            })
+        }
+    }
+}

@@ -209,6 +209,9 @@ pub struct Call {
     pub args: Option<Vec<Expr>>,
     /// The `{ ... }` after `split(..)`, `comp(..)`, `splitArea(..)`, ...
     pub block: Option<Block<Body>>,
+    /// A second block right after the first: only
+    /// `splitAndSetbackPerimeter(..) { 2 : 4 : X }* { remainder : Y }` has one.
+    pub remainder_block: Option<Block<Body>>,
     pub span: Span,
 }
 
@@ -229,6 +232,14 @@ pub enum BlockPart<T> {
     Entry(BlockEntry<T>),
     /// A nested `{ ... }` or `{ ... }*` group (split patterns).
     Group(Block<T>),
+    /// A part without head: the operands of `union { A | B }` and
+    /// `subtract { Mass. | t(1,0,0) Hole }`, the body of
+    /// `scatter(surface, 10, uniform) { Leaf }` or `inline { A B }`.
+    /// Only blocks after operations have these (never the comp function).
+    Unlabeled {
+        body: T,
+        span: Span,
+    },
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -236,6 +247,9 @@ pub struct BlockEntry<T> {
     /// A split size (`3`, `'0.5`, `~1`) or a comp selector (`front`, `0`,
     /// `isTagged("x")`, `top && !side`): an expression either way.
     pub head: Expr,
+    /// The setback depth of a `splitAndSetbackPerimeter` entry
+    /// (`length : depth : operations`); `None` everywhere else.
+    pub depth: Option<Expr>,
     pub op: BlockOp,
     pub body: T,
     pub span: Span,

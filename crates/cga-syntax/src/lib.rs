@@ -6,6 +6,9 @@
 
 pub mod ast;
 pub mod diagnostic;
+mod lexer;
+mod parser;
+pub mod sexpr;
 pub mod source;
 pub mod span;
 
@@ -14,8 +17,23 @@ pub use source::{SourceFile, SourceMap};
 pub use span::{FileId, Span};
 
 /// Parses one file. The module holds everything that could be parsed; the
-/// diagnostics say what could not.
+/// diagnostics (errors only, in source order) say what could not. A module
+/// that comes with errors may hold placeholders (an empty
+/// [`ast::ExprKind::Name`] where an expression was missing) and must not be
+/// evaluated.
+///
+/// Never panics, whatever the text; the time taken is linear in its length.
 pub fn parse(file: FileId, text: &str) -> (ast::Module, Vec<Diagnostic>) {
-    let _ = (file, text);
-    (ast::Module::default(), Vec::new())
+    // Spans are 32-bit byte offsets.
+    if text.len() >= u32::MAX as usize {
+        let diagnostic = Diagnostic {
+            severity: Severity::Error,
+            message: "rule file is too large (4 GiB or more)".to_string(),
+            span: None,
+            label: None,
+            notes: Vec::new(),
+        };
+        return (ast::Module::default(), vec![diagnostic]);
+    }
+    parser::parse(file, text)
 }

@@ -140,9 +140,13 @@ pub struct RBlock<T> {
 pub enum RPart<T> {
     Entry {
         head: RExpr,
+        /// `splitAndSetbackPerimeter` entries: `length : depth : operations`.
+        depth: Option<RExpr>,
         op: BlockOp,
         body: T,
         span: Span,
     },
     Group(RBlock<T>),
+    /// A part without head (`union { A | B }`, `scatter(...) { Leaf }`).
+    Unlabeled { body: T, span: Span },
 }

@@ -708,11 +708,16 @@ impl Resolver<'_> {
                 .map(|p| match p {
                     BlockPart::Entry(e) => RPart::Entry {
                         head: self.head(cx, &e.head),
+                        depth: e.depth.as_ref().map(|d| self.expr(cx, d)),
                         op: e.op,
                         body: self.expr(cx, &e.body),
                         span: e.span,
                     },
                     BlockPart::Group(g) => RPart::Group(self.expr_block(cx, g)),
+                    BlockPart::Unlabeled { body, span } => RPart::Unlabeled {
+                        body: self.expr(cx, body),
+                        span: *span,
+                    },
                 })
                 .collect(),
             repeat: b.repeat,
@@ -828,11 +833,16 @@ impl Resolver<'_> {
                 .map(|p| match p {
                     BlockPart::Entry(e) => RPart::Entry {
                         head: self.head(cx, &e.head),
+                        depth: e.depth.as_ref().map(|d| self.expr(cx, d)),
                         op: e.op,
                         body: self.body(cx, &e.body),
                         span: e.span,
                     },
                     BlockPart::Group(g) => RPart::Group(self.op_block(cx, g)),
+                    BlockPart::Unlabeled { body, span } => RPart::Unlabeled {
+                        body: self.body(cx, body),
+                        span: *span,
+                    },
                 })
                 .collect(),
             repeat: b.repeat,

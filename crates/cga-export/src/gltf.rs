@@ -1,0 +1,606 @@
+//! GLB and glTF (+ `.bin`) output.
+//!
+//! One glTF mesh with one triangle primitive per material, each referenced by
+//! its own node of the default scene. Per material the writer keeps the
+//! vertex attributes as `f32` (that is the output itself: nothing of the
+//! input meshes is kept) and writes the JSON and the binary data at the end,
+//! when every accessor's size is known.
+//!
+//! Binary layout: for each material in order of first appearance, positions,
+//! normals, texture coordinates (when present) and `u32` indices, each in its
+//! own buffer view; then the embedded images (GLB only). Everything is 4-byte
+//! aligned because every component is 4 bytes.
+
+use std::collections::HashMap;
+use std::fs::File;
+use std::io::{BufWriter, Read, Write};
+use std::path::{Path, PathBuf};
+
+use cga_geometry::{DVec2, DVec3, Material, Mesh};
+use gltf_json as json;
+use json::validation::{Checked::Valid, USize64};
+
+use crate::hash::FastMap;
+use crate::materials::{srgb_to_linear, MaterialTable};
+use crate::textures::{uri_encode, Textures};
+use crate::{ExportError, ExportStats, FaceData};
+
+/// Vertex data of one material.
+#[derive(Default)]
+struct Bucket {
+    positions: Vec<f32>,
+    normals: Vec<f32>,
+    /// TEXCOORD_0 (v flipped); `None` while no vertex had UVs. Vertices
+    /// from meshes without UVs get (0, 0) once the bucket has them.
+    uvs: Option<Vec<f32>>,
+    indices: Vec<u32>,
+    min: [f32; 3],
+    max: [f32; 3],
+}
+
+impl Bucket {
+    fn vertex_count(&self) -> usize {
+        self.normals.len() / 3
+    }
+
+    fn push_vertex(&mut self, p: DVec3, n: DVec3, uv: Option<DVec2>) -> Result<u32, ExportError> {
+        let index = u32::try_from(self.vertex_count()).map_err(|_| {
+            ExportError::TooLarge("more than 2^32 vertices with one material".into())
+        })?;
+        let p = p.as_vec3().to_array();
+        if index == 0 {
+            self.min = p;
+            self.max = p;
+        } else {
+            for k in 0..3 {
+                self.min[k] = self.min[k].min(p[k]);
+                self.max[k] = self.max[k].max(p[k]);
+            }
+        }
+        self.positions.extend_from_slice(&p);
+        self.normals.extend_from_slice(&n.as_vec3().to_array());
+        if let Some(uvs) = &mut self.uvs {
+            // glTF puts v = 0 at the top of the image, CGA at the bottom.
+            let (u, v) = uv.map_or((0.0, 0.0), |t| (t.x as f32, (1.0 - t.y) as f32));
+            uvs.extend_from_slice(&[u, v]);
+        }
+        Ok(index)
+    }
+}
+
+/// Identifies a vertex within one input mesh that carries its own normals,
+/// so corners that share position, normal and UV share one output vertex.
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+struct VertexKey {
+    material: u32,
+    position: u32,
+    normal: [u32; 3],
+    uv: [u32; 2],
+}
+
+pub(crate) struct GltfWriter {
+    path: PathBuf,
+    out: BufWriter<File>,
+    binary: bool,
+    /// GLB: put images into the binary chunk (else refer to them by URI).
+    embed_images: bool,
+    /// `.gltf`: file name of the `.bin` beside it.
+    bin_name: String,
+    buckets: Vec<Bucket>,
+    /// Colour map texture of each material id, if usable.
+    colormaps: Vec<Option<u32>>,
+    /// Output vertex of each corner of the mesh being added.
+    corner_vertex: Vec<u32>,
+    dedup: FastMap<VertexKey, u32>,
+}
+
+impl GltfWriter {
+    pub(crate) fn create(
+        path: &Path,
+        binary: bool,
+        embed_images: bool,
+    ) -> Result<GltfWriter, ExportError> {
+        let file = File::create(path).map_err(|e| ExportError::io(path, e))?;
+        let stem = path
+            .file_stem()
+            .map_or("model".into(), |s| s.to_string_lossy());
+        Ok(GltfWriter {
+            path: path.to_path_buf(),
+            out: BufWriter::with_capacity(1 << 16, file),
+            binary,
+            embed_images: binary && embed_images,
+            bin_name: format!("{stem}.bin"),
+            buckets: Vec::new(),
+            colormaps: Vec::new(),
+            corner_vertex: Vec::new(),
+            dedup: FastMap::default(),
+        })
+    }
+
+    /// File names this writer creates next to the output.
+    pub(crate) fn file_names(&self) -> Vec<String> {
+        let own = self
+            .path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned());
+        let mut names: Vec<String> = own.into_iter().collect();
+        if !self.binary {
+            names.push(self.bin_name.clone());
+        }
+        names
+    }
+
+    pub(crate) fn new_material(
+        &mut self,
+        material: &Material,
+        textures: &mut Textures,
+        warnings: &mut Vec<String>,
+    ) {
+        let path = &material.maps[0].path;
+        let colormap = textures.resolve(path, warnings).filter(|&t| {
+            let usable = textures.get(t).mime.is_some();
+            if !usable {
+                warnings.push(format!(
+                    "texture '{path}' is neither PNG nor JPEG, which glTF requires; written without it"
+                ));
+            }
+            usable
+        });
+        let mut bucket = Bucket::default();
+        if colormap.is_some() {
+            // A textured material needs TEXCOORD_0 on every vertex.
+            bucket.uvs = Some(Vec::new());
+        }
+        self.buckets.push(bucket);
+        self.colormaps.push(colormap);
+    }
+
+    pub(crate) fn begin_mesh(&mut self, mesh: &Mesh) {
+        self.corner_vertex.clear();
+        self.corner_vertex.resize(mesh.corners.len(), 0);
+        self.dedup.clear();
+    }
+
+    pub(crate) fn add_face(&mut self, f: &FaceData) -> Result<(), ExportError> {
+        let mesh = f.mesh;
+        let bucket = &mut self.buckets[f.material as usize];
+        let uvs = mesh.uvs[0].as_deref();
+        if uvs.is_some() && bucket.uvs.is_none() {
+            bucket.uvs = Some(vec![0.0; bucket.vertex_count() * 2]);
+        }
+        for &l in mesh.face_loops(f.face) {
+            for c in mesh.loop_corners(l) {
+                let position = mesh.corners[c];
+                let p = mesh.positions[position as usize];
+                let uv = uvs.map(|u| u[c]);
+                let vertex = match &mesh.normals {
+                    // Flat shading: each face has its own vertices.
+                    None => bucket.push_vertex(p, f.normal, uv)?,
+                    Some(normals) => {
+                        let n = normals[c].try_normalize().unwrap_or(f.normal);
+                        let key = VertexKey {
+                            material: f.material,
+                            position,
+                            normal: n.as_vec3().to_array().map(f32::to_bits),
+                            uv: uv.map_or([0; 2], |t| t.as_vec2().to_array().map(f32::to_bits)),
+                        };
+                        match self.dedup.get(&key) {
+                            Some(&v) => v,
+                            None => {
+                                let v = bucket.push_vertex(p, n, uv)?;
+                                self.dedup.insert(key, v);
+                                v
+                            }
+                        }
+                    }
+                };
+                self.corner_vertex[c] = vertex;
+            }
+        }
+        let cv = &self.corner_vertex;
+        for t in f.triangles {
+            bucket.indices.extend(t.iter().map(|&c| cv[c as usize]));
+        }
+        Ok(())
+    }
+
+    pub(crate) fn finish(
+        mut self,
+        table: &MaterialTable,
+        textures: &Textures,
+        stats: &mut ExportStats,
+    ) -> Result<(), ExportError> {
+        let mut root = json::Root {
+            asset: json::Asset {
+                generator: Some("CGA engine (cga-export)".into()),
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let mut layout = Layout::default();
+        // glTF texture index by texture id, in order of first use.
+        let mut gltf_textures: HashMap<u32, json::Index<json::Texture>> = HashMap::new();
+        let mut images: Vec<u32> = Vec::new();
+        let mut nodes = Vec::new();
+
+        for (id, bucket) in self.buckets.iter().enumerate() {
+            if bucket.indices.is_empty() {
+                continue;
+            }
+            let id = id as u32;
+            let name = table.name(id).to_string();
+            let count = bucket.vertex_count() as u64;
+            let mut attributes = std::collections::BTreeMap::new();
+            let positions = layout.accessor(
+                &mut root,
+                bucket.positions.len(),
+                count,
+                json::accessor::Type::Vec3,
+                json::accessor::ComponentType::F32,
+                Some(json::buffer::Target::ArrayBuffer),
+            );
+            let accessor = &mut root.accessors[positions.value()];
+            accessor.min = Some(bucket.min.to_vec().into());
+            accessor.max = Some(bucket.max.to_vec().into());
+            attributes.insert(Valid(json::mesh::Semantic::Positions), positions);
+            let normals = layout.accessor(
+                &mut root,
+                bucket.normals.len(),
+                count,
+                json::accessor::Type::Vec3,
+                json::accessor::ComponentType::F32,
+                Some(json::buffer::Target::ArrayBuffer),
+            );
+            attributes.insert(Valid(json::mesh::Semantic::Normals), normals);
+            if let Some(uvs) = &bucket.uvs {
+                let tex = layout.accessor(
+                    &mut root,
+                    uvs.len(),
+                    count,
+                    json::accessor::Type::Vec2,
+                    json::accessor::ComponentType::F32,
+                    Some(json::buffer::Target::ArrayBuffer),
+                );
+                attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), tex);
+            }
+            let indices = layout.accessor(
+                &mut root,
+                bucket.indices.len(),
+                bucket.indices.len() as u64,
+                json::accessor::Type::Scalar,
+                json::accessor::ComponentType::U32,
+                Some(json::buffer::Target::ElementArrayBuffer),
+            );
+
+            let base_color_texture = self.colormaps[id as usize].map(|t| {
+                let index = *gltf_textures.entry(t).or_insert_with(|| {
+                    images.push(t);
+                    add_texture(&mut root, textures, t, self.embed_images)
+                });
+                json::texture::Info {
+                    index,
+                    tex_coord: 0,
+                    extensions: None,
+                    extras: Default::default(),
+                }
+            });
+            let material = root.push(gltf_material(
+                table.get(id),
+                name.clone(),
+                base_color_texture,
+            ));
+            let mesh = root.push(json::Mesh {
+                extensions: None,
+                extras: Default::default(),
+                name: Some(name.clone()),
+                primitives: vec![json::mesh::Primitive {
+                    attributes,
+                    extensions: None,
+                    extras: Default::default(),
+                    indices: Some(indices),
+                    material: Some(material),
+                    mode: Valid(json::mesh::Mode::Triangles),
+                    targets: None,
+                }],
+                weights: None,
+            });
+            nodes.push(root.push(json::Node {
+                mesh: Some(mesh),
+                name: Some(name),
+                ..Default::default()
+            }));
+            stats.vertices += count;
+            stats.materials += 1;
+        }
+        stats.textures = images.len() as u64;
+        if self.embed_images {
+            // Images go after all geometry, in the order `write_bin` writes them.
+            for (i, &t) in images.iter().enumerate() {
+                let view = layout.view(&mut root, textures.get(t).len, None);
+                root.images[i].buffer_view = Some(view);
+            }
+        }
+
+        if !nodes.is_empty() {
+            let scene = root.push(json::Scene {
+                extensions: None,
+                extras: Default::default(),
+                name: None,
+                nodes,
+            });
+            root.scene = Some(scene);
+        }
+        let bin_len = layout.len;
+        if bin_len > 0 {
+            root.push(json::Buffer {
+                byte_length: USize64(bin_len),
+                name: None,
+                uri: (!self.binary).then(|| uri_encode(&self.bin_name)),
+                extensions: None,
+                extras: Default::default(),
+            });
+        }
+
+        let embedded: Vec<u32> = if self.embed_images {
+            images.clone()
+        } else {
+            Vec::new()
+        };
+        if self.binary {
+            self.write_glb(&root, bin_len, &embedded, textures)?;
+        } else {
+            let json = root
+                .to_vec_pretty()
+                .map_err(|e| ExportError::io(&self.path, e.into()))?;
+            self.out
+                .write_all(&json)
+                .and_then(|_| self.out.flush())
+                .map_err(|e| ExportError::io(&self.path, e))?;
+            if bin_len > 0 {
+                let bin_path = self.path.with_file_name(&self.bin_name);
+                let file = File::create(&bin_path).map_err(|e| ExportError::io(&bin_path, e))?;
+                let mut w = BufWriter::with_capacity(1 << 16, file);
+                write_bin(&mut w, &self.buckets, &[], textures, &bin_path)?;
+                w.flush().map_err(|e| ExportError::io(&bin_path, e))?;
+            }
+        }
+        if !self.embed_images {
+            textures.copy_all(images.iter().copied())?;
+        }
+        Ok(())
+    }
+
+    fn write_glb(
+        &mut self,
+        root: &json::Root,
+        bin_len: u64,
+        images: &[u32],
+        textures: &Textures,
+    ) -> Result<(), ExportError> {
+        let path = self.path.clone();
+        let io = |e| ExportError::io(&path, e);
+        let mut json = root.to_vec().map_err(|e| io(e.into()))?;
+        // Chunks are 4-byte aligned; JSON pads with spaces.
+        while json.len() % 4 != 0 {
+            json.push(b' ');
+        }
+        let bin_chunk = if bin_len > 0 { 8 + bin_len } else { 0 };
+        let total = 12 + 8 + json.len() as u64 + bin_chunk;
+        let total = u32::try_from(total)
+            .map_err(|_| ExportError::TooLarge(format!("GLB of {total} bytes exceeds 4 GiB")))?;
+        let out = &mut self.out;
+        out.write_all(b"glTF").map_err(io)?;
+        out.write_all(&2u32.to_le_bytes()).map_err(io)?;
+        out.write_all(&total.to_le_bytes()).map_err(io)?;
+        out.write_all(&(json.len() as u32).to_le_bytes())
+            .map_err(io)?;
+        out.write_all(b"JSON").map_err(io)?;
+        out.write_all(&json).map_err(io)?;
+        if bin_len > 0 {
+            out.write_all(&(bin_len as u32).to_le_bytes()).map_err(io)?;
+            out.write_all(b"BIN\0").map_err(io)?;
+            write_bin(out, &self.buckets, images, textures, &path)?;
+        }
+        out.flush().map_err(io)
+    }
+}
+
+/// Assigns buffer views and accessors their place in the binary buffer.
+#[derive(Default)]
+struct Layout {
+    /// Bytes laid out so far (always a multiple of 4).
+    len: u64,
+}
+
+impl Layout {
+    fn view(
+        &mut self,
+        root: &mut json::Root,
+        bytes: u64,
+        target: Option<json::buffer::Target>,
+    ) -> json::Index<json::buffer::View> {
+        let view = root.push(json::buffer::View {
+            buffer: json::Index::new(0),
+            byte_length: USize64(bytes),
+            byte_offset: Some(USize64(self.len)),
+            byte_stride: None,
+            name: None,
+            target: target.map(Valid),
+            extensions: None,
+            extras: Default::default(),
+        });
+        self.len += bytes.next_multiple_of(4);
+        view
+    }
+
+    /// A view holding `components` 4-byte values and an accessor on it.
+    fn accessor(
+        &mut self,
+        root: &mut json::Root,
+        components: usize,
+        count: u64,
+        type_: json::accessor::Type,
+        component_type: json::accessor::ComponentType,
+        target: Option<json::buffer::Target>,
+    ) -> json::Index<json::Accessor> {
+        let view = self.view(root, components as u64 * 4, target);
+        root.push(json::Accessor {
+            buffer_view: Some(view),
+            byte_offset: None,
+            count: USize64(count),
+            component_type: Valid(json::accessor::GenericComponentType(component_type)),
+            extensions: None,
+            extras: Default::default(),
+            type_: Valid(type_),
+            min: None,
+            max: None,
+            name: None,
+            normalized: false,
+            sparse: None,
+        })
+    }
+}
+
+/// Adds the image, sampler (shared) and texture for texture `t`. An
+/// embedded image gets its buffer view later, once all geometry is laid out.
+fn add_texture(
+    root: &mut json::Root,
+    textures: &Textures,
+    t: u32,
+    embed: bool,
+) -> json::Index<json::Texture> {
+    let tex = textures.get(t);
+    let name = Some(tex.out_name.clone());
+    let image = if embed {
+        json::Image {
+            buffer_view: None,
+            mime_type: tex.mime.map(|m| json::image::MimeType(m.to_string())),
+            name,
+            uri: None,
+            extensions: None,
+            extras: Default::default(),
+        }
+    } else {
+        json::Image {
+            buffer_view: None,
+            mime_type: None,
+            name,
+            uri: Some(uri_encode(&textures.reference(t))),
+            extensions: None,
+            extras: Default::default(),
+        }
+    };
+    let source = root.push(image);
+    if root.samplers.is_empty() {
+        // CGA textures tile (UVs beyond [0, 1] repeat); mipmaps keep
+        // distant facades from shimmering.
+        root.push(json::texture::Sampler {
+            mag_filter: Some(Valid(json::texture::MagFilter::Linear)),
+            min_filter: Some(Valid(json::texture::MinFilter::LinearMipmapLinear)),
+            wrap_s: Valid(json::texture::WrappingMode::Repeat),
+            wrap_t: Valid(json::texture::WrappingMode::Repeat),
+            ..Default::default()
+        });
+    }
+    root.push(json::Texture {
+        name: None,
+        sampler: Some(json::Index::new(0)),
+        source,
+        extensions: None,
+        extras: Default::default(),
+    })
+}
+
+/// The glTF material for a CGA material.
+fn gltf_material(
+    m: &Material,
+    name: String,
+    base_color_texture: Option<json::texture::Info>,
+) -> json::Material {
+    let linear = m.color.map(|c| srgb_to_linear(c) as f32);
+    let opacity = m.opacity.clamp(0.0, 1.0) as f32;
+    let unit = |x: f64| {
+        if x.is_finite() {
+            x.clamp(0.0, 1.0) as f32
+        } else {
+            0.0
+        }
+    };
+    let emissive = m.emissive.map(|c| srgb_to_linear(c) as f32);
+    json::Material {
+        alpha_mode: Valid(if opacity < 1.0 {
+            json::material::AlphaMode::Blend
+        } else {
+            json::material::AlphaMode::Opaque
+        }),
+        double_sided: m.double_sided,
+        name: Some(name),
+        pbr_metallic_roughness: json::material::PbrMetallicRoughness {
+            base_color_factor: json::material::PbrBaseColorFactor([
+                linear[0], linear[1], linear[2], opacity,
+            ]),
+            base_color_texture,
+            metallic_factor: json::material::StrengthFactor(unit(m.metallic)),
+            roughness_factor: json::material::StrengthFactor(unit(m.roughness)),
+            ..Default::default()
+        },
+        emissive_factor: json::material::EmissiveFactor(emissive),
+        ..Default::default()
+    }
+}
+
+/// Writes the binary buffer in [`Layout`] order: per non-empty bucket its
+/// positions, normals, UVs and indices, then the embedded `images`.
+fn write_bin(
+    w: &mut impl Write,
+    buckets: &[Bucket],
+    images: &[u32],
+    textures: &Textures,
+    path: &Path,
+) -> Result<(), ExportError> {
+    let io = |e| ExportError::io(path, e);
+    let mut scratch = vec![0u8; 1 << 14];
+    for b in buckets.iter().filter(|b| !b.indices.is_empty()) {
+        write_f32s(w, &b.positions, &mut scratch).map_err(io)?;
+        write_f32s(w, &b.normals, &mut scratch).map_err(io)?;
+        if let Some(uvs) = &b.uvs {
+            write_f32s(w, uvs, &mut scratch).map_err(io)?;
+        }
+        write_u32s(w, &b.indices, &mut scratch).map_err(io)?;
+    }
+    for &t in images {
+        let tex = textures.get(t);
+        let file = File::open(&tex.source).map_err(|e| ExportError::io(&tex.source, e))?;
+        let copied = std::io::copy(&mut file.take(tex.len), w).map_err(io)?;
+        if copied != tex.len {
+            let msg = format!(
+                "texture changed while exporting ({copied} of {} bytes)",
+                tex.len
+            );
+            return Err(ExportError::io(&tex.source, std::io::Error::other(msg)));
+        }
+        let pad = (tex.len.next_multiple_of(4) - tex.len) as usize;
+        w.write_all(&[0u8; 3][..pad]).map_err(io)?;
+    }
+    Ok(())
+}
+
+fn write_f32s(w: &mut impl Write, data: &[f32], scratch: &mut [u8]) -> std::io::Result<()> {
+    for chunk in data.chunks(scratch.len() / 4) {
+        for (dst, x) in scratch.chunks_exact_mut(4).zip(chunk) {
+            dst.copy_from_slice(&x.to_le_bytes());
+        }
+        w.write_all(&scratch[..chunk.len() * 4])?;
+    }
+    Ok(())
+}
+
+fn write_u32s(w: &mut impl Write, data: &[u32], scratch: &mut [u8]) -> std::io::Result<()> {
+    for chunk in data.chunks(scratch.len() / 4) {
+        for (dst, x) in scratch.chunks_exact_mut(4).zip(chunk) {
+            dst.copy_from_slice(&x.to_le_bytes());
+        }
+        w.write_all(&scratch[..chunk.len() * 4])?;
+    }
+    Ok(())
+}

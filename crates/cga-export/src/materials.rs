@@ -1,0 +1,227 @@
+//! The table of distinct materials of a model, in order of first appearance.
+//!
+//! Geometry is merged per material, so every face asks "which output material
+//! is this?". Materials are compared by value: two shapes that set the same
+//! colour, textures and so on share one output material even though their
+//! `Material` values were built separately.
+
+use std::collections::hash_map::Entry;
+use std::collections::{HashMap, HashSet};
+use std::hash::{Hash, Hasher};
+
+use cga_geometry::Material;
+
+/// A material as a hash map key. Equality is by value with two twists that
+/// keep the table small and well-defined: `0.0` and `-0.0` are the same, and
+/// so are any two NaNs (with IEEE equality a NaN material would never match
+/// itself and would create a new output material for every face).
+struct Key(Material);
+
+/// Bits of an `f64` under [`Key`]'s equality.
+fn bits(x: f64) -> u64 {
+    if x == 0.0 {
+        0
+    } else if x.is_nan() {
+        f64::NAN.to_bits()
+    } else {
+        x.to_bits()
+    }
+}
+
+/// How many numbers a material has (colours, scalars, texture transforms).
+const NUMBERS: usize = 4 * 3 + 7 + 10 * 5;
+
+/// Every number of a material as [`bits`], in a fixed order.
+fn numbers(m: &Material) -> [u64; NUMBERS] {
+    let mut out = [0u64; NUMBERS];
+    let colours = [m.color, m.ambient, m.specular, m.emissive];
+    let scalars = [
+        m.opacity,
+        m.reflectivity,
+        m.shininess,
+        m.bump_value,
+        m.metallic,
+        m.roughness,
+        m.opacitymap_cutoff,
+    ];
+    let transforms = m.maps.iter().flat_map(|t| [t.su, t.sv, t.tu, t.tv, t.rw]);
+    let all = colours
+        .into_iter()
+        .flatten()
+        .chain(scalars)
+        .chain(transforms);
+    for (slot, x) in out.iter_mut().zip(all) {
+        *slot = bits(x);
+    }
+    out
+}
+
+impl Hash for Key {
+    fn hash<H: Hasher>(&self, state: &mut H) {
+        let m = &self.0;
+        m.name.hash(state);
+        m.shader.hash(state);
+        m.double_sided.hash(state);
+        m.opacitymap_mode.hash(state);
+        for t in &m.maps {
+            t.path.hash(state);
+        }
+        numbers(m).hash(state);
+    }
+}
+
+impl PartialEq for Key {
+    fn eq(&self, other: &Key) -> bool {
+        let (a, b) = (&self.0, &other.0);
+        if a.name != b.name
+            || a.shader != b.shader
+            || a.double_sided != b.double_sided
+            || a.opacitymap_mode != b.opacitymap_mode
+            || a.maps.iter().zip(&b.maps).any(|(x, y)| x.path != y.path)
+        {
+            return false;
+        }
+        numbers(a) == numbers(b)
+    }
+}
+
+impl Eq for Key {}
+
+/// Distinct materials with their output names, indexed by material id.
+#[derive(Default)]
+pub(crate) struct MaterialTable {
+    ids: HashMap<Key, u32>,
+    /// Material by id (a clone; the input meshes are not kept).
+    materials: Vec<Material>,
+    /// Output name by id: unique, derived from `Material::name`.
+    names: Vec<String>,
+    taken: HashSet<String>,
+}
+
+impl MaterialTable {
+    /// The id of `m`, and whether it was new.
+    pub(crate) fn intern(&mut self, m: &Material) -> (u32, bool) {
+        // Cloning a material is cheap (its strings are `Arc`s); the lookup
+        // needs an owned key because `Key` wraps a value.
+        match self.ids.entry(Key(m.clone())) {
+            Entry::Occupied(e) => (*e.get(), false),
+            Entry::Vacant(e) => {
+                let id = self.materials.len() as u32;
+                e.insert(id);
+                self.materials.push(m.clone());
+                let name = unique_name(&m.name, &mut self.taken);
+                self.names.push(name);
+                (id, true)
+            }
+        }
+    }
+
+    pub(crate) fn get(&self, id: u32) -> &Material {
+        &self.materials[id as usize]
+    }
+
+    pub(crate) fn name(&self, id: u32) -> &str {
+        &self.names[id as usize]
+    }
+}
+
+/// A name usable in an MTL file (one token, no whitespace or control
+/// characters) that no earlier material of the model has: `brick`, then
+/// `brick_2`, `brick_3`, ... Names follow the order of first appearance, so
+/// the same model always gets the same names.
+fn unique_name(wanted: &str, taken: &mut HashSet<String>) -> String {
+    let mut base: String = wanted
+        .trim()
+        .chars()
+        .map(|c| {
+            if c.is_whitespace() || c.is_control() {
+                '_'
+            } else {
+                c
+            }
+        })
+        .collect();
+    if base.is_empty() {
+        base.push_str("material");
+    }
+    let mut name = base.clone();
+    let mut n = 2;
+    while taken.contains(&name) {
+        name = format!("{base}_{n}");
+        n += 1;
+    }
+    taken.insert(name.clone());
+    name
+}
+
+/// Converts a non-linear sRGB component to linear, as glTF requires for
+/// colour factors (CGA's `material.color` is sRGB, like the colour pickers
+/// that produce it).
+pub(crate) fn srgb_to_linear(c: f64) -> f64 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn equal_values_share_an_id() {
+        let mut t = MaterialTable::default();
+        let a = Material {
+            color: [0.5, 0.25, 0.0],
+            ..Material::default()
+        };
+        let mut b = Material::default();
+        b.color = [0.5, 0.25, -0.0];
+        assert_eq!(t.intern(&a), (0, true));
+        assert_eq!(t.intern(&b), (0, false));
+        let c = Material {
+            opacity: 0.5,
+            ..a.clone()
+        };
+        assert_eq!(t.intern(&c), (1, true));
+    }
+
+    #[test]
+    fn nan_material_matches_itself() {
+        let mut t = MaterialTable::default();
+        let m = Material {
+            roughness: f64::NAN,
+            ..Material::default()
+        };
+        assert_eq!(t.intern(&m), (0, true));
+        assert_eq!(t.intern(&m), (0, false));
+    }
+
+    #[test]
+    fn names_are_unique_and_tokens() {
+        let mut t = MaterialTable::default();
+        let named = |name: &str, r: f64| Material {
+            name: name.into(),
+            color: [r, 1.0, 1.0],
+            ..Material::default()
+        };
+        t.intern(&named("red brick", 0.1));
+        t.intern(&named("red brick", 0.2));
+        t.intern(&named("", 0.3));
+        t.intern(&named("red_brick_2", 0.4));
+        assert_eq!(t.name(0), "red_brick");
+        assert_eq!(t.name(1), "red_brick_2");
+        assert_eq!(t.name(2), "material");
+        assert_eq!(t.name(3), "red_brick_2_2");
+    }
+
+    #[test]
+    fn srgb_to_linear_known_values() {
+        assert_eq!(srgb_to_linear(0.0), 0.0);
+        assert_eq!(srgb_to_linear(1.0), 1.0);
+        assert!((srgb_to_linear(0.5) - 0.214_041_140_482_232_5).abs() < 1e-12);
+        assert!((srgb_to_linear(0.04) - 0.04 / 12.92).abs() < 1e-15);
+    }
+}

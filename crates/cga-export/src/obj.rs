@@ -1,0 +1,416 @@
+//! Wavefront OBJ + MTL output.
+//!
+//! Vertices (`v`, `vt`, `vn`) are written as meshes come, shared within a
+//! mesh (a position used by several faces of a shape is one `v`). Faces are
+//! grouped per material so each material has one `usemtl` group: the
+//! writer keeps them as compact index triples (12 bytes per corner) and
+//! writes them, and the MTL file, in `finish`.
+//!
+//! Faces are written as polygons; faces with holes are written as their
+//! triangles, since OBJ has no holes. Numbers are written with at most six
+//! decimals (micrometres for coordinates in metres), trailing zeros dropped.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use cga_geometry::{Material, Mesh};
+
+use crate::hash::FastMap;
+use crate::materials::MaterialTable;
+use crate::textures::Textures;
+use crate::{ExportError, ExportStats, FaceData};
+
+/// MTL statements for texture channels, with the channel index
+/// (see `cga_geometry::TEXTURE_CHANNELS`).
+const MAPS: [(&str, usize); 5] = [
+    ("map_Kd", 0),   // colormap
+    ("map_bump", 1), // bumpmap
+    ("map_Ks", 3),   // specularmap
+    ("map_d", 4),    // opacitymap
+    ("norm", 5),     // normalmap
+];
+
+/// How the MTL names one texture channel's file.
+enum MapRef {
+    /// A texture file that was found.
+    Found(u32),
+    /// Not found: the path as the rule wrote it (the name still tells a
+    /// reader, or a later copy of the textures, what was meant).
+    Missing(Arc<str>),
+}
+
+/// The faces of one material: per face its corner count, and per corner
+/// its 1-based (v, vt, vn) indices (vt = 0: none).
+#[derive(Default)]
+struct Group {
+    sizes: Vec<u32>,
+    refs: Vec<[u32; 3]>,
+}
+
+pub(crate) struct ObjWriter {
+    path: PathBuf,
+    out: BufWriter<File>,
+    mtl_name: String,
+    line: Vec<u8>,
+    v_count: u32,
+    vt_count: u32,
+    vn_count: u32,
+    /// `v` index of each position of the mesh being added (0: not written).
+    position_v: Vec<u32>,
+    vt_ids: FastMap<[u64; 2], u32>,
+    vn_ids: FastMap<[u64; 3], u32>,
+    /// (v, vt, vn) of each corner of the face being added.
+    corner_refs: Vec<[u32; 3]>,
+    groups: Vec<Group>,
+    maps: Vec<[Option<MapRef>; MAPS.len()]>,
+}
+
+impl ObjWriter {
+    pub(crate) fn create(path: &Path) -> Result<ObjWriter, ExportError> {
+        let file = File::create(path).map_err(|e| ExportError::io(path, e))?;
+        let stem = path
+            .file_stem()
+            .map_or("model".into(), |s| s.to_string_lossy());
+        let mtl_name = format!("{stem}.mtl");
+        let mut out = BufWriter::with_capacity(1 << 16, file);
+        // Material names are tokens (no spaces), the MTL file name may not be.
+        writeln!(out, "# CGA engine model\nmtllib {mtl_name}")
+            .map_err(|e| ExportError::io(path, e))?;
+        Ok(ObjWriter {
+            path: path.to_path_buf(),
+            out,
+            mtl_name,
+            line: Vec::with_capacity(256),
+            v_count: 0,
+            vt_count: 0,
+            vn_count: 0,
+            position_v: Vec::new(),
+            vt_ids: FastMap::default(),
+            vn_ids: FastMap::default(),
+            corner_refs: Vec::new(),
+            groups: Vec::new(),
+            maps: Vec::new(),
+        })
+    }
+
+    /// File names this writer creates next to the output.
+    pub(crate) fn file_names(&self) -> Vec<String> {
+        let own = self
+            .path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned());
+        own.into_iter().chain([self.mtl_name.clone()]).collect()
+    }
+
+    pub(crate) fn new_material(
+        &mut self,
+        material: &Material,
+        textures: &mut Textures,
+        warnings: &mut Vec<String>,
+    ) {
+        let maps = MAPS.map(|(_, channel)| {
+            let path = &material.maps[channel].path;
+            if path.is_empty() {
+                return None;
+            }
+            Some(match textures.resolve(path, warnings) {
+                Some(t) => MapRef::Found(t),
+                None => MapRef::Missing(path.clone()),
+            })
+        });
+        self.maps.push(maps);
+        self.groups.push(Group::default());
+    }
+
+    pub(crate) fn begin_mesh(&mut self, mesh: &Mesh) {
+        self.position_v.clear();
+        self.position_v.resize(mesh.positions.len(), 0);
+        self.vt_ids.clear();
+        self.vn_ids.clear();
+        self.corner_refs.clear();
+        self.corner_refs.resize(mesh.corners.len(), [0; 3]);
+    }
+
+    pub(crate) fn add_face(&mut self, f: &FaceData) -> Result<(), ExportError> {
+        let mesh = f.mesh;
+        let uvs = mesh.uvs[0].as_deref();
+        let loops = mesh.face_loops(f.face);
+        for &l in loops {
+            for c in mesh.loop_corners(l) {
+                let position = mesh.corners[c] as usize;
+                let mut v = self.position_v[position];
+                if v == 0 {
+                    let p = mesh.positions[position];
+                    v = next(&mut self.v_count)?;
+                    self.position_v[position] = v;
+                    write_line(&mut self.out, &mut self.line, "v", &[p.x, p.y, p.z])
+                        .map_err(|e| ExportError::io(&self.path, e))?;
+                }
+                let vt = match uvs {
+                    None => 0,
+                    Some(uvs) => {
+                        let t = uvs[c];
+                        let key = [t.x, t.y].map(f64::to_bits);
+                        match self.vt_ids.get(&key) {
+                            Some(&vt) => vt,
+                            None => {
+                                let vt = next(&mut self.vt_count)?;
+                                self.vt_ids.insert(key, vt);
+                                write_line(&mut self.out, &mut self.line, "vt", &[t.x, t.y])
+                                    .map_err(|e| ExportError::io(&self.path, e))?;
+                                vt
+                            }
+                        }
+                    }
+                };
+                let n = match &mesh.normals {
+                    Some(normals) => normals[c].try_normalize().unwrap_or(f.normal),
+                    None => f.normal,
+                };
+                let key = [n.x, n.y, n.z].map(f64::to_bits);
+                let vn = match self.vn_ids.get(&key) {
+                    Some(&vn) => vn,
+                    None => {
+                        let vn = next(&mut self.vn_count)?;
+                        self.vn_ids.insert(key, vn);
+                        write_line(&mut self.out, &mut self.line, "vn", &[n.x, n.y, n.z])
+                            .map_err(|e| ExportError::io(&self.path, e))?;
+                        vn
+                    }
+                };
+                self.corner_refs[c] = [v, vt, vn];
+            }
+        }
+        let group = &mut self.groups[f.material as usize];
+        if loops.len() == 1 {
+            let outer = mesh.loop_corners(loops[0]);
+            group.sizes.push(outer.len() as u32);
+            group.refs.extend(outer.map(|c| self.corner_refs[c]));
+        } else {
+            for t in f.triangles {
+                group.sizes.push(3);
+                group
+                    .refs
+                    .extend(t.iter().map(|&c| self.corner_refs[c as usize]));
+            }
+        }
+        Ok(())
+    }
+
+    pub(crate) fn finish(
+        mut self,
+        table: &MaterialTable,
+        textures: &Textures,
+        stats: &mut ExportStats,
+    ) -> Result<(), ExportError> {
+        let path = self.path.clone();
+        let io = |e| ExportError::io(&path, e);
+        let used: Vec<u32> = (0..self.groups.len() as u32)
+            .filter(|&id| !self.groups[id as usize].sizes.is_empty())
+            .collect();
+        let out = &mut self.out;
+        for &id in &used {
+            let group = &self.groups[id as usize];
+            writeln!(out, "usemtl {}", table.name(id)).map_err(io)?;
+            let mut refs = group.refs.iter();
+            for &size in &group.sizes {
+                let line = &mut self.line;
+                line.clear();
+                line.push(b'f');
+                for &[v, vt, vn] in refs.by_ref().take(size as usize) {
+                    line.push(b' ');
+                    push_u32(line, v);
+                    line.push(b'/');
+                    if vt != 0 {
+                        push_u32(line, vt);
+                    }
+                    line.push(b'/');
+                    push_u32(line, vn);
+                }
+                line.push(b'\n');
+                out.write_all(line).map_err(io)?;
+            }
+        }
+        out.flush().map_err(io)?;
+
+        let mtl_path = self.path.with_file_name(&self.mtl_name);
+        let file = File::create(&mtl_path).map_err(|e| ExportError::io(&mtl_path, e))?;
+        let mut mtl = BufWriter::new(file);
+        let mut copied = Vec::new();
+        for &id in &used {
+            write_material(
+                &mut mtl,
+                table.name(id),
+                table.get(id),
+                &self.maps[id as usize],
+                textures,
+                &mut copied,
+            )
+            .map_err(|e| ExportError::io(&mtl_path, e))?;
+        }
+        mtl.flush().map_err(|e| ExportError::io(&mtl_path, e))?;
+        copied.sort_unstable();
+        copied.dedup();
+        textures.copy_all(copied.iter().copied())?;
+
+        stats.vertices += self.v_count as u64;
+        stats.materials += used.len() as u64;
+        stats.textures += copied.len() as u64;
+        Ok(())
+    }
+}
+
+fn write_material(
+    w: &mut impl Write,
+    name: &str,
+    m: &Material,
+    maps: &[Option<MapRef>],
+    textures: &Textures,
+    used_textures: &mut Vec<u32>,
+) -> std::io::Result<()> {
+    let mut line = Vec::new();
+    writeln!(w, "newmtl {name}\nillum 2")?;
+    write_line(w, &mut line, "Kd", &m.color)?;
+    write_line(w, &mut line, "Ka", &m.ambient)?;
+    write_line(w, &mut line, "Ks", &m.specular)?;
+    if m.emissive != [0.0; 3] {
+        write_line(w, &mut line, "Ke", &m.emissive)?;
+    }
+    write_line(w, &mut line, "Ns", &[m.shininess])?;
+    write_line(w, &mut line, "d", &[m.opacity])?;
+    for ((keyword, _), map) in MAPS.iter().zip(maps) {
+        match map {
+            None => {}
+            Some(MapRef::Found(t)) => {
+                used_textures.push(*t);
+                writeln!(w, "{keyword} {}", textures.reference(*t))?;
+            }
+            Some(MapRef::Missing(path)) => writeln!(w, "{keyword} {path}")?,
+        }
+    }
+    writeln!(w)
+}
+
+/// The next 1-based index of a counter.
+fn next(count: &mut u32) -> Result<u32, ExportError> {
+    *count = count
+        .checked_add(1)
+        .ok_or_else(|| ExportError::TooLarge("more than 2^32 OBJ vertices".into()))?;
+    Ok(*count)
+}
+
+/// Writes `keyword x y ...` and a newline.
+fn write_line(
+    w: &mut impl Write,
+    line: &mut Vec<u8>,
+    keyword: &str,
+    values: &[f64],
+) -> std::io::Result<()> {
+    line.clear();
+    line.extend_from_slice(keyword.as_bytes());
+    for &x in values {
+        line.push(b' ');
+        push_f64(line, x);
+    }
+    line.push(b'\n');
+    w.write_all(line)
+}
+
+/// Appends `x` with at most six decimals, without trailing zeros (`2.5`,
+/// `-0.333333`, `10`). Much faster than `format!` and gives compact files;
+/// values too large for that (|x| >= 9e9) use Rust's shortest form.
+fn push_f64(out: &mut Vec<u8>, x: f64) {
+    const SCALE: f64 = 1e6;
+    let scaled = (x * SCALE).round();
+    if scaled.is_nan() || scaled.abs() >= 9e15 {
+        if x.is_finite() {
+            out.extend_from_slice(format!("{x}").as_bytes());
+        } else {
+            out.push(b'0');
+        }
+        return;
+    }
+    let mut n = scaled as i64;
+    if n == 0 {
+        // Also for -0.0 and tiny negatives: `-0` would be odd.
+        out.push(b'0');
+        return;
+    }
+    if n < 0 {
+        out.push(b'-');
+        n = -n;
+    }
+    push_u64(out, (n / 1_000_000) as u64);
+    let mut frac = n % 1_000_000;
+    if frac != 0 {
+        let mut digits = 6;
+        while frac % 10 == 0 {
+            frac /= 10;
+            digits -= 1;
+        }
+        out.push(b'.');
+        let mut buf = [b'0'; 6];
+        for d in buf[..digits].iter_mut().rev() {
+            *d = b'0' + (frac % 10) as u8;
+            frac /= 10;
+        }
+        out.extend_from_slice(&buf[..digits]);
+    }
+}
+
+fn push_u32(out: &mut Vec<u8>, n: u32) {
+    push_u64(out, n as u64);
+}
+
+fn push_u64(out: &mut Vec<u8>, mut n: u64) {
+    let mut buf = [0u8; 20];
+    let mut i = buf.len();
+    loop {
+        i -= 1;
+        buf[i] = b'0' + (n % 10) as u8;
+        n /= 10;
+        if n == 0 {
+            break;
+        }
+    }
+    out.extend_from_slice(&buf[i..]);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fmt(x: f64) -> String {
+        let mut v = Vec::new();
+        push_f64(&mut v, x);
+        String::from_utf8(v).unwrap()
+    }
+
+    #[test]
+    fn numbers_are_compact_and_rounded() {
+        assert_eq!(fmt(0.0), "0");
+        assert_eq!(fmt(-0.0), "0");
+        assert_eq!(fmt(-1e-9), "0");
+        assert_eq!(fmt(2.5), "2.5");
+        assert_eq!(fmt(-2.5), "-2.5");
+        assert_eq!(fmt(10.0), "10");
+        assert_eq!(fmt(0.1 + 0.2), "0.3");
+        assert_eq!(fmt(1.0 / 3.0), "0.333333");
+        assert_eq!(fmt(-0.000_001), "-0.000001");
+        assert_eq!(fmt(0.05), "0.05");
+        assert_eq!(fmt(123_456.789_012_3), "123456.789012");
+        assert_eq!(fmt(1e12), "1000000000000");
+        assert_eq!(fmt(f64::NAN), "0");
+    }
+
+    #[test]
+    fn integers() {
+        let mut v = Vec::new();
+        push_u32(&mut v, 0);
+        v.push(b' ');
+        push_u32(&mut v, 4_294_967_295);
+        assert_eq!(v, b"0 4294967295");
+    }
+}

@@ -1,0 +1,272 @@
+//! Finding texture files and deciding how the output refers to them.
+//!
+//! A rule names textures as it wrote them (`"assets/brick.jpg"`,
+//! `"/Project/assets/brick.jpg"`). Such a path is looked up as an existing
+//! absolute path first, then relative to each texture root in order (a
+//! leading `/`, CityEngine's workspace-absolute form, is dropped for that).
+//! A texture that cannot be found is a warning, never an error: the model is
+//! still worth having without it.
+
+use std::collections::{HashMap, HashSet};
+use std::fs::File;
+use std::io::Read;
+use std::path::{Component, Path, PathBuf};
+use std::sync::Arc;
+
+use crate::ExportError;
+
+/// One texture file that the output uses.
+pub(crate) struct Texture {
+    /// Where the file is (canonical path).
+    pub source: PathBuf,
+    /// File size when it was found; embedding checks it did not change.
+    pub len: u64,
+    /// `image/png` or `image/jpeg`, from the file's first bytes; `None` for
+    /// other formats (which glTF cannot use).
+    pub mime: Option<&'static str>,
+    /// File name next to the output when textures are copied there; unique
+    /// among the textures and output files of the model.
+    pub out_name: String,
+}
+
+pub(crate) struct Textures {
+    roots: Vec<PathBuf>,
+    /// Copy textures next to the output (else refer to them where they are).
+    copy: bool,
+    out_dir: PathBuf,
+    by_rule_path: HashMap<Arc<str>, Option<u32>>,
+    by_source: HashMap<PathBuf, u32>,
+    names: HashSet<String>,
+    list: Vec<Texture>,
+}
+
+impl Textures {
+    /// `reserved`: file names of the model's own output files, which a copied
+    /// texture must not overwrite.
+    pub(crate) fn new(roots: &[PathBuf], copy: bool, out_dir: &Path, reserved: &[&str]) -> Self {
+        Textures {
+            roots: roots.to_vec(),
+            copy,
+            out_dir: out_dir.to_path_buf(),
+            by_rule_path: HashMap::new(),
+            by_source: HashMap::new(),
+            names: reserved.iter().map(|s| s.to_string()).collect(),
+            list: Vec::new(),
+        }
+    }
+
+    /// The texture a rule path names, found once per distinct path; a path
+    /// that names no readable file adds one warning and gives `None`.
+    pub(crate) fn resolve(
+        &mut self,
+        rule_path: &Arc<str>,
+        warnings: &mut Vec<String>,
+    ) -> Option<u32> {
+        if rule_path.is_empty() {
+            return None;
+        }
+        if let Some(&known) = self.by_rule_path.get(rule_path) {
+            return known;
+        }
+        let found = self.locate(rule_path).and_then(|p| self.add(&p).ok());
+        if found.is_none() {
+            let searched = if self.roots.is_empty() {
+                "the current directory".to_string()
+            } else {
+                self.roots
+                    .iter()
+                    .map(|r| format!("'{}'", r.display()))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            warnings.push(format!(
+                "texture '{rule_path}' not found (searched {searched}); written without it"
+            ));
+        }
+        self.by_rule_path.insert(rule_path.clone(), found);
+        found
+    }
+
+    fn locate(&self, rule_path: &str) -> Option<PathBuf> {
+        let path = Path::new(rule_path);
+        if path.is_absolute() && path.is_file() {
+            return Some(path.to_path_buf());
+        }
+        let relative = rule_path.trim_start_matches(['/', '\\']);
+        if relative.is_empty() {
+            return None;
+        }
+        if self.roots.is_empty() {
+            let p = Path::new(relative);
+            return p.is_file().then(|| p.to_path_buf());
+        }
+        self.roots
+            .iter()
+            .map(|root| root.join(relative))
+            .find(|p| p.is_file())
+    }
+
+    fn add(&mut self, path: &Path) -> std::io::Result<u32> {
+        let source = path.canonicalize()?;
+        if let Some(&i) = self.by_source.get(&source) {
+            return Ok(i);
+        }
+        let mut file = File::open(&source)?;
+        let len = file.metadata()?.len();
+        let mut magic = [0u8; 8];
+        let n = read_up_to(&mut file, &mut magic)?;
+        let mime = sniff_mime(&magic[..n]);
+        let out_name = self.unique_name(&source);
+        let i = self.list.len() as u32;
+        self.list.push(Texture {
+            source: source.clone(),
+            len,
+            mime,
+            out_name,
+        });
+        self.by_source.insert(source, i);
+        Ok(i)
+    }
+
+    /// `wall.jpg`, or `wall_2.jpg` when another texture already took that
+    /// name (two folders can both hold a `wall.jpg`).
+    fn unique_name(&mut self, source: &Path) -> String {
+        let stem = source
+            .file_stem()
+            .map_or("texture".into(), |s| s.to_string_lossy());
+        let ext = source.extension().map(|e| e.to_string_lossy());
+        let with = |suffix: &str| match &ext {
+            Some(e) => format!("{stem}{suffix}.{e}"),
+            None => format!("{stem}{suffix}"),
+        };
+        let mut name = with("");
+        let mut n = 2;
+        while self.names.contains(&name) {
+            name = with(&format!("_{n}"));
+            n += 1;
+        }
+        self.names.insert(name.clone());
+        name
+    }
+
+    pub(crate) fn get(&self, i: u32) -> &Texture {
+        &self.list[i as usize]
+    }
+
+    /// How the output refers to texture `i`, as a `/`-separated path: its
+    /// copied file name, or the path from the output's folder to the source.
+    pub(crate) fn reference(&self, i: u32) -> String {
+        let t = self.get(i);
+        if self.copy {
+            return t.out_name.clone();
+        }
+        let out_dir = self
+            .out_dir
+            .canonicalize()
+            .unwrap_or_else(|_| self.out_dir.clone());
+        match relative_path(&out_dir, &t.source) {
+            Some(rel) => rel,
+            None => t.source.to_string_lossy().replace('\\', "/"),
+        }
+    }
+
+    /// Copies the given textures next to the output, when copying.
+    pub(crate) fn copy_all(&self, which: impl IntoIterator<Item = u32>) -> Result<(), ExportError> {
+        if !self.copy {
+            return Ok(());
+        }
+        for t in which.into_iter().map(|i| self.get(i)) {
+            let dest = self.out_dir.join(&t.out_name);
+            let same = dest.canonicalize().is_ok_and(|d| d == t.source);
+            if !same {
+                std::fs::copy(&t.source, &dest).map_err(|e| ExportError::io(&dest, e))?;
+            }
+        }
+        Ok(())
+    }
+}
+
+fn read_up_to(file: &mut File, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut n = 0;
+    while n < buf.len() {
+        match file.read(&mut buf[n..])? {
+            0 => break,
+            k => n += k,
+        }
+    }
+    Ok(n)
+}
+
+/// The image formats glTF 2.0 core allows, recognised by their signatures.
+fn sniff_mime(head: &[u8]) -> Option<&'static str> {
+    if head.starts_with(&[0x89, b'P', b'N', b'G', b'\r', b'\n', 0x1a, b'\n']) {
+        Some("image/png")
+    } else if head.starts_with(&[0xff, 0xd8, 0xff]) {
+        Some("image/jpeg")
+    } else {
+        None
+    }
+}
+
+/// `to` relative to the folder `from` (both absolute), `/`-separated, or
+/// `None` when they share no root (other drive).
+fn relative_path(from: &Path, to: &Path) -> Option<String> {
+    let a: Vec<Component> = from.components().collect();
+    let b: Vec<Component> = to.components().collect();
+    let common = a.iter().zip(&b).take_while(|(x, y)| x == y).count();
+    if common == 0 {
+        return None;
+    }
+    let mut parts: Vec<String> = vec!["..".to_string(); a.len() - common];
+    parts.extend(
+        b[common..]
+            .iter()
+            .map(|c| c.as_os_str().to_string_lossy().into_owned()),
+    );
+    Some(parts.join("/"))
+}
+
+/// Percent-encodes a `/`-separated relative path for a glTF `uri`: every byte
+/// but RFC 3986's unreserved characters and `/` is escaped, so spaces and
+/// non-ASCII names survive.
+pub(crate) fn uri_encode(path: &str) -> String {
+    let mut out = String::with_capacity(path.len());
+    for b in path.bytes() {
+        if b.is_ascii_alphanumeric() || matches!(b, b'-' | b'.' | b'_' | b'~' | b'/') {
+            out.push(b as char);
+        } else {
+            out.push_str(&format!("%{b:02X}"));
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn relative_paths() {
+        assert_eq!(
+            relative_path(Path::new("/a/b/out"), Path::new("/a/b/tex/w.png")).as_deref(),
+            Some("../tex/w.png")
+        );
+        assert_eq!(
+            relative_path(Path::new("/a/out"), Path::new("/a/out/w.png")).as_deref(),
+            Some("w.png")
+        );
+    }
+
+    #[test]
+    fn uri_encoding_escapes_spaces_and_utf8() {
+        assert_eq!(uri_encode("../my tex/é.png"), "../my%20tex/%C3%A9.png");
+    }
+
+    #[test]
+    fn mime_from_signature() {
+        assert_eq!(sniff_mime(b"\x89PNG\r\n\x1a\n"), Some("image/png"));
+        assert_eq!(sniff_mime(&[0xff, 0xd8, 0xff, 0xe0]), Some("image/jpeg"));
+        assert_eq!(sniff_mime(b"II*\0"), None);
+        assert_eq!(sniff_mime(b""), None);
+    }
+}

@@ -1,1 +1,289 @@
-fn main() {}
+//! `cga`: generate 3D models from CGA rule files, and check rule files.
+//!
+//! ```text
+//! cga generate RULES.cga [--lot SPEC]... [--start-rule NAME] [--attr NAME=VALUE]...
+//!                        [--seed N] [-o OUT.glb|OUT.gltf|OUT.obj] [--report OUT.json]
+//! cga check RULES.cga
+//! ```
+//!
+//! Standard output carries only the lines of `print()`, in derivation order.
+//! Diagnostics go to standard error. Exit status: 0 on success, 1 when a rule
+//! file has errors (or derivation stopped on one), 2 on usage errors.
+
+mod report;
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Args, Parser, Subcommand};
+
+use cga_engine::generate::parse_value;
+use cga_engine::lot::{self, Lot};
+use cga_engine::{generate_lot, GenerateOptions, Limits};
+use cga_export::{ExportOptions, Format, ModelWriter};
+use cga_syntax::{Diagnostic, SourceMap};
+
+#[derive(Parser)]
+#[command(name = "cga", version, about = "Generate 3D models from CGA shape grammar rules")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Derive lots with a rule file and write the model.
+    Generate(GenerateArgs),
+    /// Parse and resolve a rule file; report every error.
+    Check {
+        /// The rule file.
+        rules: PathBuf,
+    },
+}
+
+#[derive(Args)]
+struct GenerateArgs {
+    /// The rule file (.cga).
+    rules: PathBuf,
+    /// A lot: `rect:W,D`, an .obj file (each face one lot) or a .geojson
+    /// file (each polygon one lot). Repeatable. Default: `rect:20,30`.
+    #[arg(long = "lot", value_name = "SPEC")]
+    lots: Vec<String>,
+    /// The start rule (default: the rule marked @StartRule, else `Lot`).
+    #[arg(long, value_name = "NAME")]
+    start_rule: Option<String>,
+    /// Set a rule attribute: a number, `true`/`false`, or a string. Repeatable.
+    #[arg(long = "attr", value_name = "NAME=VALUE")]
+    attrs: Vec<String>,
+    /// Random seed.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Output model: .glb, .gltf or .obj.
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    output: Option<PathBuf>,
+    /// Write the values of report() as JSON.
+    #[arg(long, value_name = "FILE")]
+    report: Option<PathBuf>,
+    /// Maximum nesting of rule invocations.
+    #[arg(long, default_value_t = Limits::default().max_depth)]
+    max_depth: usize,
+    /// Maximum number of shapes per lot.
+    #[arg(long, default_value_t = Limits::default().max_shapes)]
+    max_shapes: usize,
+}
+
+/// How a run ended.
+enum Failure {
+    /// Errors in the rules (already reported): exit 1.
+    Rules,
+    /// A usage error (bad arguments, unreadable lot file): exit 2.
+    Usage(String),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Generate(args) => generate(args),
+        Command::Check { rules } => check(&rules),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(Failure::Rules) => ExitCode::from(1),
+        Err(Failure::Usage(message)) => {
+            eprintln!("error: {message}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn report_diagnostics(diags: &[Diagnostic], sources: &SourceMap) {
+    for d in diags {
+        eprint!("{}", d.render(sources));
+    }
+}
+
+/// Loads and resolves a rule file, reporting its diagnostics.
+fn load(path: &Path, sources: &mut SourceMap) -> Result<cga_engine::Program, Failure> {
+    if !path.is_file() {
+        return Err(Failure::Usage(format!(
+            "rule file {} not found",
+            path.display()
+        )));
+    }
+    let loaded = cga_engine::load(path, sources);
+    report_diagnostics(&loaded.diagnostics, sources);
+    loaded.program.ok_or(Failure::Rules)
+}
+
+fn check(path: &Path) -> Result<(), Failure> {
+    let mut sources = SourceMap::new();
+    let program = load(path, &mut sources)?;
+    eprintln!(
+        "{}: ok ({} rules, {} attributes, {} functions)",
+        path.display(),
+        program.rules.len(),
+        program.attrs.len(),
+        program.functions.len()
+    );
+    Ok(())
+}
+
+fn read_lots(specs: &[String]) -> Result<Vec<Lot>, Failure> {
+    if specs.is_empty() {
+        return Ok(vec![lot::rect(20.0, 30.0)]);
+    }
+    let mut lots = Vec::new();
+    for spec in specs {
+        if let Some(rect) = spec.strip_prefix("rect:") {
+            lots.push(lot::parse_rect(rect).map_err(Failure::Usage)?);
+            continue;
+        }
+        let path = Path::new(spec);
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase());
+        let more = match ext.as_deref() {
+            Some("obj") => lot::from_obj(path),
+            Some("geojson" | "json") => lot::from_geojson(path),
+            _ => {
+                return Err(Failure::Usage(format!(
+                    "unknown lot `{spec}`: expected rect:W,D, an .obj or a .geojson file"
+                )))
+            }
+        };
+        lots.extend(more.map_err(Failure::Usage)?);
+    }
+    Ok(lots)
+}
+
+fn generate(args: GenerateArgs) -> Result<(), Failure> {
+    let format = match &args.output {
+        Some(path) => Some(Format::from_path(path).ok_or_else(|| {
+            Failure::Usage(format!(
+                "cannot tell the output format of {}: use .glb, .gltf or .obj",
+                path.display()
+            ))
+        })?),
+        None => None,
+    };
+    let lots = read_lots(&args.lots)?;
+    let mut sources = SourceMap::new();
+    let program = load(&args.rules, &mut sources)?;
+    let rule = program
+        .start_rule(args.start_rule.as_deref())
+        .map_err(Failure::Usage)?;
+    let mut options = GenerateOptions {
+        seed: args.seed,
+        limits: Limits {
+            max_depth: args.max_depth,
+            max_shapes: args.max_shapes,
+        },
+        ..GenerateOptions::default()
+    };
+    for a in &args.attrs {
+        let (name, value) = a
+            .split_once('=')
+            .ok_or_else(|| Failure::Usage(format!("expected --attr NAME=VALUE, found `{a}`")))?;
+        let id = program.main_attr(name).ok_or_else(|| {
+            let known: Vec<&str> = program.main_attrs.iter().map(|(n, _)| n.as_str()).collect();
+            Failure::Usage(format!(
+                "the rule file has no attribute `{name}` (attributes: {})",
+                if known.is_empty() {
+                    "none".to_string()
+                } else {
+                    known.join(", ")
+                }
+            ))
+        })?;
+        options.attrs.push((id, parse_value(value)));
+    }
+
+    let assets = cga_engine::assets::Assets::new(&sources);
+    let mut writer = match (&args.output, format) {
+        (Some(path), Some(format)) => {
+            let root = args
+                .rules
+                .parent()
+                .map(Path::to_path_buf)
+                .unwrap_or_default();
+            let export = ExportOptions {
+                texture_roots: project_roots(&root),
+                ..ExportOptions::default()
+            };
+            Some(
+                ModelWriter::create(path, format, export)
+                    .map_err(|e| Failure::Usage(format!("cannot write {}: {e}", path.display())))?,
+            )
+        }
+        _ => None,
+    };
+
+    let mut failed = false;
+    let mut reports = report::Reports::default();
+    let mut shapes = 0usize;
+    let mut leaves = 0usize;
+    for (i, lot) in lots.iter().enumerate() {
+        let (out, error) = generate_lot(&program, &assets, rule, lot, i, &options);
+        {
+            use std::io::Write;
+            let mut stdout = std::io::stdout().lock();
+            for line in &out.prints {
+                let _ = writeln!(stdout, "{line}");
+            }
+        }
+        report_diagnostics(&out.warnings, &sources);
+        if let Some(e) = error {
+            report_diagnostics(&[e.to_diagnostic()], &sources);
+            failed = true;
+        }
+        reports.add(&out.reports);
+        shapes += out.shapes;
+        leaves += out.meshes.len();
+        if let Some(w) = writer.as_mut() {
+            for m in &out.meshes {
+                w.add_mesh(m)
+                    .map_err(|e| Failure::Usage(format!("export failed: {e}")))?;
+            }
+        }
+    }
+    if let Some(w) = writer {
+        let stats = w
+            .finish()
+            .map_err(|e| Failure::Usage(format!("export failed: {e}")))?;
+        for warning in &stats.warnings {
+            eprintln!("warning: {warning}");
+        }
+        if let Some(path) = &args.output {
+            eprintln!(
+                "wrote {}: {} lots, {} shapes, {} leaf shapes, {} faces, {} triangles",
+                path.display(),
+                lots.len(),
+                shapes,
+                leaves,
+                stats.faces,
+                stats.triangles
+            );
+        }
+    }
+    if let Some(path) = &args.report {
+        std::fs::write(path, reports.to_json())
+            .map_err(|e| Failure::Usage(format!("cannot write {}: {e}", path.display())))?;
+    }
+    if failed {
+        Err(Failure::Rules)
+    } else {
+        Ok(())
+    }
+}
+
+/// Where textures named in the rules may be: the rule file's folder and its
+/// ancestors (project roots), with their `assets/` folders.
+fn project_roots(rule_dir: &Path) -> Vec<PathBuf> {
+    let mut roots = Vec::new();
+    for dir in rule_dir.ancestors() {
+        roots.push(dir.join("assets"));
+        roots.push(dir.to_path_buf());
+    }
+    roots
+}

@@ -205,3 +205,108 @@ mod tests {
         assert!((s.scope.frame.axes.y_axis - DVec3::Y).length() < 1e-12);
     }
 }
+
+/// Each polygon of a GeoJSON file is one lot (MultiPolygons give one lot
+/// per polygon); holes are kept; feature properties become attribute values.
+/// GeoJSON `[x, y, z]` maps to `(x, z, -y)`: y up, north away from the viewer.
+pub fn from_geojson(path: &std::path::Path) -> Result<Vec<Lot>, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("cannot read lot file {}: {e}", path.display()))?;
+    let gj: geojson::GeoJson = text
+        .parse()
+        .map_err(|e| format!("{} is not valid GeoJSON: {e}", path.display()))?;
+    let features: Vec<geojson::Feature> = match gj {
+        geojson::GeoJson::FeatureCollection(fc) => fc.features,
+        geojson::GeoJson::Feature(f) => vec![f],
+        geojson::GeoJson::Geometry(g) => vec![geojson::Feature {
+            geometry: Some(g),
+            ..Default::default()
+        }],
+    };
+    let mut lots = Vec::new();
+    for (fi, feature) in features.iter().enumerate() {
+        let attrs: Vec<(String, Value)> = feature
+            .properties
+            .iter()
+            .flatten()
+            .filter_map(|(k, v)| {
+                let v = match v {
+                    serde_json::Value::Number(n) => Value::Float(n.as_f64()?),
+                    serde_json::Value::Bool(b) => Value::Bool(*b),
+                    serde_json::Value::String(s) => Value::Str(Arc::from(s.as_str())),
+                    _ => return None,
+                };
+                Some((k.clone(), v))
+            })
+            .collect();
+        let Some(geometry) = &feature.geometry else {
+            continue;
+        };
+        let polygons: Vec<&Vec<Vec<Vec<f64>>>> = match &geometry.value {
+            geojson::Value::Polygon(p) => vec![p],
+            geojson::Value::MultiPolygon(mp) => mp.iter().collect(),
+            _ => continue,
+        };
+        for (pi, rings) in polygons.into_iter().enumerate() {
+            let mut mesh = Mesh::new();
+            let mut loops: Vec<Vec<u32>> = Vec::new();
+            for ring in rings {
+                let mut pts: Vec<DVec3> = ring
+                    .iter()
+                    .filter(|c| c.len() >= 2 && c.iter().all(|x| x.is_finite()))
+                    .map(|c| DVec3::new(c[0], c.get(2).copied().unwrap_or(0.0), -c[1]))
+                    .collect();
+                // GeoJSON rings repeat their first point at the end.
+                if pts.len() > 1 && pts.first() == pts.last() {
+                    pts.pop();
+                }
+                if pts.len() < 3 {
+                    continue;
+                }
+                let start = mesh.positions.len() as u32;
+                mesh.positions.extend(pts.iter().copied());
+                loops.push((start..mesh.positions.len() as u32).collect());
+            }
+            if loops.is_empty() {
+                continue;
+            }
+            orient_rings(&mesh.positions, &mut loops);
+            let refs: Vec<&[u32]> = loops.iter().map(|l| l.as_slice()).collect();
+            mesh.add_face(&refs, 0);
+            let id = feature
+                .id
+                .as_ref()
+                .map(|id| match id {
+                    geojson::feature::Id::String(s) => s.clone(),
+                    geojson::feature::Id::Number(n) => n.to_string(),
+                })
+                .unwrap_or_else(|| fi.to_string());
+            lots.push(Lot {
+                name: if pi == 0 { id } else { format!("{id}.{pi}") },
+                mesh,
+                attrs: attrs.clone(),
+            });
+        }
+    }
+    if lots.is_empty() {
+        return Err(format!("{} has no polygons to use as lots", path.display()));
+    }
+    Ok(lots)
+}
+
+/// Outer ring counter-clockwise seen from above (+y), holes clockwise.
+fn orient_rings(positions: &[DVec3], loops: &mut [Vec<u32>]) {
+    for (i, l) in loops.iter_mut().enumerate() {
+        // Signed area in the x-z plane seen from +y: positive = counter-clockwise.
+        let mut a = 0.0;
+        for k in 0..l.len() {
+            let p = positions[l[k] as usize];
+            let q = positions[l[(k + 1) % l.len()] as usize];
+            a += p.z * q.x - p.x * q.z;
+        }
+        let ccw = a > 0.0;
+        if (i == 0) != ccw {
+            l[1..].reverse();
+        }
+    }
+}

@@ -177,8 +177,10 @@ mod tests {
             color: [0.5, 0.25, 0.0],
             ..Material::default()
         };
-        let mut b = Material::default();
-        b.color = [0.5, 0.25, -0.0];
+        let b = Material {
+            color: [0.5, 0.25, -0.0],
+            ..Material::default()
+        };
         assert_eq!(t.intern(&a), (0, true));
         assert_eq!(t.intern(&b), (0, false));
         let c = Material {

@@ -2,9 +2,9 @@
 //!
 //!     cargo run --release -p cga-export --example export_city -- city.glb 100000
 //!
-//! Each building is one mesh (6 quads) with one of 8 colours; every 10th
-//! building is a textured-free translucent box, so merging per material is
-//! exercised.
+//! Each building is one mesh (6 quads) with one of 8 materials in turn (one
+//! of them translucent), so every mesh switches material and the per-material
+//! merging is exercised.
 use std::path::PathBuf;
 use std::time::Instant;
 

@@ -12,9 +12,7 @@ pub(crate) fn face_normal(mesh: &Mesh, face: usize) -> Option<DVec3> {
     let outer = mesh.outer_loop(face);
     let idx = mesh.loop_indices(outer);
     let mut n = DVec3::ZERO;
-    let Some(&last) = idx.last() else {
-        return None;
-    };
+    let &last = idx.last()?;
     let mut prev = mesh.positions[last as usize];
     for &i in idx {
         let p = mesh.positions[i as usize];
@@ -36,9 +34,15 @@ pub(crate) fn face_is_finite(mesh: &Mesh, face: usize) -> bool {
     let normals = mesh.normals.as_deref();
     mesh.face_loops(face).iter().all(|&l| {
         mesh.loop_corners(l).all(|c| {
-            mesh.positions[mesh.corners[c] as usize].is_finite()
-                && uvs.map_or(true, |u| u[c].is_finite())
-                && normals.map_or(true, |n| n[c].is_finite())
+            let uv_ok = match uvs {
+                Some(u) => u[c].is_finite(),
+                None => true,
+            };
+            let normal_ok = match normals {
+                Some(n) => n[c].is_finite(),
+                None => true,
+            };
+            mesh.positions[mesh.corners[c] as usize].is_finite() && uv_ok && normal_ok
         })
     })
 }

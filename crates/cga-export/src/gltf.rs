@@ -52,9 +52,9 @@ impl Bucket {
             self.min = p;
             self.max = p;
         } else {
-            for k in 0..3 {
-                self.min[k] = self.min[k].min(p[k]);
-                self.max[k] = self.max[k].max(p[k]);
+            for ((lo, hi), x) in self.min.iter_mut().zip(&mut self.max).zip(p) {
+                *lo = lo.min(x);
+                *hi = hi.max(x);
             }
         }
         self.positions.extend_from_slice(&p);

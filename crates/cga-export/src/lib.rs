@@ -259,13 +259,17 @@ impl ModelWriter {
             if self.triangles.is_empty() {
                 continue;
             }
+            // No normal means zero area: nothing to see, and no valid normal
+            // to write.
+            let Some(normal) =
+                face_normal(mesh, face).or_else(|| triangles_normal(mesh, &self.triangles))
+            else {
+                continue;
+            };
             let slot = mesh.faces[face].material as usize;
             if self.slot_ids[slot] == UNSEEN {
                 self.slot_ids[slot] = self.intern(&mesh.materials[slot]);
             }
-            let normal = face_normal(mesh, face)
-                .or_else(|| triangles_normal(mesh, &self.triangles))
-                .unwrap_or(DVec3::Y);
             let data = FaceData {
                 mesh,
                 face,

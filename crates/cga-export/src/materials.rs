@@ -6,10 +6,12 @@
 //! `Material` values were built separately.
 
 use std::collections::hash_map::Entry;
-use std::collections::{HashMap, HashSet};
+use std::collections::HashSet;
 use std::hash::{Hash, Hasher};
 
 use cga_geometry::Material;
+
+use crate::hash::FastMap;
 
 /// A material as a hash map key. Equality is by value with two twists that
 /// keep the table small and well-defined: `0.0` and `-0.0` are the same, and
@@ -28,61 +30,62 @@ fn bits(x: f64) -> u64 {
     }
 }
 
-/// How many numbers a material has (colours, scalars, texture transforms).
-const NUMBERS: usize = 4 * 3 + 7 + 10 * 5;
+/// Whether two numbers are the same under [`Key`]'s equality.
+fn same(a: f64, b: f64) -> bool {
+    bits(a) == bits(b)
+}
 
-/// Every number of a material as [`bits`], in a fixed order.
-fn numbers(m: &Material) -> [u64; NUMBERS] {
-    let mut out = [0u64; NUMBERS];
-    let colours = [m.color, m.ambient, m.specular, m.emissive];
-    let scalars = [
-        m.opacity,
-        m.reflectivity,
-        m.shininess,
-        m.bump_value,
-        m.metallic,
-        m.roughness,
-        m.opacitymap_cutoff,
-    ];
-    let transforms = m.maps.iter().flat_map(|t| [t.su, t.sv, t.tu, t.tv, t.rw]);
-    let all = colours
-        .into_iter()
-        .flatten()
-        .chain(scalars)
-        .chain(transforms);
-    for (slot, x) in out.iter_mut().zip(all) {
-        *slot = bits(x);
-    }
-    out
+fn same3(a: &[f64; 3], b: &[f64; 3]) -> bool {
+    a.iter().zip(b).all(|(&x, &y)| same(x, y))
 }
 
 impl Hash for Key {
+    /// Hashes the fields that usually tell materials apart; equality checks
+    /// the rest. Cheap, because every face of a new mesh looks up its
+    /// material.
     fn hash<H: Hasher>(&self, state: &mut H) {
         let m = &self.0;
         m.name.hash(state);
-        m.shader.hash(state);
-        m.double_sided.hash(state);
-        m.opacitymap_mode.hash(state);
-        for t in &m.maps {
-            t.path.hash(state);
+        m.maps[0].path.hash(state);
+        for x in m.color {
+            state.write_u64(bits(x));
         }
-        numbers(m).hash(state);
+        state.write_u64(bits(m.opacity));
     }
 }
 
 impl PartialEq for Key {
     fn eq(&self, other: &Key) -> bool {
-        let (a, b) = (&self.0, &other.0);
-        if a.name != b.name
-            || a.shader != b.shader
-            || a.double_sided != b.double_sided
-            || a.opacitymap_mode != b.opacitymap_mode
-            || a.maps.iter().zip(&b.maps).any(|(x, y)| x.path != y.path)
-        {
-            return false;
-        }
-        numbers(a) == numbers(b)
+        same_material(&self.0, &other.0)
     }
+}
+
+/// Equality by value, as [`Key`] defines it; the most discriminating fields
+/// are compared first.
+fn same_material(a: &Material, b: &Material) -> bool {
+    same3(&a.color, &b.color)
+        && same(a.opacity, b.opacity)
+        && a.name == b.name
+        && a.maps.iter().zip(&b.maps).all(|(x, y)| {
+            x.path == y.path
+                && same(x.su, y.su)
+                && same(x.sv, y.sv)
+                && same(x.tu, y.tu)
+                && same(x.tv, y.tv)
+                && same(x.rw, y.rw)
+        })
+        && same3(&a.ambient, &b.ambient)
+        && same3(&a.specular, &b.specular)
+        && same3(&a.emissive, &b.emissive)
+        && same(a.reflectivity, b.reflectivity)
+        && same(a.shininess, b.shininess)
+        && same(a.bump_value, b.bump_value)
+        && same(a.metallic, b.metallic)
+        && same(a.roughness, b.roughness)
+        && same(a.opacitymap_cutoff, b.opacitymap_cutoff)
+        && a.double_sided == b.double_sided
+        && a.shader == b.shader
+        && a.opacitymap_mode == b.opacitymap_mode
 }
 
 impl Eq for Key {}
@@ -90,20 +93,28 @@ impl Eq for Key {}
 /// Distinct materials with their output names, indexed by material id.
 #[derive(Default)]
 pub(crate) struct MaterialTable {
-    ids: HashMap<Key, u32>,
+    ids: FastMap<Key, u32>,
     /// Material by id (a clone; the input meshes are not kept).
     materials: Vec<Material>,
     /// Output name by id: unique, derived from `Material::name`.
     names: Vec<String>,
     taken: HashSet<String>,
+    /// The id returned last: consecutive shapes mostly share a material,
+    /// and comparing with it avoids cloning and hashing.
+    last: Option<u32>,
 }
 
 impl MaterialTable {
     /// The id of `m`, and whether it was new.
     pub(crate) fn intern(&mut self, m: &Material) -> (u32, bool) {
-        // Cloning a material is cheap (its strings are `Arc`s); the lookup
-        // needs an owned key because `Key` wraps a value.
-        match self.ids.entry(Key(m.clone())) {
+        if let Some(last) = self.last {
+            if same_material(&self.materials[last as usize], m) {
+                return (last, false);
+            }
+        }
+        // The lookup needs an owned key because `Key` wraps a value; cloning
+        // a material is cheap (its strings are `Arc`s).
+        let (id, new) = match self.ids.entry(Key(m.clone())) {
             Entry::Occupied(e) => (*e.get(), false),
             Entry::Vacant(e) => {
                 let id = self.materials.len() as u32;
@@ -113,7 +124,9 @@ impl MaterialTable {
                 self.names.push(name);
                 (id, true)
             }
-        }
+        };
+        self.last = Some(id);
+        (id, new)
     }
 
     pub(crate) fn get(&self, id: u32) -> &Material {
@@ -177,8 +190,10 @@ mod tests {
             color: [0.5, 0.25, 0.0],
             ..Material::default()
         };
-        let mut b = Material::default();
-        b.color = [0.5, 0.25, -0.0];
+        let b = Material {
+            color: [0.5, 0.25, -0.0],
+            ..Material::default()
+        };
         assert_eq!(t.intern(&a), (0, true));
         assert_eq!(t.intern(&b), (0, false));
         let c = Material {

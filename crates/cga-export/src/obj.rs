@@ -1,7 +1,8 @@
 //! Wavefront OBJ + MTL output.
 //!
-//! Vertices (`v`, `vt`, `vn`) are written as meshes come, shared within a
-//! mesh (a position used by several faces of a shape is one `v`). Faces are
+//! Vertices (`v`, `vt`, `vn`) are written as meshes come: a position used by
+//! several faces of a mesh is one `v`; equal UVs and normals share one `vt` /
+//! `vn`, also across meshes. Faces are
 //! grouped per material so each material has one `usemtl` group: the
 //! writer keeps them as compact index triples (12 bytes per corner) and
 //! writes them, and the MTL file, in `finish`.
@@ -31,6 +32,9 @@ const MAPS: [(&str, usize); 5] = [
     ("map_d", 4),    // opacitymap
     ("norm", 5),     // normalmap
 ];
+
+/// Entries above which the `vt` / `vn` lookup tables are emptied.
+const SHARED_LOOKUP_LIMIT: usize = 1 << 16;
 
 /// How the MTL names one texture channel's file.
 enum MapRef {
@@ -127,8 +131,15 @@ impl ObjWriter {
     pub(crate) fn begin_mesh(&mut self, mesh: &Mesh) {
         self.position_v.clear();
         self.position_v.resize(mesh.positions.len(), 0);
-        self.vt_ids.clear();
-        self.vn_ids.clear();
+        // UVs and normals repeat across shapes (every wall facing south has
+        // the same normal), so they are shared across meshes; the tables are
+        // emptied now and then so memory stays bounded.
+        if self.vt_ids.len() > SHARED_LOOKUP_LIMIT {
+            self.vt_ids.clear();
+        }
+        if self.vn_ids.len() > SHARED_LOOKUP_LIMIT {
+            self.vn_ids.clear();
+        }
         self.corner_refs.clear();
         self.corner_refs.resize(mesh.corners.len(), [0; 3]);
     }

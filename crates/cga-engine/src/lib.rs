@@ -1,1 +1,2 @@
 //! The CGA interpreter.
+pub mod split_layout;

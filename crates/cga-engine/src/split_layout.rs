@@ -58,6 +58,11 @@
 //!    evaluated first independently on whichever side of the split the repetition is denoted"):
 //!    they take as many whole repetitions as fit into `L` minus the fixed parts outside repeats,
 //!    before floating parts get anything (`{ 2 : Green }* | ~1 : Blue` on 10: five Greens, no Blue).
+//!    So `~1 : Green | { 2 : Blue }* | ~1 : Green` centres as many Blues as fit (on 10.6: five,
+//!    and Greens of 0.3; on 10: five and no Green), which is what rules such as Candler's pipe
+//!    holders `~3 : NIL | { 0.3 : Holder | 4 : NIL }* | 0.3 : Holder | ~3 : NIL` are written for.
+//!    (Choosing that count by least stretching of the Greens instead would give four Blues and
+//!    Greens of 1 on 10, contradicting the quoted rule.)
 //!    Several such repeats take turns, one repetition each, while one still fits (round robin), so
 //!    `1 | { 2 : G }* | { 1 : Y }* | 1` on 10 gives G G G Y Y between the borders. This is the
 //!    natural reading of "as many times as possible" for parallel repeats; the pages give no numbers
@@ -80,10 +85,16 @@
 //!    A repeat may end up with no repetition when that is the least stretched solution
 //!    (`{ ~w : Window | d : Wall }* | ~w : Window` with one window's worth of space gives one window
 //!    and no divider, as CGA facades rely on).
-//! 3. If after that nothing floats (no floating part got room) and space is left, the first
-//!    fixed-only repeat due in the round robin fills it with one more, cut, repetition: `{ 2 : X | 1
-//!    : Y }*` on 10 is XYXYXY and "half a X" of length 1. The same cut makes a relative repeat
-//!    `{ '0.3 }*` give 30/30/30/10 %, as `splitArea`'s page states.
+//! 3. If after that the split has no floating weight at all (no floating part outside repeats, no
+//!    repetition of a floating repeat) and space is left, the fixed-only repeat whose turn it is in
+//!    the round robin fills that space with one more repetition, cut at its end:
+//!    `{ 2 : X | 1 : Y }*` on 10 is XYXYXY and "half a X" of length 1, and in
+//!    `1 : A | { 2 : B }* | 1 : A` on 10.5 the last B is 0.5 long and the second A stays whole.
+//!    The same cut makes a relative repeat `{ '0.3 }*` give 30/30/30/10 %, as `splitArea`'s page
+//!    states. When there is no fixed-only repeat, a floating repeat of which not even one
+//!    repetition fits gets that cut repetition (its floating parts have no room in it): `{ 1 : A |
+//!    ~1 : B }*` on 0.5 is one A of 0.5, as the same split without `*` would be, rather than
+//!    nothing.
 //!
 //! Nested repeats inside a repeat (`{ a | { b }* }*`) are laid out once per outer repetition (the
 //! inner `*` is ignored): the pages describe no such pattern and give no numbers for it.
@@ -96,15 +107,17 @@
 //!
 //! # Floating point
 //!
-//! Whether something fits is decided with a tolerance of [`FIT_TOLERANCE`]` * L`, so that sums such
-//! as `5 * '0.2` or `3 * 3.3 + 0.1` count as filling `L` exactly: a repetition that fits up to
-//! rounding is taken, a rest of that size is treated as nothing, a part ending within it of the end
-//! of its space is snapped to that end (so the last part ends exactly at `L` when floating parts
-//! fill the split, and no 1e-15 sliver ever becomes a part). Positions are sums of the preceding
-//! sizes, each repetition re-anchored at `start + r * period`, so they are exact to a few ulps of
-//! `L` however many repetitions there are. Each part
-//! carries its `end` as well as its `size`: `start + size` can miss the exact end by an ulp (no
-//! double `d` may satisfy `a + d == b`), so cut geometry at [`Placed::start`] and [`Placed::end`].
+//! Whether something fits is decided with a tolerance of [`FIT_TOLERANCE`]` * L`, so that sums
+//! such as `5 * '0.2` or `3 * 3.3 + 0.1` count as filling `L` exactly: a repetition that fits up
+//! to rounding is taken, a rest that small is treated as nothing (floating parts get no room from
+//! it, no cut repetition is made of it), and a part ending that close to the end of its space is
+//! snapped to that end. So the last part ends exactly at `L` when floating parts fill the split,
+//! and no 1e-15 sliver ever becomes a part. Positions are sums of the preceding sizes, each
+//! repetition re-anchored at `start + r * period`, so they stay within a few ulps of `L` however
+//! many repetitions there are. Each part carries its `end` as well as its `size`: in floating point
+//! `start + size` can miss the intended end by an ulp (for some `a < b` no double `d` satisfies
+//! `a + d == b`), so geometry should be cut at [`Placed::start`] and [`Placed::end`]; a part's
+//! `end` is bit for bit the next part's `start`.
 
 use std::fmt;
 
@@ -500,7 +513,7 @@ impl SplitLayouter {
         // 1. Fixed-only repeats take whole repetitions, in turns, before anything floats.
         let mut rest = length - fixed_outside;
         let mut budget = Budget::new(parts_outside);
-        let mut next_turn = self.assign_fixed_repeats(&mut rest, tol, &mut budget)?;
+        let next_turn = self.assign_fixed_repeats(&mut rest, tol, &mut budget)?;
 
         // 2. Repeats with floating parts: least stretching of the common floating scale.
         let floating =
@@ -514,7 +527,14 @@ impl SplitLayouter {
         };
         let mut partial_length = 0.0;
         if floating == 0.0 && rest > tol {
-            if let Some(j) = next_turn.take() {
+            // (With no fixed-only repeat, a floating repeat none of whose repetitions fit gets
+            // the cut repetition: its fixed parts cover the space instead of leaving a hole.)
+            let candidate = next_turn.or_else(|| {
+                self.slots
+                    .iter()
+                    .position(|s| s.is_floating() && s.count == 0)
+            });
+            if let Some(j) = candidate {
                 self.slots[j].partial = true;
                 partial_length = rest;
                 budget.add(self.slots[j].parts as f64)?;

@@ -944,10 +944,27 @@ fn absolute_repeat_between_absolutes_cuts_its_last_repetition() {
 
 #[test]
 fn floating_repeat_too_small_for_its_fixed_parts() {
-    // { 1 : X | ~2.7 : Y }* | 1 : X on 1.5: no repetition fits; the last X and a gap.
-    check("{ { 1 : X | ~2.7 : Y }* | 1 : X }", 1.5, &[("X", 0.0, 1.0)]);
+    // { 1 : X | ~2.7 : Y }* | 1 : X on 1.5: no whole repetition fits in the 0.5 left by the last
+    // X; a cut one covers it.
+    check(
+        "{ { 1 : X | ~2.7 : Y }* | 1 : X }",
+        1.5,
+        &[("X", 0.0, 0.5), ("X", 0.5, 1.0)],
+    );
     // A floating repeat alone on a short length: one stretched (shrunk) part.
     check("{ ~2.1 : G }*", 0.5, &[("G", 0.0, 0.5)]);
+    // Not even the fixed part of one repetition fits: a cut repetition, as without the `*`.
+    check("{ 1 : A | ~1 : B }*", 0.5, &[("A", 0.0, 0.5)]);
+    check(
+        "{ ~1 : Window | 0.5 : Pillar }*",
+        0.4,
+        &[("Pillar", 0.0, 0.4)],
+    );
+    check(
+        "{ 1 : A | { 1 : B | ~1 : C }* | 1 : A }",
+        2.5,
+        &[("A", 0.0, 1.0), ("B", 1.0, 0.5), ("A", 1.5, 1.0)],
+    );
 }
 
 #[test]
@@ -1148,6 +1165,7 @@ fn random_layouts_tile_the_split() {
     let mut out = Vec::new();
     let mut p = SplitPattern::new(false);
     let mut sizes = Vec::new();
+    let (mut filled, mut repeated_cases, mut cut) = (0, 0, 0);
     for case in 0..20_000 {
         p.reset(rng.below(3) == 0);
         sizes.clear();
@@ -1187,6 +1205,16 @@ fn random_layouts_tile_the_split() {
         // Floating parts that got room fill the split exactly.
         if any_floating {
             assert_eq!(end, length, "{}", ctx());
+            filled += 1;
+        }
+        if has_repeat && out.len() > sizes.len() {
+            repeated_cases += 1;
+        }
+        if out.iter().any(|q| match sizes[q.part] {
+            Size::Absolute(z) => q.size < z * (1.0 - 1e-9),
+            _ => false,
+        }) {
+            cut += 1;
         }
         // Without repeats, a floating part of positive weight with room left covers [0, L].
         let fixed_total: f64 = sizes
@@ -1204,6 +1232,75 @@ fn random_layouts_tile_the_split() {
             assert_eq!(end, length, "{}", ctx());
         }
     }
+    // The generator exercises every case, not only trivial ones.
+    assert!(
+        filled > 5_000 && repeated_cases > 2_000 && cut > 2_000,
+        "{filled} {repeated_cases} {cut}"
+    );
+}
+
+/// The least stretched count of one floating repeat between random borders, by brute force.
+#[test]
+fn random_floating_repeat_counts_are_least_stretched() {
+    let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+    let mut checked = 0;
+    for case in 0..5_000 {
+        // fixed and floating borders, and a repeat of fixed `a` and floating weight `f`
+        let border_fixed = (rng.below(3) as f64) * rng.unit() * 3.0;
+        let border_float = if rng.below(2) == 0 {
+            0.0
+        } else {
+            rng.unit() * 3.0
+        };
+        let a = if rng.below(3) == 0 {
+            0.0
+        } else {
+            rng.unit() * 2.0
+        };
+        let f = 0.05 + rng.unit() * 3.0;
+        let length = rng.unit() * 40.0;
+        let mut p = SplitPattern::new(false);
+        p.push(Size::Absolute(border_fixed));
+        p.open();
+        if a > 0.0 {
+            p.push(Size::Absolute(a));
+        }
+        let rep = p.push(Size::Floating(f));
+        p.close(true).unwrap();
+        p.push(Size::Floating(border_float));
+        let parts = layout(&p, length).unwrap();
+        let n = parts.iter().filter(|q| q.part == rep).count();
+
+        let rest0 = length - border_fixed;
+        let stretch = |n: usize| {
+            let rest = rest0 - n as f64 * a;
+            let weight = border_float + n as f64 * f;
+            if weight > 0.0 {
+                (rest.max(0.0) / weight - 1.0).abs()
+            } else if rest <= 1e-9 * length {
+                0.0
+            } else {
+                f64::INFINITY
+            }
+        };
+        if rest0 <= 1e-9 * length {
+            continue;
+        }
+        let mut best = 0;
+        let mut k = 1;
+        while rest0 - k as f64 * a >= -1e-9 * length && k < 10_000 {
+            if stretch(k) < stretch(best) - 1e-12 {
+                best = k;
+            }
+            k += 1;
+        }
+        assert_eq!(
+            n, best,
+            "case {case}: {border_fixed} | {{ {a} | ~{f} }}* | ~{border_float} on {length}: {parts:?}"
+        );
+        checked += 1;
+    }
+    assert!(checked > 4_000);
 }
 
 #[test]

@@ -14,6 +14,7 @@ pub mod program;
 pub mod resolve;
 pub mod shape;
 pub mod shape_fns;
+pub mod split_layout;
 mod value_shim;
 
 pub use generate::{generate_lot, GenerateOptions};

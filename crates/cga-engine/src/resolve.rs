@@ -326,7 +326,45 @@ impl Resolver<'_> {
                 self.tables[rs as usize].imports.insert(a, child);
             }
         }
+        self.attach_foreign_rules(rs);
         rs
+    }
+
+    /// Rules a file defines for a rule set it imports (`imp.Glazing(d) --> ...`)
+    /// become rules of that rule set, replacing its own of the same arity;
+    /// their bodies are resolved in the defining file.
+    fn attach_foreign_rules(&mut self, rs: RuleSetId) {
+        let foreign: Vec<(String, RuleId)> = self.tables[rs as usize]
+            .rules
+            .iter()
+            .filter(|(name, _)| name.contains('.'))
+            .flat_map(|(name, ids)| ids.iter().map(move |&id| (name.clone(), id)))
+            .collect();
+        for (name, id) in foreign {
+            let mut target = rs;
+            let mut rest = name.as_str();
+            while let Some((alias, tail)) = rest.split_once('.') {
+                match self.tables[target as usize].imports.get(alias) {
+                    Some(&child) => {
+                        target = child;
+                        rest = tail;
+                    }
+                    None => break,
+                }
+            }
+            if target == rs {
+                // No import of that name: a rule whose name has a dot.
+                continue;
+            }
+            let arity = self.program.rules[id as usize].arity;
+            let list = self.tables[target as usize]
+                .rules
+                .entry(rest.to_string())
+                .or_default();
+            let rules = &self.program.rules;
+            list.retain(|&r| rules[r as usize].arity != arity);
+            list.push(id);
+        }
     }
 
     fn declare_attr(
@@ -637,7 +675,17 @@ impl Resolver<'_> {
             ExprKind::Str(s) => RExprKind::Const(Value::Str(Arc::from(s.as_str()))),
             ExprKind::Name(ident) => return self.name(cx, ident, false),
             ExprKind::Call { name, args } => {
-                let args: Vec<RExpr> = args.iter().map(|a| self.expr(cx, a)).collect();
+                let args: Vec<RExpr> = args
+                    .iter()
+                    .enumerate()
+                    .map(|(i, a)| {
+                        if shape_fns::arg_is_selector(&name.name, i) {
+                            self.selector_arg(cx, a)
+                        } else {
+                            self.expr(cx, a)
+                        }
+                    })
+                    .collect();
                 return self.call(cx, name, args, span);
             }
             ExprKind::Unary {
@@ -927,6 +975,23 @@ impl Resolver<'_> {
             return RStmt::Leaf(self.symbol(name));
         }
         let arities = self.rule_arities(cx.rs, name);
+        let looks_like_rule = name
+            .rsplit('.')
+            .next()
+            .and_then(|n| n.chars().next())
+            .is_some_and(|c| c.is_uppercase());
+        if arities.is_empty() && looks_like_rule {
+            // A rule that is not defined here (an importing file may define
+            // it, `imp.Rule(x) --> ...`): a leaf shape, as in CityEngine.
+            self.diags.push(
+                Diagnostic::warning(
+                    format!("rule `{name}` is not defined; the shape becomes a leaf"),
+                    call.name.span,
+                )
+                .with_label("no rule of this name"),
+            );
+            return RStmt::Leaf(self.symbol(name));
+        }
         if !arities.is_empty() {
             self.error(
                 format!(

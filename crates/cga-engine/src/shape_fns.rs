@@ -31,6 +31,31 @@ pub enum ShapeFn {
     P,
     /// `print(value)` as a function: prints and returns its argument.
     Print,
+    /// Occlusion and context queries (`inside`, `overlaps`, `touches`,
+    /// `contextCount`, `contextCompare`, `minimumDistance`).
+    Context(ContextFn),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContextFn {
+    Inside,
+    Overlaps,
+    Touches,
+    ContextCount,
+    ContextCompare,
+    MinimumDistance,
+}
+
+/// Whether argument `pos` of the function `name` is a selector keyword
+/// (`inside(all, "x")`, `convert(x, scope, world, pos, 0, 0, 0)`).
+pub fn arg_is_selector(name: &str, pos: usize) -> bool {
+    match name {
+        "inside" | "overlaps" | "touches" | "contextCount" | "contextCompare"
+        | "minimumDistance" => pos == 0,
+        "convert" => pos < 4,
+        "assetInfo" | "imageInfo" => pos == 1,
+        _ => false,
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -152,6 +177,12 @@ pub fn lookup(name: &str, arity: usize) -> Option<ShapeFn> {
         ("rand", 0..=2) => ShapeFn::Rand,
         ("p", 1) => ShapeFn::P,
         ("print", 1) => ShapeFn::Print,
+        ("inside", 0..=2) => ShapeFn::Context(ContextFn::Inside),
+        ("overlaps", 0..=2) => ShapeFn::Context(ContextFn::Overlaps),
+        ("touches", 0..=2) => ShapeFn::Context(ContextFn::Touches),
+        ("contextCount", 1..=3) => ShapeFn::Context(ContextFn::ContextCount),
+        ("contextCompare", 1..=4) => ShapeFn::Context(ContextFn::ContextCompare),
+        ("minimumDistance", 1..=3) => ShapeFn::Context(ContextFn::MinimumDistance),
         _ => return None,
     };
     Some(f)
@@ -194,7 +225,7 @@ mod eval {
 
     use cga_value::Value;
 
-    use super::{GeometryFn, ShapeFn};
+    use super::{ContextFn, GeometryFn, ShapeFn};
     use crate::derive::{Interp, RtError};
     use crate::expr::RExpr;
     use crate::geom_shim as gm;
@@ -305,6 +336,17 @@ mod eval {
                     args[0].clone()
                 }
                 ShapeFn::Geometry(g) => self.geometry_fn(g, args, shape, at)?,
+                ShapeFn::Context(c) => {
+                    // Without other shapes to query, nothing is occluded.
+                    self.warn_once(at.span, || {
+                        format!("context query {c:?} is not supported yet; it finds no other shapes")
+                    });
+                    match c {
+                        ContextFn::ContextCount | ContextFn::ContextCompare => fl(0.0),
+                        ContextFn::MinimumDistance => fl(f64::INFINITY),
+                        _ => Value::Bool(false),
+                    }
+                }
             })
         }
 

@@ -3,7 +3,19 @@
 //! functions that depend only on their arguments (math, strings, conversions,
 //! arrays, the utility library). Functions that read the current shape live
 //! in `cga-engine`.
+//!
+//! Everything here is total: bad input gives a [`ValueError`], never a panic.
 
+pub mod array;
+pub mod builtins;
+pub mod error;
+pub mod format;
+pub mod ops;
 pub mod value;
 
-pub use value::{Array, Value};
+pub use array::{build_array, index, range, set_elems};
+pub use builtins::{lookup, lookup_name, Builtin, BuiltinFn, BUILTINS};
+pub use error::ValueError;
+pub use format::{format_float, to_text, write_float, write_value};
+pub use ops::{binary, unary, values_equal, BinaryOp, UnaryOp};
+pub use value::{Array, Element, Value, ValueType, MAX_ARRAY_SIZE};

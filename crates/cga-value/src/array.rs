@@ -139,7 +139,7 @@ fn concat<T: Element>(
 pub fn range(base: f64, step: Option<f64>, limit: f64) -> Result<Value, ValueError> {
     let step = step.unwrap_or(1.0);
     let mut data = Vec::new();
-    if step > 0.0 || step < 0.0 {
+    if step != 0.0 && !step.is_nan() {
         let ascending = step > 0.0;
         // Reject huge ranges before allocating anything.
         let estimate = ((limit - base) / step).floor();
@@ -250,7 +250,9 @@ fn index_typed<T: Element>(a: &Array<T>, indices: &[Value]) -> Result<Value, Val
                 let Indices::List(list) = Indices::of(idx, "index operator")? else {
                     unreachable!("a bool array gives a list")
                 };
-                Ok(T::wrap_array(Array::row(list.into_iter().map(linear).collect())))
+                Ok(T::wrap_array(Array::row(
+                    list.into_iter().map(linear).collect(),
+                )))
             }
             _ => Err(ValueError::new(format!(
                 "index operator: an index must be float, float[] or bool[], not {}",
@@ -258,7 +260,10 @@ fn index_typed<T: Element>(a: &Array<T>, indices: &[Value]) -> Result<Value, Val
             ))),
         },
         [r, c] => {
-            let (ri, ci) = (Indices::of(r, "index operator")?, Indices::of(c, "index operator")?);
+            let (ri, ci) = (
+                Indices::of(r, "index operator")?,
+                Indices::of(c, "index operator")?,
+            );
             let at = |r: Option<usize>, c: Option<usize>| -> T {
                 match (r, c) {
                     (Some(r), Some(c)) => a.get(r, c).cloned().unwrap_or_else(T::default_value),
@@ -357,7 +362,7 @@ fn set_typed<T: Element>(
             let mut out: Array<T> = (**a).clone();
             if let Some(max) = max {
                 if max >= out.len() {
-                    let needed = max.checked_add(1).unwrap_or(usize::MAX);
+                    let needed = max.saturating_add(1);
                     if out.is_1d() {
                         if needed > MAX_ARRAY_SIZE {
                             return Err(ValueError::too_large("setElems", needed));

@@ -225,7 +225,9 @@ mod tests {
     use super::*;
 
     /// Measured output of CityEngine's runtime for `str()` / `print()`.
+    /// The inputs are written as they were measured, digits beyond f64 included.
     #[test]
+    #[allow(clippy::approx_constant, clippy::excessive_precision)]
     fn floats_print_as_cityengine_does() {
         let cases: &[(f64, &str)] = &[
             (1.0 / 3.0, "0.333333333333333"),
@@ -309,7 +311,10 @@ mod tests {
 
     #[test]
     fn one_dimensional_arrays() {
-        assert_eq!(to_text(&Value::float_row(vec![0.0, 1.0, 2.0])), "(3)[0,1,2]");
+        assert_eq!(
+            to_text(&Value::float_row(vec![0.0, 1.0, 2.0])),
+            "(3)[0,1,2]"
+        );
         assert_eq!(to_text(&Value::bool_row(vec![false])), "(1)[false]");
         assert_eq!(to_text(&Value::str_row(&["uhm"])), "(1)[uhm]");
         assert_eq!(to_text(&Value::str_row(&["a b", ""])), "(2)[a b,]");
@@ -326,10 +331,12 @@ mod tests {
         assert_eq!(to_text(&f), "(2x3)\n   1   2   3\n   4   5   6");
         let b = Value::from(Array::new(2, 2, vec![false, true, true, false]));
         assert_eq!(to_text(&b), "(2x2)\n   false    true\n    true   false");
-        let s: Vec<std::sync::Arc<str>> = ["first", "row", "second", "row", "third", "row", "fourth", "row"]
-            .iter()
-            .map(|s| std::sync::Arc::from(*s))
-            .collect();
+        let s: Vec<std::sync::Arc<str>> = [
+            "first", "row", "second", "row", "third", "row", "fourth", "row",
+        ]
+        .iter()
+        .map(|s| std::sync::Arc::from(*s))
+        .collect();
         let s = Value::from(Array::new(4, 2, s));
         assert_eq!(
             to_text(&s),

@@ -6,6 +6,9 @@
 //!
 //! Everything here is total: bad input gives a [`ValueError`], never a panic.
 
+// Tests pass `&[v.clone()]` argument lists freely.
+#![cfg_attr(test, allow(clippy::cloned_ref_to_slice_refs))]
+
 pub mod array;
 pub mod builtins;
 pub mod error;

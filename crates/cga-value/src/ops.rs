@@ -127,6 +127,7 @@ pub fn binary(op: BinaryOp, elementwise: bool, a: &Value, b: &Value) -> Result<V
 /// emits the JVM instruction `dcmpl`, which treats an unordered pair (a NaN
 /// operand) as "less". So `nan < x` and `nan <= x` are true while `nan > x`
 /// and `nan >= x` are false (seen in CityEngine's compiled rule files).
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // the negations are the point
 fn float_relation(op: BinaryOp, x: f64, y: f64) -> bool {
     match op {
         BinaryOp::Lt => !(x >= y),
@@ -163,7 +164,10 @@ fn ordering_relation(op: BinaryOp, ord: Ordering) -> bool {
 }
 
 fn is_relational(op: BinaryOp) -> bool {
-    matches!(op, BinaryOp::Lt | BinaryOp::Le | BinaryOp::Gt | BinaryOp::Ge)
+    matches!(
+        op,
+        BinaryOp::Lt | BinaryOp::Le | BinaryOp::Gt | BinaryOp::Ge
+    )
 }
 
 fn plain_binary(op: BinaryOp, a: &Value, b: &Value) -> Result<Value, ValueError> {
@@ -190,15 +194,17 @@ fn plain_binary(op: BinaryOp, a: &Value, b: &Value) -> Result<Value, ValueError>
         (_, V::Float(x), V::Float(y)) if is_relational(op) => {
             Ok(V::Bool(float_relation(op, *x, *y)))
         }
-        (_, V::Str(x), V::Str(y)) if is_relational(op) => {
-            Ok(V::Bool(ordering_relation(op, x.as_bytes().cmp(y.as_bytes()))))
-        }
+        (_, V::Str(x), V::Str(y)) if is_relational(op) => Ok(V::Bool(ordering_relation(
+            op,
+            x.as_bytes().cmp(y.as_bytes()),
+        ))),
         (_, V::FloatArray(x), V::FloatArray(y)) if is_relational(op) => Ok(V::Bool(
             ordering_relation(op, compare_arrays(x, y, cmp_float_dcmpl)),
         )),
-        (_, V::StrArray(x), V::StrArray(y)) if is_relational(op) => Ok(V::Bool(
-            ordering_relation(op, compare_arrays(x, y, |p, q| p.as_bytes().cmp(q.as_bytes()))),
-        )),
+        (_, V::StrArray(x), V::StrArray(y)) if is_relational(op) => Ok(V::Bool(ordering_relation(
+            op,
+            compare_arrays(x, y, |p, q| p.as_bytes().cmp(q.as_bytes())),
+        ))),
         (And, V::Bool(x), V::Bool(y)) => Ok(V::Bool(*x && *y)),
         (Or, V::Bool(x), V::Bool(y)) => Ok(V::Bool(*x || *y)),
         _ => {
@@ -425,7 +431,10 @@ fn elementwise_binary(op: BinaryOp, a: &Value, b: &Value) -> Result<Value, Value
             })
         }
         Add | Sub | Mul | Div | Rem => {
-            let (x, y) = (float_side(a).ok_or_else(mismatch)?, float_side(b).ok_or_else(mismatch)?);
+            let (x, y) = (
+                float_side(a).ok_or_else(mismatch)?,
+                float_side(b).ok_or_else(mismatch)?,
+            );
             match op {
                 Add => zip_with(op, x, y, |p, q| p + q),
                 Sub => zip_with(op, x, y, |p, q| p - q),
@@ -464,7 +473,10 @@ fn elementwise_binary(op: BinaryOp, a: &Value, b: &Value) -> Result<Value, Value
             }
         }
         And | Or => {
-            let (x, y) = (bool_side(a).ok_or_else(mismatch)?, bool_side(b).ok_or_else(mismatch)?);
+            let (x, y) = (
+                bool_side(a).ok_or_else(mismatch)?,
+                bool_side(b).ok_or_else(mismatch)?,
+            );
             if op == And {
                 zip_with(op, x, y, |p, q| *p && *q)
             } else {

@@ -110,7 +110,8 @@ impl<T> Array<T> {
 
     /// Same-shape check used by the element-wise operators.
     pub fn same_dims<U>(&self, other: &Array<U>) -> bool {
-        (self.is_empty() && other.is_empty()) || (self.rows == other.rows && self.cols == other.cols)
+        (self.is_empty() && other.is_empty())
+            || (self.rows == other.rows && self.cols == other.cols)
     }
 }
 

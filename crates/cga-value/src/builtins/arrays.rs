@@ -102,7 +102,10 @@ fn sort_row_order<T>(a: &Array<T>, cmp: impl Fn(&T, &T) -> Ordering) -> Value {
     let cols = a.cols;
     let mut idx: Vec<usize> = (0..a.n_rows()).collect();
     idx.sort_by(|&i, &j| {
-        let (ri, rj) = (&a.data[i * cols..(i + 1) * cols], &a.data[j * cols..(j + 1) * cols]);
+        let (ri, rj) = (
+            &a.data[i * cols..(i + 1) * cols],
+            &a.data[j * cols..(j + 1) * cols],
+        );
         ri.iter()
             .zip(rj)
             .map(|(x, y)| cmp(x, y))
@@ -157,7 +160,11 @@ pub fn find_first(args: &[Value]) -> Result<Value, ValueError> {
             "findFirst: cannot search {} for {}{}",
             a.type_name(),
             v.type_name(),
-            if args.len() == 3 { " with an epsilon" } else { "" }
+            if args.len() == 3 {
+                " with an epsilon"
+            } else {
+                ""
+            }
         ))),
     }
 }
@@ -171,9 +178,7 @@ fn elementwise<T: Element>(
 ) -> Result<Value, ValueError> {
     let first = arrays[0];
     if arrays.iter().any(|a| !a.same_dims(first)) {
-        return Err(ValueError::new(format!(
-            "{name}: array dimensions differ"
-        )));
+        return Err(ValueError::new(format!("{name}: array dimensions differ")));
     }
     let mut elems: Vec<&T> = Vec::with_capacity(arrays.len());
     let data = (0..first.len())
@@ -254,7 +259,9 @@ pub fn min(args: &[Value]) -> Result<Value, ValueError> {
     match (arg(args, 0, "min")?, arg(args, 1, "min")?) {
         (V::Float(a), V::Float(b)) => Ok(V::Float(min_f(*a, *b))),
         (V::Str(a), V::Str(b)) => Ok(V::Str(min_s(a, b).clone())),
-        (V::FloatArray(a), V::FloatArray(b)) => elementwise("min", &[a, b], |e| min_f(*e[0], *e[1])),
+        (V::FloatArray(a), V::FloatArray(b)) => {
+            elementwise("min", &[a, b], |e| min_f(*e[0], *e[1]))
+        }
         (V::StrArray(a), V::StrArray(b)) => {
             elementwise("min", &[a, b], |e| min_s(e[0], e[1]).clone())
         }
@@ -267,7 +274,9 @@ pub fn max(args: &[Value]) -> Result<Value, ValueError> {
     match (arg(args, 0, "max")?, arg(args, 1, "max")?) {
         (V::Float(a), V::Float(b)) => Ok(V::Float(max_f(*a, *b))),
         (V::Str(a), V::Str(b)) => Ok(V::Str(max_s(a, b).clone())),
-        (V::FloatArray(a), V::FloatArray(b)) => elementwise("max", &[a, b], |e| max_f(*e[0], *e[1])),
+        (V::FloatArray(a), V::FloatArray(b)) => {
+            elementwise("max", &[a, b], |e| max_f(*e[0], *e[1]))
+        }
         (V::StrArray(a), V::StrArray(b)) => {
             elementwise("max", &[a, b], |e| max_s(e[0], e[1]).clone())
         }
@@ -312,7 +321,12 @@ mod tests {
         Array::new(rows, cols, d.to_vec()).into()
     }
     fn strs(rows: usize, cols: usize, d: &[&str]) -> Value {
-        Array::new(rows, cols, d.iter().map(|s| std::sync::Arc::from(*s)).collect()).into()
+        Array::new(
+            rows,
+            cols,
+            d.iter().map(|s| std::sync::Arc::from(*s)).collect(),
+        )
+        .into()
     }
 
     /// func_size.md, func_nRows.md, func_nColumns.md.
@@ -336,7 +350,10 @@ mod tests {
     #[test]
     fn transpose_examples() {
         let a = strs(3, 2, &["a", "b", "c", "d", "e", "f"]);
-        assert_eq!(c("transpose", &[a]), strs(2, 3, &["a", "c", "e", "b", "d", "f"]));
+        assert_eq!(
+            c("transpose", &[a]),
+            strs(2, 3, &["a", "c", "e", "b", "d", "f"])
+        );
         // zipping
         let a = Value::float_row(vec![1.0; 3]);
         let b = Value::float_row(vec![2.0; 3]);
@@ -354,8 +371,14 @@ mod tests {
     #[test]
     fn sum_examples() {
         assert_eq!(c("sum", &[Value::float_row(vec![1.0, 2.0, 3.0])]), f(6.0));
-        assert_eq!(c("sum", &[Value::bool_row(vec![true, false, true])]), f(2.0));
-        assert_eq!(c("sum", &[Value::str_row(&["a", "b", "c"])]), Value::str("abc"));
+        assert_eq!(
+            c("sum", &[Value::bool_row(vec![true, false, true])]),
+            f(2.0)
+        );
+        assert_eq!(
+            c("sum", &[Value::str_row(&["a", "b", "c"])]),
+            Value::str("abc")
+        );
         // cumsum(array) = [cumsum(array[0:size-2]), sum(array)]
         fn cumsum(a: &Value) -> Value {
             let n = a.array_len().unwrap();
@@ -365,13 +388,18 @@ mod tests {
             let head = index(a, &[range(0.0, None, n as f64 - 2.0).unwrap()]).unwrap();
             build_array(&[vec![cumsum(&head), call("sum", &[a.clone()]).unwrap()]]).unwrap()
         }
-        assert_eq!(t(&cumsum(&range(1.0, None, 5.0).unwrap())), "(5)[1,3,6,10,15]");
+        assert_eq!(
+            t(&cumsum(&range(1.0, None, 5.0).unwrap())),
+            "(5)[1,3,6,10,15]"
+        );
         assert_eq!(
             t(&cumsum(&Value::str_row(&["a", "b", "c", "d", "e"]))),
             "(5)[a,ab,abc,abcd,abcde]"
         );
         assert_eq!(
-            t(&cumsum(&Value::bool_row(vec![false, true, true, false, true]))),
+            t(&cumsum(&Value::bool_row(vec![
+                false, true, true, false, true
+            ]))),
             "(5)[0,1,2,2,3]"
         );
     }
@@ -389,7 +417,10 @@ mod tests {
         assert_eq!(t(&index(&a, &[s]).unwrap()), "(5)[1,1,2,3,3]");
         let m = strs(3, 3, &["e", "c", "d", "b", "a", "c", "d", "a", "d"]);
         let s = c("sortIndices", &[m.clone()]);
-        assert_eq!(s, floats(3, 3, &[1.0, 2.0, 0.0, 4.0, 3.0, 5.0, 7.0, 6.0, 8.0]));
+        assert_eq!(
+            s,
+            floats(3, 3, &[1.0, 2.0, 0.0, 4.0, 3.0, 5.0, 7.0, 6.0, 8.0])
+        );
         assert_eq!(
             index(&m, &[s]).unwrap(),
             strs(3, 3, &["c", "d", "e", "a", "b", "c", "a", "d", "d"])
@@ -452,7 +483,10 @@ mod tests {
             f(1.0)
         );
         assert_eq!(
-            c("findFirst", &[Value::bool_row(vec![false, false]), Value::Bool(true)]),
+            c(
+                "findFirst",
+                &[Value::bool_row(vec![false, false]), Value::Bool(true)]
+            ),
             f(-1.0)
         );
 
@@ -475,9 +509,15 @@ mod tests {
     #[test]
     fn min_max_clamp() {
         assert_eq!(c("min", &[f(10.0), f(-10.0)]), f(-10.0));
-        assert_eq!(c("min", &[Value::str("abc"), Value::str("def")]), Value::str("abc"));
+        assert_eq!(
+            c("min", &[Value::str("abc"), Value::str("def")]),
+            Value::str("abc")
+        );
         assert_eq!(c("max", &[f(10.0), f(-10.0)]), f(10.0));
-        assert_eq!(c("max", &[Value::str("abc"), Value::str("def")]), Value::str("def"));
+        assert_eq!(
+            c("max", &[Value::str("abc"), Value::str("def")]),
+            Value::str("def")
+        );
         assert_eq!(c("clamp", &[f(1.5), f(0.0), f(1.0)]), f(1.0));
         assert_eq!(c("clamp", &[f(-11.0), f(-10.0), f(10.0)]), f(-10.0));
         assert_eq!(c("clamp", &[f(0.5), f(0.0), f(1.0)]), f(0.5));
@@ -490,7 +530,10 @@ mod tests {
         assert!(call("min", &[f(1.0), Value::str("a")]).is_err());
         assert!(call(
             "min",
-            &[Value::float_row(vec![1.0]), Value::float_row(vec![1.0, 2.0])]
+            &[
+                Value::float_row(vec![1.0]),
+                Value::float_row(vec![1.0, 2.0])
+            ]
         )
         .is_err());
     }

@@ -105,7 +105,11 @@ pub fn rgb_to_hex(r: f64, g: f64, b: f64, opacity: Option<f64>) -> String {
 
 /// HSV (hue in degrees, wrapped into [0, 360); s and v clamped to [0, 1]) to RGB.
 fn hsv_to_rgb(h: f64, s: f64, v: f64) -> (f64, f64, f64) {
-    let h = if h.is_finite() { h.rem_euclid(360.0) } else { 0.0 };
+    let h = if h.is_finite() {
+        h.rem_euclid(360.0)
+    } else {
+        0.0
+    };
     let s = if s.is_nan() { 0.0 } else { s.clamp(0.0, 1.0) };
     let v = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
     let c = v * s;
@@ -125,27 +129,43 @@ fn hsv_to_rgb(h: f64, s: f64, v: f64) -> (f64, f64, f64) {
 
 pub fn rgb_to_hex_fn(args: &[Value]) -> Result<Value, ValueError> {
     let f = "colorRGBToHex";
-    let (r, g, b) = (float_arg(args, 0, f)?, float_arg(args, 1, f)?, float_arg(args, 2, f)?);
+    let (r, g, b) = (
+        float_arg(args, 0, f)?,
+        float_arg(args, 1, f)?,
+        float_arg(args, 2, f)?,
+    );
     Ok(Value::from(rgb_to_hex(r, g, b, None)))
 }
 
 pub fn rgbo_to_hex_fn(args: &[Value]) -> Result<Value, ValueError> {
     let f = "colorRGBOToHex";
-    let (r, g, b) = (float_arg(args, 0, f)?, float_arg(args, 1, f)?, float_arg(args, 2, f)?);
+    let (r, g, b) = (
+        float_arg(args, 0, f)?,
+        float_arg(args, 1, f)?,
+        float_arg(args, 2, f)?,
+    );
     let o = float_arg(args, 3, f)?;
     Ok(Value::from(rgb_to_hex(r, g, b, Some(o))))
 }
 
 pub fn hsv_to_hex_fn(args: &[Value]) -> Result<Value, ValueError> {
     let f = "colorHSVToHex";
-    let (h, s, v) = (float_arg(args, 0, f)?, float_arg(args, 1, f)?, float_arg(args, 2, f)?);
+    let (h, s, v) = (
+        float_arg(args, 0, f)?,
+        float_arg(args, 1, f)?,
+        float_arg(args, 2, f)?,
+    );
     let (r, g, b) = hsv_to_rgb(h, s, v);
     Ok(Value::from(rgb_to_hex(r, g, b, None)))
 }
 
 pub fn hsvo_to_hex_fn(args: &[Value]) -> Result<Value, ValueError> {
     let f = "colorHSVOToHex";
-    let (h, s, v) = (float_arg(args, 0, f)?, float_arg(args, 1, f)?, float_arg(args, 2, f)?);
+    let (h, s, v) = (
+        float_arg(args, 0, f)?,
+        float_arg(args, 1, f)?,
+        float_arg(args, 2, f)?,
+    );
     let o = float_arg(args, 3, f)?;
     let (r, g, b) = hsv_to_rgb(h, s, v);
     Ok(Value::from(rgb_to_hex(r, g, b, Some(o))))
@@ -171,7 +191,11 @@ const RAMPS: &[(&str, &[[u8; 3]])] = &[
 /// `colorRamp(gradient, value)`: the hex colour at `value` (clamped to
 /// [0, 1]) of a preset gradient; an error for an unknown preset.
 pub fn color_ramp(gradient: &str, value: f64) -> Result<String, ValueError> {
-    let t = if value.is_nan() { 0.0 } else { value.clamp(0.0, 1.0) };
+    let t = if value.is_nan() {
+        0.0
+    } else {
+        value.clamp(0.0, 1.0)
+    };
     if gradient == "spectrum" {
         let (r, g, b) = hsv_to_rgb(300.0 * (1.0 - t), 1.0, 1.0);
         return Ok(rgb_to_hex(r, g, b, None));

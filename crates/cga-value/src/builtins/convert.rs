@@ -25,7 +25,11 @@ pub fn parse_float(s: &str) -> f64 {
     let rest = &s[i..];
     let lower_starts = |p: &str| rest.len() >= p.len() && rest[..p.len()].eq_ignore_ascii_case(p);
     if lower_starts("inf") {
-        return if negative { f64::NEG_INFINITY } else { f64::INFINITY };
+        return if negative {
+            f64::NEG_INFINITY
+        } else {
+            f64::INFINITY
+        };
     }
     if lower_starts("nan") {
         return f64::NAN;
@@ -172,7 +176,10 @@ mod tests {
         assert_eq!(c("bool", Value::str("false")), Value::Bool(false));
         assert_eq!(c("bool", Value::str("f")), Value::Bool(false));
         assert_eq!(c("bool", Value::str("true")), Value::Bool(true));
-        assert_eq!(c("bool", Value::str("beneath the remains")), Value::Bool(true));
+        assert_eq!(
+            c("bool", Value::str("beneath the remains")),
+            Value::Bool(true)
+        );
         assert_eq!(c("bool", Value::Bool(11.5 == 0.0)), Value::Bool(false));
         // "0.0" etc. from the description
         assert_eq!(c("bool", Value::str("0")), Value::Bool(false));
@@ -186,7 +193,10 @@ mod tests {
         assert_eq!(c("float", Value::str("0.5")), Value::Float(0.5));
         assert_eq!(c("float", Value::Bool(true)), Value::Float(1.0));
         assert_eq!(c("float", Value::str("001.5")), Value::Float(1.5));
-        assert_eq!(c("float", Value::Float(1.0 / 0.0)), Value::Float(f64::INFINITY));
+        assert_eq!(
+            c("float", Value::Float(1.0 / 0.0)),
+            Value::Float(f64::INFINITY)
+        );
         assert_eq!(to_text(&c("float", Value::Float(1.0 / 0.0))), "inf");
         assert!(parse_float("a").is_nan());
         assert!(parse_float("").is_nan());
@@ -237,7 +247,10 @@ mod tests {
             "(4)[1,0,1.777,20]"
         );
         assert_eq!(
-            t("floatArray", Value::str_row(&["1.5", "-2", "0", "nixda", "5+6"])),
+            t(
+                "floatArray",
+                Value::str_row(&["1.5", "-2", "0", "nixda", "5+6"])
+            ),
             "(5)[1.5,-2,0,nan,5]"
         );
         assert_eq!(
@@ -258,7 +271,10 @@ mod tests {
         );
         // the empty forms
         assert_eq!(to_text(&call("floatArray", &[]).unwrap()), "(0)[]");
-        assert_eq!(call("boolArray", &[]).unwrap().value_type().name(), "bool[]");
+        assert_eq!(
+            call("boolArray", &[]).unwrap().value_type().name(),
+            "bool[]"
+        );
         assert_eq!(call("stringArray", &[]).unwrap().array_len(), Some(0));
         // conversions keep the dimensions
         let m = Value::from(Array::new(2, 1, vec![0.0, 3.0]));

@@ -14,7 +14,7 @@ use super::strings::{char_len, count, find, get_prefix, substring};
 use super::{arg, arg_mismatch, float_arg, str_arg};
 use crate::error::ValueError;
 use crate::format::write_value;
-use crate::ops::{float_relation_lt, float_relation_ge};
+use crate::ops::{float_relation_ge, float_relation_gt, float_relation_lt};
 use crate::value::{Array, Value};
 
 /// `listTerminate`: appends the missing `;` to a non-empty list.
@@ -108,7 +108,7 @@ pub fn list_range(args: &[Value]) -> Result<Value, ValueError> {
         return Ok(Value::str(""));
     }
     // `left <= 0` in CGA, where a NaN compares as less.
-    let from_start = !(left > 0.0);
+    let from_start = !float_relation_gt(left, 0.0);
     Ok(if from_start {
         if float_relation_lt(right, n) {
             Value::str(substring(l, 0.0, find(l, ";", right - 1.0) + 1.0))
@@ -141,14 +141,18 @@ pub fn list_clean(args: &[Value]) -> Result<Value, ValueError> {
 pub fn list_count(args: &[Value]) -> Result<Value, ValueError> {
     let l = str_arg(args, 0, "listCount")?;
     let p = str_arg(args, 1, "listCount")?;
-    Ok(Value::Float(items(l).filter(|i| matches(i, p)).count() as f64))
+    Ok(Value::Float(
+        items(l).filter(|i| matches(i, p)).count() as f64
+    ))
 }
 
 pub fn list_index(args: &[Value]) -> Result<Value, ValueError> {
     let l = str_arg(args, 0, "listIndex")?;
     let p = str_arg(args, 1, "listIndex")?;
     Ok(Value::Float(
-        items(l).position(|i| matches(i, p)).map_or(-1.0, |k| k as f64),
+        items(l)
+            .position(|i| matches(i, p))
+            .map_or(-1.0, |k| k as f64),
     ))
 }
 
@@ -218,20 +222,35 @@ mod tests {
     /// The examples of the celib/list*.md pages.
     #[test]
     fn list_examples() {
-        assert_eq!(s("listAdd", &[v("rule;your;"), v("city")]), v("rule;your;city;"));
-        assert_eq!(s("listAdd", &[v("rule;your;"), v("city;")]), v("rule;your;city;"));
+        assert_eq!(
+            s("listAdd", &[v("rule;your;"), v("city")]),
+            v("rule;your;city;")
+        );
+        assert_eq!(
+            s("listAdd", &[v("rule;your;"), v("city;")]),
+            v("rule;your;city;")
+        );
         assert_eq!(
             s("listClean", &[v(";;;;;my;city;rules;;your;;city;;")]),
             v("my;city;rules;your;city;")
         );
-        assert_eq!(s("listClean", &[v(";;cityengine;;;rules")]), v("cityengine;rules;"));
+        assert_eq!(
+            s("listClean", &[v(";;cityengine;;;rules")]),
+            v("cityengine;rules;")
+        );
         assert_eq!(s("listCount", &[v("rule;your;city;"), v("city")]), f(1.0));
-        assert_eq!(s("listCount", &[v("city;cityengine;city;"), v("city")]), f(2.0));
+        assert_eq!(
+            s("listCount", &[v("city;cityengine;city;"), v("city")]),
+            f(2.0)
+        );
         assert_eq!(s("listCount", &[v("rule;your;city;"), v("*y*")]), f(2.0));
         assert_eq!(s("listCount", &[v("rule;your;city;"), v("*y")]), f(1.0));
         assert_eq!(s("listFirst", &[v("rule;your;city;")]), v("rule"));
         assert_eq!(
-            to_text(&s("listFromArray", &[Value::float_row(vec![1.0, 2.0, 3.0])])),
+            to_text(&s(
+                "listFromArray",
+                &[Value::float_row(vec![1.0, 2.0, 3.0])]
+            )),
             "1;2;3;"
         );
         assert_eq!(
@@ -239,7 +258,10 @@ mod tests {
             v("true;false;true;")
         );
         assert_eq!(
-            s("listFromArray", &[Value::str_row(&["rule", "your", "city"])]),
+            s(
+                "listFromArray",
+                &[Value::str_row(&["rule", "your", "city"])]
+            ),
             v("rule;your;city;")
         );
         assert_eq!(s("listIndex", &[v("rule;your;city;"), v("city")]), f(2.0));
@@ -248,12 +270,18 @@ mod tests {
         assert_eq!(s("listIndex", &[v("rule;your;city;"), v("town")]), f(-1.0));
         assert_eq!(s("listItem", &[v("rule;your;city;"), f(2.0)]), v("city"));
         assert_eq!(
-            s("listItem", &[v("texture_1.jpg;texture_2.jpg;texture_3.jpg;"), f(0.0)]),
+            s(
+                "listItem",
+                &[v("texture_1.jpg;texture_2.jpg;texture_3.jpg;"), f(0.0)]
+            ),
             v("texture_1.jpg")
         );
         assert_eq!(s("listLast", &[v("rule;your;city;")]), v("city"));
         assert_eq!(
-            s("listRange", &[v("rule;your;city;with;cityengine;"), f(0.0), f(3.0)]),
+            s(
+                "listRange",
+                &[v("rule;your;city;with;cityengine;"), f(0.0), f(3.0)]
+            ),
             v("rule;your;city;")
         );
         // The page states "texture_3" for this one, without the `;` that its
@@ -269,22 +297,37 @@ mod tests {
             ),
             v("texture_3;")
         );
-        assert_eq!(s("listRemove", &[v("rule;your;city;"), v("your")]), v("rule;city;"));
-        assert_eq!(s("listRemove", &[v("rule;your;city;"), v("*u*")]), v("your;city;"));
+        assert_eq!(
+            s("listRemove", &[v("rule;your;city;"), v("your")]),
+            v("rule;city;")
+        );
+        assert_eq!(
+            s("listRemove", &[v("rule;your;city;"), v("*u*")]),
+            v("your;city;")
+        );
         assert_eq!(
             s("listRemove", &[v("floor_1;floor_2;floor_3;"), v("*_2")]),
             v("floor_1;floor_3;")
         );
         assert_eq!(
-            s("listRemoveAll", &[v("rule;your;designs;and;your;cities;"), v("your")]),
+            s(
+                "listRemoveAll",
+                &[v("rule;your;designs;and;your;cities;"), v("your")]
+            ),
             v("rule;designs;and;cities;")
         );
         assert_eq!(
-            s("listRemoveAll", &[v("rule;your;designs;and;your;cities;"), v("*u*")]),
+            s(
+                "listRemoveAll",
+                &[v("rule;your;designs;and;your;cities;"), v("*u*")]
+            ),
             v("designs;and;cities;")
         );
         assert_eq!(
-            s("listRetainAll", &[v("rule;your;designs;and;your;cities;"), v("*s")]),
+            s(
+                "listRetainAll",
+                &[v("rule;your;designs;and;your;cities;"), v("*s")]
+            ),
             v("designs;cities;")
         );
         assert_eq!(

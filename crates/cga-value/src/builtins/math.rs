@@ -62,7 +62,12 @@ pub fn is_null(args: &[Value]) -> Result<Value, ValueError> {
         Value::Str(s) => Ok(Value::Bool(&**s == NULL_STRING)),
         Value::FloatArray(a) => Ok(a.map(|x| x.is_nan()).into()),
         Value::StrArray(a) => Ok(a.map(|s| &**s == NULL_STRING).into()),
-        v => Err(arg_mismatch("isNull", 0, "float, string or an array of them", v)),
+        v => Err(arg_mismatch(
+            "isNull",
+            0,
+            "float, string or an array of them",
+            v,
+        )),
     }
 }
 

@@ -174,7 +174,9 @@ fn cached_regex(pattern: &str) -> Result<Arc<Regex>, ValueError> {
             return Ok(Arc::clone(re));
         }
         let re = Arc::new(Regex::new(pattern).map_err(|e| {
-            ValueError::new(format!("splitString: invalid regular expression {pattern:?}: {e}"))
+            ValueError::new(format!(
+                "splitString: invalid regular expression {pattern:?}: {e}"
+            ))
         })?);
         let mut cache = cache.borrow_mut();
         if cache.len() >= 256 {
@@ -388,7 +390,10 @@ mod tests {
             v("our city with ")
         );
         let tex = v("myTexture.hasName.001.jpg");
-        assert_eq!(s("getRange", &[tex.clone(), v("hasName."), v(".jpg")]), v("001"));
+        assert_eq!(
+            s("getRange", &[tex.clone(), v("hasName."), v(".jpg")]),
+            v("001")
+        );
         assert_eq!(s("getRange", &[tex, v("."), v(".")]), v("hasName.001"));
         assert_eq!(
             s("getRange", &[v("CityEngine"), v("CityEn"), v("tyEngine")]),

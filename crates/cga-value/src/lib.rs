@@ -5,6 +5,15 @@
 //! in `cga-engine`.
 //!
 //! Everything here is total: bad input gives a [`ValueError`], never a panic.
+//!
+//! * [`value`]: [`Value`], [`Array`] (row-major, `rows x cols`; 1D = one row).
+//! * [`ops`]: [`binary`] / [`unary`] for `+ - * / % == != < <= > >= && || !`
+//!   and their dotted element-wise forms.
+//! * [`array`](mod@array): [`build_array`] (`[a, b ; c, d]`), [`range`] (`[a : s : b]`),
+//!   [`index`] (`a[i]`, `a[i, j]`), [`set_elems`].
+//! * [`format`](mod@format): [`to_text`], the text of `str()` / `print()` / concatenation.
+//! * [`builtins`]: the function registry, resolved once per call site with
+//!   [`lookup`] (name and argument count).
 
 // Tests pass `&[v.clone()]` argument lists freely.
 #![cfg_attr(test, allow(clippy::cloned_ref_to_slice_refs))]

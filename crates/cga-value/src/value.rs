@@ -24,6 +24,10 @@ pub enum Value {
 /// A row-major array. A 1D array has `rows == 1` and prints as `(n)[...]`;
 /// any other shape prints as a `(rows x cols)` table.
 ///
+/// Invariant: `data.len() == rows * cols`. Code that builds an `Array` by
+/// hand must keep it (the functions of this crate index `data` by
+/// `row * cols + col`); [`Array::new`] and [`Array::row`] do.
+///
 /// An empty array is always stored as `1 x 0` (use [`Array::new`] or
 /// [`Array::row`] to keep that invariant); [`Array::n_rows`] reports 0 for it.
 #[derive(Clone, Debug, PartialEq)]

@@ -91,7 +91,7 @@ impl Arg {
             other => Err(RtError::new(
                 format!(
                     "expected a float, found {}",
-                    crate::value_shim::type_name(other)
+                    crate::values::type_name(other)
                 ),
                 self.span,
             )),
@@ -113,7 +113,7 @@ impl Arg {
             other => Err(RtError::new(
                 format!(
                     "expected a string, found {}",
-                    crate::value_shim::type_name(other)
+                    crate::values::type_name(other)
                 ),
                 self.span,
             )),
@@ -126,7 +126,7 @@ impl Arg {
             other => Err(RtError::new(
                 format!(
                     "expected a bool, found {}",
-                    crate::value_shim::type_name(other)
+                    crate::values::type_name(other)
                 ),
                 self.span,
             )),

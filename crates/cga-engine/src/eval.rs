@@ -7,7 +7,7 @@ use crate::derive::{AttrSlot, Interp, RtError};
 use crate::expr::{RExpr, RExprKind};
 use crate::program::{AttrId, FuncId};
 use crate::shape::Shape;
-use crate::value_shim as vs;
+use crate::values as vs;
 
 impl Interp<'_> {
     pub fn eval(&mut self, e: &RExpr, frame: &[Value], shape: &Shape) -> Result<Value, RtError> {
@@ -27,7 +27,7 @@ impl Interp<'_> {
                 for a in args {
                     values.push(self.eval(a, frame, shape)?);
                 }
-                (b.f)(&values).map_err(|m| RtError::new(format!("{}: {m}", b.name), e.span))
+                (b.f)(&values).map_err(|m| RtError::new(format!("{}: {}", b.name, m.message), e.span))
             }
             RExprKind::Shape(f, args) => {
                 let mut values = Vec::with_capacity(args.len());
@@ -81,7 +81,7 @@ impl Interp<'_> {
                     }
                     out.push(r);
                 }
-                vs::build_array(out).map_err(|m| RtError::new(m, e.span))
+                vs::build_array(&out).map_err(|m| RtError::new(m.message, e.span))
             }
             RExprKind::Range { base, step, limit } => {
                 let b = self.eval_num(base, frame, shape)?;
@@ -90,7 +90,7 @@ impl Interp<'_> {
                     None => None,
                 };
                 let l = self.eval_num(limit, frame, shape)?;
-                vs::range(b, s, l).map_err(|m| RtError::new(m, e.span))
+                vs::range(b, s, l).map_err(|m| RtError::new(m.message, e.span))
             }
             RExprKind::Index { base, indices } => {
                 let b = self.eval(base, frame, shape)?;
@@ -98,7 +98,7 @@ impl Interp<'_> {
                 for i in indices {
                     idx.push(self.eval(i, frame, shape)?);
                 }
-                vs::index(&b, &idx).map_err(|m| RtError::new(m, e.span))
+                vs::index(&b, &idx).map_err(|m| RtError::new(m.message, e.span))
             }
             RExprKind::Case {
                 branches,

@@ -25,7 +25,7 @@ pub enum RExprKind {
     /// A user function or const (constness is on the definition).
     Func(FuncId, Vec<RExpr>),
     /// A built-in that depends on its arguments only.
-    Pure(&'static crate::value_shim::Builtin, Vec<RExpr>),
+    Pure(&'static crate::values::Builtin, Vec<RExpr>),
     /// A built-in that reads (or, for `rand`/`p`, advances) the current shape.
     Shape(ShapeFn, Vec<RExpr>),
     Unary {

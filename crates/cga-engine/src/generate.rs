@@ -10,7 +10,7 @@ use crate::derive::{InitialInfo, Interp, Limits, LotOutput, RtError};
 use crate::expr::RExpr;
 use crate::lot::{initial_shape, Lot};
 use crate::program::{AttrId, Program, RuleId};
-use crate::value_shim::to_text;
+use crate::values::to_text;
 
 #[derive(Clone, Debug, Default)]
 pub struct GenerateOptions {

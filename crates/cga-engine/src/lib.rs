@@ -15,7 +15,7 @@ pub mod resolve;
 pub mod shape;
 pub mod shape_fns;
 pub mod split_layout;
-mod value_shim;
+pub mod values;
 
 pub use generate::{generate_lot, GenerateOptions};
 pub use derive::{InitialInfo, Interp, Limits, LotOutput, RtError};

@@ -146,7 +146,7 @@ impl MatField {
         let text = || -> Result<Arc<str>, String> {
             Ok(match v {
                 Value::Str(s) => s.clone(),
-                other => Arc::from(crate::value_shim::to_text(other).as_str()),
+                other => Arc::from(crate::values::to_text(other).as_str()),
             })
         };
         match self {

@@ -24,7 +24,7 @@ use crate::program::{
     RuleSetId,
 };
 use crate::shape_fns;
-use crate::value_shim;
+use crate::values;
 
 /// The result of loading a rule file: the program (if it resolved without
 /// errors) and every diagnostic found.
@@ -786,7 +786,7 @@ impl Resolver<'_> {
             RExprKind::Func(f, Vec::new())
         } else if let Some(f) = shape_fns::lookup(name, 0) {
             RExprKind::Shape(f, Vec::new())
-        } else if let Some(b) = value_shim::lookup(name).filter(|b| b.min_args == 0) {
+        } else if let Some(b) = values::lookup(name, 0) {
             RExprKind::Pure(b, Vec::new())
         } else if selector_ok {
             RExprKind::Const(Value::Str(Arc::from(name)))
@@ -803,19 +803,18 @@ impl Resolver<'_> {
             RExprKind::Func(f, args)
         } else if let Some(f) = shape_fns::lookup(&name.name, n) {
             RExprKind::Shape(f, args)
-        } else if let Some(b) = value_shim::lookup(&name.name) {
-            if n < b.min_args || n > b.max_args {
-                self.error(
-                    format!(
-                        "`{}` takes {} arguments, found {n}",
-                        name.name,
-                        arity_text(b.min_args, b.max_args)
-                    ),
-                    span,
-                );
-                return placeholder(span);
-            }
+        } else if let Some(b) = values::lookup(&name.name, n) {
             RExprKind::Pure(b, args)
+        } else if let Some(b) = values::lookup_name(&name.name) {
+            self.error(
+                format!(
+                    "`{}` takes {} arguments, found {n}",
+                    name.name,
+                    arity_text(b.min_args, b.max_args)
+                ),
+                span,
+            );
+            return placeholder(span);
         } else {
             self.unknown("function", name, cx.rs, NameKind::Value);
             return placeholder(span);

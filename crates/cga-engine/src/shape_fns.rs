@@ -238,7 +238,7 @@ mod eval {
             other => Err(RtError::new(
                 format!(
                     "expected a float, found {}",
-                    crate::value_shim::type_name(other)
+                    crate::values::type_name(other)
                 ),
                 at.span,
             )),
@@ -332,7 +332,7 @@ mod eval {
                     })
                 }
                 ShapeFn::Print => {
-                    self.out.prints.push(crate::value_shim::to_text(&args[0]));
+                    self.out.prints.push(crate::values::to_text(&args[0]));
                     args[0].clone()
                 }
                 ShapeFn::Geometry(g) => self.geometry_fn(g, args, shape, at)?,

@@ -11,7 +11,7 @@ use crate::expr::OpCall;
 use crate::material_attr::{parse_hex_color, MatField, MaterialOverrides};
 use crate::shape::{euler_to_mat, Shape};
 use crate::shape_fns::ShapeFn;
-use crate::value_shim::{to_text, type_name};
+use crate::values::{to_text, type_name};
 
 pub fn exec(
     cx: &mut Interp,

@@ -3,8 +3,12 @@
 //! texture coordinates and normals), and the algorithms the operations need.
 
 pub mod material;
+pub mod measure;
 pub mod mesh;
+pub mod topology;
+pub mod triangulate;
 
 pub use glam::{DAffine3, DMat3, DQuat, DVec2, DVec3};
 pub use material::{Material, TextureChannel, TEXTURE_CHANNELS};
 pub use mesh::{Face, Loop, Mesh, UV_SETS};
+pub use triangulate::triangulate_face;

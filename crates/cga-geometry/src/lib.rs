@@ -2,6 +2,7 @@
 //! polygon meshes in f64 (faces with holes, per-face materials, per-corner
 //! texture coordinates and normals), and the algorithms the operations need.
 
+pub mod cut;
 pub mod material;
 pub mod measure;
 pub mod mesh;

@@ -3,6 +3,7 @@
 //! texture coordinates and normals), and the algorithms the operations need.
 
 pub mod cut;
+pub mod extrude;
 pub mod material;
 pub mod measure;
 pub mod mesh;

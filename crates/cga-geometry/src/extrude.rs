@@ -91,11 +91,7 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
     match how {
         Extrusion::FaceNormal => {
             for f in 0..mesh.faces.len() {
-                let n = if normals[f] != DVec3::ZERO {
-                    normals[f]
-                } else {
-                    stored_normal(mesh, f)
-                };
+                let n = face_dir(f);
                 for &l in mesh.face_loops(f) {
                     for c in mesh.loop_corners(l) {
                         vec_of_corner[c] = n * distance;
@@ -132,11 +128,7 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
             let mut acc = vec![DVec3::ZERO; weld.count];
             let mut last_face = vec![u32::MAX; weld.count];
             for f in 0..mesh.faces.len() {
-                let n = if normals[f] != DVec3::ZERO {
-                    normals[f]
-                } else {
-                    stored_normal(mesh, f)
-                };
+                let n = face_dir(f);
                 for &l in mesh.face_loops(f) {
                     for c in mesh.loop_corners(l) {
                         let v = vid(c) as usize;
@@ -264,7 +256,7 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
             .loop_corners(outer)
             .map(|c| vec_of_corner[c])
             .sum::<DVec3>();
-        let flip = mean.dot(normals[f]) < 0.0;
+        let flip = mean.dot(face_dir(f)) < 0.0;
         let base: Vec<Vec<(u32, u32)>> = mesh
             .face_loops(f)
             .iter()

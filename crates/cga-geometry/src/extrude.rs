@@ -85,6 +85,15 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
     let normals: Vec<DVec3> = (0..mesh.faces.len())
         .map(|f| face_normal(mesh, f))
         .collect();
+    // The direction a face moves along with `face.normal`: its normal, or
+    // for edge and vertex shapes the normal stored on their corners.
+    let face_dir = |f: usize| {
+        if normals[f] != DVec3::ZERO {
+            normals[f]
+        } else {
+            stored_normal(mesh, f)
+        }
+    };
 
     // The extrusion vector of every corner.
     let mut vec_of_corner = vec![DVec3::ZERO; mesh.corners.len()];

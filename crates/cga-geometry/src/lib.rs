@@ -7,6 +7,7 @@ pub mod extrude;
 pub mod material;
 pub mod measure;
 pub mod mesh;
+pub mod obj;
 pub mod topology;
 pub mod triangulate;
 

@@ -9,6 +9,7 @@ pub mod measure;
 pub mod mesh;
 pub mod obj;
 pub mod topology;
+pub mod transform;
 pub mod triangulate;
 
 pub use glam::{DAffine3, DMat3, DQuat, DVec2, DVec3};

@@ -8,6 +8,7 @@ pub mod material;
 pub mod measure;
 pub mod mesh;
 pub mod obj;
+pub mod primitive;
 pub mod topology;
 pub mod transform;
 pub mod triangulate;

@@ -1286,6 +1286,48 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn extruded_lot_split_into_floors() {
+        // Lot 20 x 30 extruded by 10, split(y) at 3, 6, 9: four closed
+        // floors, the last 1 m high.
+        let lot = Mesh::polygon(&[
+            v(0., 0., 0.),
+            v(20., 0., 0.),
+            v(20., 0., -30.),
+            v(0., 0., -30.),
+        ]);
+        let mass = crate::extrude::extrude(&lot, crate::extrude::Extrusion::FaceNormal, 10.0);
+        let floors = split_along_axis(&mass, 1, &[3.0, 6.0, 9.0]);
+        let vols: Vec<f64> = floors.iter().map(volume).collect();
+        assert_eq!(
+            vols.iter().map(|v| v.round()).collect::<Vec<_>>(),
+            vec![1800.0, 1800.0, 1800.0, 600.0]
+        );
+        for (i, f) in floors.iter().enumerate() {
+            assert!(closed(f), "floor {i}");
+            assert_eq!(f.faces.len(), 6);
+            assert_eq!(f.positions.len(), 8);
+            // Side faces keep their order: the front (+z) comes right after
+            // the bottom and top (or caps) of the original mass.
+            assert!(f.faces.iter().all(|x| x.loop_count == 1));
+        }
+        // The ground floor: original bottom, then the 4 sides, then the cap.
+        assert_eq!(face_normal(&floors[0], 0), -DVec3::Y);
+        assert_eq!(face_normal(&floors[0], 1), DVec3::Z);
+        assert_eq!(face_normal(&floors[0], 5), DVec3::Y);
+        // The front facade split into 4 tiles along x: open, area kept.
+        let facade = Mesh::polygon(&[
+            v(0., 0., 0.),
+            v(20., 0., 0.),
+            v(20., 10., 0.),
+            v(0., 10., 0.),
+        ]);
+        let tiles = split_along_axis(&facade, 0, &[5.0, 10.0, 15.0]);
+        assert!(tiles
+            .iter()
+            .all(|t| mesh_area(t) == 50.0 && t.faces.len() == 1));
+    }
+
+    #[test]
     fn cut_at_faces_lying_in_the_plane() {
         let b = unit_box();
         // At the top face: everything below, nothing above, no caps.

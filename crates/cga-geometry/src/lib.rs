@@ -1,10 +1,35 @@
 //! Geometry for the CGA engine, knowing nothing of the language: indexed
 //! polygon meshes in f64 (faces with holes, per-face materials, per-corner
 //! texture coordinates and normals), and the algorithms the operations need.
+//!
+//! | module | what |
+//! | --- | --- |
+//! | [`mesh`], [`material`] | the data |
+//! | [`measure`] | normals, areas, volume, bounds, the `geometry.*` measures |
+//! | [`topology`] | welding, unique edges with their faces (`comp(e)` order), closedness |
+//! | [`triangulate`] | faces to triangles for export |
+//! | [`cut`] | plane cuts with caps: `split`, trim planes |
+//! | [`extrude`] | `extrude` |
+//! | [`primitive`] | `primitive*` and `builtin:cube` |
+//! | [`obj`] | OBJ + MTL assets |
+//! | [`transform`] | affine transforms, reversing, merging |
 
+pub mod cut;
+pub mod extrude;
 pub mod material;
+pub mod measure;
 pub mod mesh;
+pub mod obj;
+pub mod primitive;
+pub mod topology;
+pub mod transform;
+pub mod triangulate;
 
+pub use cut::{cut_by_plane, split_along_axis, split_by_parallel_planes};
+pub use extrude::{extrude, extrude_with_roles, ExtrudeRole, Extrusion};
 pub use glam::{DAffine3, DMat3, DQuat, DVec2, DVec3};
 pub use material::{Material, TextureChannel, TEXTURE_CHANNELS};
 pub use mesh::{Face, Loop, Mesh, UV_SETS};
+pub use obj::{load_obj, parse_obj, ObjAsset, ObjError};
+pub use topology::Topology;
+pub use triangulate::triangulate_face;

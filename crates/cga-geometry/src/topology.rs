@@ -1,0 +1,264 @@
+//! Welding and edge topology: which faces share which edges.
+//!
+//! Meshes may repeat a position under several indices (assets, meshes
+//! merged from several shapes), so topology is computed on *welded* vertex
+//! ids: positions closer than a tolerance count as one vertex. Edges are
+//! numbered in the order CGA's `comp(e)` uses: index 0 is the first edge of
+//! the first face, then the second edge of the first face, and so on; an edge
+//! shared with an earlier face is skipped on its second encounter.
+
+use std::collections::HashMap;
+
+use glam::DVec3;
+
+use crate::mesh::Mesh;
+
+/// The tolerance used by this crate to decide that two points coincide or
+/// that a point lies on a plane: 1e-9 relative to the magnitude of the
+/// coordinates (at least 1e-9 absolute), far below any modelling scale and
+/// far above the rounding of f64 arithmetic on such coordinates.
+pub fn mesh_tolerance(mesh: &Mesh) -> f64 {
+    let m = mesh
+        .positions
+        .iter()
+        .fold(0.0f64, |m, p| m.max(p.abs().max_element()));
+    1e-9 * m.max(1.0)
+}
+
+/// Welded vertex ids for a list of points.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Weld {
+    /// For each input point, its vertex id in `0..count`. Ids are given in
+    /// order of first appearance, so the first point of each cluster names it.
+    pub id: Vec<u32>,
+    /// Number of distinct vertices.
+    pub count: usize,
+    /// For each vertex id, the index of the input point that represents it.
+    pub representative: Vec<u32>,
+}
+
+fn cell_key(p: DVec3, cell: f64) -> [i64; 3] {
+    // `+ 0.0` turns -0.0 into 0.0 so that both land in the same cell.
+    [p.x, p.y, p.z].map(|c| ((c + 0.0) / cell).floor() as i64)
+}
+
+/// Welds points closer than `tol` (per coordinate, a box test) to the first
+/// of them. `tol <= 0` welds only bitwise-equal coordinates. Runs in linear
+/// time with a hash grid of cell size `tol`. Clusters are formed greedily: a
+/// point joins the first earlier representative within `tol`.
+pub fn weld_points(points: &[DVec3], tol: f64) -> Weld {
+    let mut id = Vec::with_capacity(points.len());
+    let mut representative: Vec<u32> = Vec::new();
+    if tol <= 0.0 || !tol.is_finite() {
+        let mut seen: HashMap<[u64; 3], u32> = HashMap::with_capacity(points.len());
+        for (i, p) in points.iter().enumerate() {
+            let key = [p.x + 0.0, p.y + 0.0, p.z + 0.0].map(f64::to_bits);
+            let next = representative.len() as u32;
+            let v = *seen.entry(key).or_insert(next);
+            if v == next {
+                representative.push(i as u32);
+            }
+            id.push(v);
+        }
+    } else {
+        // Cell of size `tol`: a point within `tol` of another lies in the same
+        // or an adjacent cell. `head` holds the first representative of each
+        // cell, `next` chains further representatives of the same cell.
+        let mut head: HashMap<[i64; 3], u32> = HashMap::with_capacity(points.len());
+        let mut next: Vec<u32> = Vec::new();
+        for (i, &p) in points.iter().enumerate() {
+            let k = cell_key(p, tol);
+            let mut found = None;
+            'search: for dx in -1..=1 {
+                for dy in -1..=1 {
+                    for dz in -1..=1 {
+                        let kk = [k[0] + dx, k[1] + dy, k[2] + dz];
+                        let mut r = head.get(&kk).copied().unwrap_or(u32::MAX);
+                        while r != u32::MAX {
+                            let q = points[representative[r as usize] as usize];
+                            if (q - p).abs().max_element() <= tol {
+                                found = Some(r);
+                                break 'search;
+                            }
+                            r = next[r as usize];
+                        }
+                    }
+                }
+            }
+            let v = match found {
+                Some(v) => v,
+                None => {
+                    let v = representative.len() as u32;
+                    representative.push(i as u32);
+                    let h = head.entry(k).or_insert(u32::MAX);
+                    next.push(*h);
+                    *h = v;
+                    v
+                }
+            };
+            id.push(v);
+        }
+    }
+    Weld {
+        count: representative.len(),
+        id,
+        representative,
+    }
+}
+
+/// One use of an edge by a face: the corner the edge starts at (the edge runs
+/// from `corner` to the next corner of its loop).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EdgeUse {
+    pub face: u32,
+    pub corner: u32,
+    /// True if this use runs against the edge's direction (`Edge::v[1]` to `v[0]`).
+    pub reversed: bool,
+}
+
+/// A unique undirected edge between two welded vertices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Edge {
+    /// Welded vertex ids, in the direction of the first face that uses it.
+    pub v: [u32; 2],
+    /// Position indices of the two ends (from the first use).
+    pub p: [u32; 2],
+}
+
+/// Edge topology of a mesh on welded vertices.
+#[derive(Clone, Debug, Default)]
+pub struct Topology {
+    /// Welded vertex id of every position of the mesh.
+    pub weld: Weld,
+    /// Unique edges, in `comp(e)` order.
+    pub edges: Vec<Edge>,
+    /// For each corner, the edge from it to the next corner of its loop;
+    /// `u32::MAX` where that edge has zero length (both ends weld together).
+    pub edge_of_corner: Vec<u32>,
+    /// `uses[use_start[e]..use_start[e + 1]]` are the uses of edge `e`.
+    pub use_start: Vec<u32>,
+    pub uses: Vec<EdgeUse>,
+}
+
+impl Topology {
+    /// Computes the topology with the default tolerance ([`mesh_tolerance`]).
+    pub fn new(mesh: &Mesh) -> Topology {
+        Topology::with_tolerance(mesh, mesh_tolerance(mesh))
+    }
+
+    pub fn with_tolerance(mesh: &Mesh, tol: f64) -> Topology {
+        let weld = weld_points(&mesh.positions, tol);
+        let mut index: HashMap<(u32, u32), u32> = HashMap::with_capacity(mesh.corners.len());
+        let mut edges = Vec::new();
+        let mut edge_of_corner = vec![u32::MAX; mesh.corners.len()];
+        let mut counts: Vec<u32> = Vec::new();
+        for face in 0..mesh.faces.len() {
+            for &l in mesh.face_loops(face) {
+                let r = mesh.loop_corners(l);
+                for c in r.clone() {
+                    let n = if c + 1 == r.end { r.start } else { c + 1 };
+                    let (pa, pb) = (mesh.corners[c], mesh.corners[n]);
+                    let (a, b) = (weld.id[pa as usize], weld.id[pb as usize]);
+                    if a == b {
+                        continue;
+                    }
+                    let key = (a.min(b), a.max(b));
+                    let e = *index.entry(key).or_insert_with(|| {
+                        edges.push(Edge {
+                            v: [a, b],
+                            p: [pa, pb],
+                        });
+                        counts.push(0);
+                        (edges.len() - 1) as u32
+                    });
+                    counts[e as usize] += 1;
+                    edge_of_corner[c] = e;
+                }
+            }
+        }
+        // Counting sort of the uses by edge (keeps face/corner order per edge).
+        let mut use_start = Vec::with_capacity(edges.len() + 1);
+        let mut acc = 0u32;
+        for &c in &counts {
+            use_start.push(acc);
+            acc += c;
+        }
+        use_start.push(acc);
+        let mut fill = use_start.clone();
+        let mut uses = vec![
+            EdgeUse {
+                face: 0,
+                corner: 0,
+                reversed: false
+            };
+            acc as usize
+        ];
+        for face in 0..mesh.faces.len() {
+            for &l in mesh.face_loops(face) {
+                for c in mesh.loop_corners(l) {
+                    let e = edge_of_corner[c];
+                    if e == u32::MAX {
+                        continue;
+                    }
+                    let a = weld.id[mesh.corners[c] as usize];
+                    let slot = &mut fill[e as usize];
+                    uses[*slot as usize] = EdgeUse {
+                        face: face as u32,
+                        corner: c as u32,
+                        reversed: a != edges[e as usize].v[0],
+                    };
+                    *slot += 1;
+                }
+            }
+        }
+        Topology {
+            weld,
+            edges,
+            edge_of_corner,
+            use_start,
+            uses,
+        }
+    }
+
+    /// The uses of edge `e` by faces, in face order.
+    pub fn edge_uses(&self, e: usize) -> &[EdgeUse] {
+        &self.uses[self.use_start[e] as usize..self.use_start[e + 1] as usize]
+    }
+
+    /// True if the edge is used by at most one face corner (a border edge in
+    /// CGA's sense: "connected to only one face").
+    pub fn is_border(&self, e: usize) -> bool {
+        self.use_start[e + 1] - self.use_start[e] <= 1
+    }
+
+    /// Number of distinct welded vertices referenced by the mesh's corners.
+    pub fn referenced_vertex_count(&self, mesh: &Mesh) -> usize {
+        let mut seen = vec![false; self.weld.count];
+        let mut n = 0;
+        for &p in &mesh.corners {
+            let v = self.weld.id[p as usize] as usize;
+            if !seen[v] {
+                seen[v] = true;
+                n += 1;
+            }
+        }
+        n
+    }
+
+    /// True if the mesh has at least one face of three or more corners and
+    /// every edge is used exactly twice, once in each direction, by such
+    /// faces (a watertight, consistently oriented surface). Faces of one or
+    /// two corners (edge and vertex shapes) make a mesh not closed.
+    pub fn is_closed(&self, mesh: &Mesh) -> bool {
+        if mesh.faces.is_empty() {
+            return false;
+        }
+        if (0..mesh.faces.len()).any(|f| mesh.outer_loop(f).len < 3) {
+            return false;
+        }
+        (0..self.edges.len()).all(|e| {
+            let u = self.edge_uses(e);
+            u.len() == 2 && u[0].reversed != u[1].reversed
+        })
+    }
+}

@@ -1,0 +1,257 @@
+//! Triangulation of polygon faces (with holes) for export and rendering.
+//!
+//! Each face is projected onto its own plane (basis from its Newell normal)
+//! and handed to `earcut`, a port of Mapbox's ear-clipping triangulator that
+//! copes with concave outlines, collinear points and holes touching the
+//! outline. Triangles index `Mesh::corners` (not positions) so that per-corner
+//! texture coordinates and normals can follow each triangle corner.
+
+use std::cell::RefCell;
+
+use earcut::Earcut;
+use glam::{DVec2, DVec3};
+
+use crate::mesh::Mesh;
+
+/// Reused per-thread buffers: exporting a city triangulates millions of
+/// faces, so none of them should allocate.
+struct Scratch {
+    earcut: Earcut<f64>,
+    points: Vec<[f64; 2]>,
+    /// Corner index of each entry of `points`.
+    corner_of: Vec<u32>,
+    holes: Vec<u32>,
+    tris: Vec<u32>,
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch {
+        earcut: Earcut::new(),
+        points: Vec::new(),
+        corner_of: Vec::new(),
+        holes: Vec::new(),
+        tris: Vec::new(),
+    });
+}
+
+/// An orthonormal basis `(u, v)` of the plane with normal `n`, such that
+/// `u × v = n` (so counter-clockwise around `n` stays counter-clockwise in
+/// the `(u, v)` coordinates). `n` must be of unit length.
+pub fn plane_basis(n: DVec3) -> (DVec3, DVec3) {
+    // Pick the world axis least aligned with n to build u from.
+    let a = if n.x.abs() <= n.y.abs() && n.x.abs() <= n.z.abs() {
+        DVec3::X
+    } else if n.y.abs() <= n.z.abs() {
+        DVec3::Y
+    } else {
+        DVec3::Z
+    };
+    let u = a.cross(n).normalize();
+    let v = n.cross(u);
+    (u, v)
+}
+
+/// Appends the triangles of face `face` to `out`, as triples of indices into
+/// `mesh.corners`, counter-clockwise seen from the side the face normal points
+/// to. Faces with loops of fewer than three corners (edge and vertex shapes)
+/// and faces of zero area give no triangles.
+pub fn triangulate_face(mesh: &Mesh, face: usize, out: &mut Vec<[u32; 3]>) {
+    let Some(f) = mesh.faces.get(face) else {
+        return;
+    };
+    let loops = mesh.face_loops(face);
+    let outer = loops[0];
+    if outer.len < 3 {
+        return;
+    }
+    let n = crate::measure::face_normal(mesh, face);
+    if n == DVec3::ZERO {
+        return;
+    }
+    let (u, v) = plane_basis(n);
+    let project = |c: usize| {
+        let p = mesh.positions[mesh.corners[c] as usize];
+        DVec2::new(p.dot(u), p.dot(v))
+    };
+    let s = outer.start;
+
+    // Fast paths for the overwhelmingly common triangles and quads.
+    if f.loop_count == 1 && outer.len == 3 {
+        out.push([s, s + 1, s + 2]);
+        return;
+    }
+    if f.loop_count == 1 && outer.len == 4 {
+        let q = [0, 1, 2, 3].map(|i| project((s + i) as usize));
+        let area = |a: DVec2, b: DVec2, c: DVec2| (b - a).perp_dot(c - a);
+        // Use the diagonal a–c if both halves turn left, else b–d (one of the
+        // two diagonals of a simple quad always lies inside it).
+        if area(q[0], q[1], q[2]) > 0.0 && area(q[0], q[2], q[3]) > 0.0 {
+            out.push([s, s + 1, s + 2]);
+            out.push([s, s + 2, s + 3]);
+        } else {
+            out.push([s + 1, s + 2, s + 3]);
+            out.push([s + 1, s + 3, s]);
+        }
+        return;
+    }
+
+    SCRATCH.with(|scratch| {
+        let mut guard = scratch.borrow_mut();
+        let sc = &mut *guard;
+        sc.points.clear();
+        sc.corner_of.clear();
+        sc.holes.clear();
+        for (k, l) in loops.iter().enumerate() {
+            if l.len < 3 {
+                continue; // a degenerate hole contributes no area
+            }
+            if k > 0 {
+                sc.holes.push(sc.points.len() as u32);
+            }
+            for c in mesh.loop_corners(*l) {
+                let p = project(c);
+                sc.points.push([p.x, p.y]);
+                sc.corner_of.push(c as u32);
+            }
+        }
+        let Scratch {
+            earcut,
+            points,
+            corner_of,
+            holes,
+            tris,
+        } = sc;
+        earcut.earcut(points.iter().copied(), holes, tris);
+        for t in tris.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| i as usize);
+            let pa = DVec2::from(points[a]);
+            let pb = DVec2::from(points[b]);
+            let pc = DVec2::from(points[c]);
+            // earcut's output winding is not specified: make it match the face.
+            if (pb - pa).perp_dot(pc - pa) >= 0.0 {
+                out.push([corner_of[a], corner_of[b], corner_of[c]]);
+            } else {
+                out.push([corner_of[a], corner_of[c], corner_of[b]]);
+            }
+        }
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::measure::{face_area, face_normal};
+
+    fn v(x: f64, y: f64, z: f64) -> DVec3 {
+        DVec3::new(x, y, z)
+    }
+
+    /// Triangulates every face and checks that the triangles cover the face
+    /// area exactly once, each wound counter-clockwise around the face normal.
+    fn check(mesh: &Mesh) -> Vec<[u32; 3]> {
+        let mut all = Vec::new();
+        for f in 0..mesh.faces.len() {
+            let mut tris = Vec::new();
+            triangulate_face(mesh, f, &mut tris);
+            let n = face_normal(mesh, f);
+            let mut sum = 0.0;
+            for t in &tris {
+                let p = t.map(|c| mesh.positions[mesh.corners[c as usize] as usize]);
+                let a = (p[1] - p[0]).cross(p[2] - p[0]);
+                assert!(a.dot(n) >= 0.0, "triangle {t:?} wound against the face");
+                sum += 0.5 * a.length();
+                let r = mesh.loop_corners(mesh.outer_loop(f));
+                let last = mesh.face_loops(f).last().unwrap();
+                for &c in t {
+                    assert!(
+                        r.start <= c as usize && (c as usize) < (last.start + last.len) as usize
+                    );
+                }
+            }
+            assert!(
+                (sum - face_area(mesh, f)).abs() <= 1e-9 * sum.max(1.0),
+                "face {f}: triangles {sum} vs area {}",
+                face_area(mesh, f)
+            );
+            all.extend(tris);
+        }
+        all
+    }
+
+    #[test]
+    fn triangle_and_quads() {
+        let tri = Mesh::polygon(&[v(0., 0., 0.), v(1., 0., 0.), v(0., 1., 0.)]);
+        assert_eq!(check(&tri), vec![[0, 1, 2]]);
+        let quad = Mesh::polygon(&[v(0., 0., 0.), v(2., 0., 0.), v(2., 0., -1.), v(0., 0., -1.)]);
+        assert_eq!(check(&quad).len(), 2);
+        // A dart (concave quad): the reflex corner is at index 3, so only the
+        // diagonal 1-3 lies inside.
+        let dart = Mesh::polygon(&[
+            v(0., 0., 0.),
+            v(2., 0., -1.),
+            v(0., 0., -2.),
+            v(0.5, 0., -1.),
+        ]);
+        assert_eq!(check(&dart), vec![[1, 2, 3], [1, 3, 0]]);
+    }
+
+    #[test]
+    fn concave_polygon_with_collinear_points() {
+        // An L with extra collinear points along its long edges.
+        let m = Mesh::polygon(&[
+            v(0., 0., 0.),
+            v(1., 0., 0.),
+            v(2., 0., 0.),
+            v(2., 0., -1.),
+            v(1., 0., -1.),
+            v(1., 0., -2.),
+            v(0., 0., -2.),
+            v(0., 0., -1.),
+        ]);
+        let tris = check(&m);
+        assert_eq!(tris.len(), 6); // n - 2 for a simple polygon without holes
+    }
+
+    #[test]
+    fn holes_including_one_touching_the_outline() {
+        let mut m = Mesh::new();
+        m.positions.extend([
+            v(0., 0., 0.),
+            v(4., 0., 0.),
+            v(4., 0., -4.),
+            v(0., 0., -4.),
+            // a clockwise hole in the middle
+            v(1., 0., -1.),
+            v(1., 0., -2.),
+            v(2., 0., -2.),
+            v(2., 0., -1.),
+        ]);
+        m.add_face(&[&[0, 1, 2, 3], &[4, 5, 6, 7]], 0);
+        assert_eq!(check(&m).len(), 8);
+        assert_eq!(face_area(&m, 0), 15.0);
+        // A hole touching the outline at the corner (4, 0, -4).
+        m.positions.extend([
+            v(3., 0., -3.),
+            v(3., 0., -4.),
+            v(4., 0., -4.),
+            v(4., 0., -3.),
+        ]);
+        m.add_face(&[&[0, 1, 2, 3], &[8, 9, 10, 11]], 0);
+        check(&m);
+        assert_eq!(face_area(&m, 1), 15.0);
+    }
+
+    #[test]
+    fn vertical_and_degenerate_faces() {
+        // A facade quad facing +z (x right, y up).
+        let m = Mesh::polygon(&[v(0., 0., 0.), v(5., 0., 0.), v(5., 3., 0.), v(0., 3., 0.)]);
+        assert_eq!(check(&m).len(), 2);
+        let mut e = Mesh::new();
+        e.positions.extend([v(0., 0., 0.), v(1., 0., 0.)]);
+        e.add_face(&[&[0, 1]], 0);
+        let mut out = Vec::new();
+        triangulate_face(&e, 0, &mut out);
+        triangulate_face(&e, 7, &mut out); // out of range: nothing, no panic
+        assert!(out.is_empty());
+    }
+}

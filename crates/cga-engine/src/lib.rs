@@ -6,7 +6,6 @@ pub mod derive;
 mod eval;
 pub mod expr;
 pub mod generate;
-mod geom_shim;
 pub mod lot;
 pub mod material_attr;
 pub mod ops;

@@ -111,7 +111,7 @@ pub fn initial_shape(lot: &Lot, seed: u64, name: u32) -> Shape {
     let mut mesh = lot.mesh.clone();
     let (mut normal, mut x) = first_edge_frame(&mesh);
     if normal.y < -1e-9 {
-        crate::shape::reverse_faces(&mut mesh);
+        cga_geometry::transform::reverse_faces(&mut mesh);
         (normal, x) = first_edge_frame(&mesh);
     }
     let y = normal;

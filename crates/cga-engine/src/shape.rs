@@ -121,43 +121,11 @@ impl Geometry {
 /// facing outwards.
 pub fn transformed(mesh: &Mesh, t: &DAffine3) -> Mesh {
     let mut m = mesh.clone();
-    for p in &mut m.positions {
-        *p = t.transform_point3(*p);
-    }
-    let linear = t.matrix3;
-    if let Some(normals) = &mut m.normals {
-        let n_mat = linear.inverse().transpose();
-        for n in normals.iter_mut() {
-            *n = (n_mat * *n).normalize_or_zero();
-        }
-    }
-    if linear.determinant() < 0.0 {
-        reverse_faces(&mut m);
+    cga_geometry::transform::transform(&mut m, t);
+    if t.matrix3.determinant() < 0.0 {
+        cga_geometry::transform::reverse_faces(&mut m);
     }
     m
-}
-
-/// Reverses the orientation of every loop (outer and holes), keeping each
-/// loop's first corner first so that "the first edge" stays recognisable.
-pub fn reverse_faces(m: &mut Mesh) {
-    for l in m.loops.clone() {
-        let r = m.loop_corners(l);
-        if r.len() < 3 {
-            continue;
-        }
-        let first = r.start;
-        let rest = first + 1..r.end;
-        m.corners[rest.clone()].reverse();
-        for set in m.uvs.iter_mut().flatten() {
-            set[rest.clone()].reverse();
-        }
-        if let Some(n) = &mut m.normals {
-            n[rest.clone()].reverse();
-            for v in &mut n[r] {
-                *v = -*v;
-            }
-        }
-    }
 }
 
 /// Trim state of a shape (`trim.horizontal`, `trim.vertical`).

@@ -53,6 +53,8 @@ pub fn arg_is_selector(name: &str, pos: usize) -> bool {
         "inside" | "overlaps" | "touches" | "contextCount" | "contextCompare"
         | "minimumDistance" => pos == 0,
         "convert" => pos < 4,
+        "geometry.area" | "geometry.angle" | "geometry.isOriented" => pos == 0,
+        "geometry.du" | "geometry.dv" | "geometry.hasTags" => pos == 1,
         "assetInfo" | "imageInfo" => pos == 1,
         _ => false,
     }
@@ -228,7 +230,6 @@ mod eval {
     use super::{ContextFn, GeometryFn, ShapeFn};
     use crate::derive::{Interp, RtError};
     use crate::expr::RExpr;
-    use crate::geom_shim as gm;
     use crate::shape::{mat_to_euler, Shape};
 
     fn num(v: &Value, at: &RExpr) -> Result<f64, RtError> {
@@ -357,28 +358,85 @@ mod eval {
             shape: &Shape,
             at: &RExpr,
         ) -> Result<Value, RtError> {
+            use cga_geometry::measure as m;
+            use cga_geometry::Topology;
             // Measures are taken in object coordinates: scaling is lazy, so the
             // stored mesh alone would give wrong areas.
             let mesh = shape.object_mesh();
             let fl = Value::Float;
+            let uv_set = |i: usize| -> Result<usize, RtError> {
+                match args.get(i) {
+                    Some(v) => {
+                        let k = num(v, at)?;
+                        if (0.0..10.0).contains(&k) {
+                            Ok(k as usize)
+                        } else {
+                            Err(RtError::new(format!("uv set {k} is not in [0, 9]"), at.span))
+                        }
+                    }
+                    None => Ok(0),
+                }
+            };
+            let tolerance = |i: usize| -> Result<f64, RtError> {
+                args.get(i).map_or(Ok(0.0), |v| num(v, at))
+            };
             Ok(match g {
-                GeometryFn::Area => fl(gm::area(&mesh)),
-                GeometryFn::Volume => fl(if gm::is_closed(&mesh) {
-                    gm::volume(&mesh)
+                GeometryFn::Area => {
+                    if let Some(Value::Str(sel)) = args.first() {
+                        if !matches!(&**sel, "all" | "surface") {
+                            self.warn_once(at.span, || {
+                                format!("geometry.area({sel}) is not supported yet; the whole area is used")
+                            });
+                        }
+                    }
+                    fl(m::mesh_area(&mesh))
+                }
+                GeometryFn::Volume => fl(if m::is_closed(&mesh) {
+                    m::volume(&mesh).abs()
                 } else {
                     0.0
                 }),
-                GeometryFn::NVertices => fl(gm::n_vertices(&mesh) as f64),
+                GeometryFn::NVertices | GeometryFn::NEdges => {
+                    let counts = m::counts(&mesh, &Topology::new(&mesh));
+                    fl(if g == GeometryFn::NVertices {
+                        counts.vertices
+                    } else {
+                        counts.edges
+                    } as f64)
+                }
                 GeometryFn::NFaces => fl(mesh.faces.len() as f64),
-                GeometryFn::NHoles => fl(gm::n_holes(&mesh) as f64),
-                GeometryFn::IsClosedSurface => Value::Bool(gm::is_closed(&mesh)),
-                GeometryFn::Height => fl(gm::bbox(&mesh).map_or(0.0, |(lo, hi)| hi.y - lo.y)),
-                other => {
-                    let _ = args;
-                    self.warn_once(at.span, || {
-                        format!("geometry function {other:?} is not supported yet; it returns 0")
-                    });
-                    fl(0.0)
+                GeometryFn::NHoles => fl(m::hole_count(&mesh) as f64),
+                GeometryFn::IsClosedSurface => Value::Bool(m::is_closed(&mesh)),
+                GeometryFn::IsPlanar => Value::Bool(m::is_planar(&mesh, tolerance(0)?)),
+                GeometryFn::IsRectangular => Value::Bool(m::is_rectangular(&mesh, tolerance(0)?)),
+                GeometryFn::IsConcave => Value::Bool(m::is_concave(&mesh)),
+                GeometryFn::BoundaryLength => {
+                    fl(m::boundary_length(&mesh, &Topology::new(&mesh)))
+                }
+                GeometryFn::Height => fl(m::height(&mesh)),
+                GeometryFn::HasUVs => Value::Bool(match args.first() {
+                    Some(_) => mesh.uvs[uv_set(0)?].is_some(),
+                    None => mesh.uvs.iter().any(|u| u.is_some()),
+                }),
+                GeometryFn::UMin | GeometryFn::UMax | GeometryFn::VMin | GeometryFn::VMax => {
+                    let b = m::uv_bounds(&mesh, uv_set(0)?);
+                    fl(b.map_or(0.0, |(lo, hi)| match g {
+                        GeometryFn::UMin => lo.x,
+                        GeometryFn::UMax => hi.x,
+                        GeometryFn::VMin => lo.y,
+                        _ => hi.y,
+                    }))
+                }
+                GeometryFn::Du | GeometryFn::Dv => {
+                    let set = uv_set(0)?;
+                    let unit = matches!(args.get(1), Some(Value::Str(s)) if &**s == "unitSpace");
+                    let range = m::uv_bounds(&mesh, set).map_or(cga_geometry::DVec2::ZERO, |(lo, hi)| hi - lo);
+                    let range = if unit {
+                        range * m::uv_unit_scale(&mesh, set).unwrap_or(cga_geometry::DVec2::ZERO)
+                    } else {
+                        range
+                    };
+                    fl(if g == GeometryFn::Du { range.x } else { range.y })
                 }
             })
         }

@@ -9,8 +9,7 @@ use super::transform::selector;
 use super::Op;
 use crate::derive::{Arg, Interp, RtError, ShapeState};
 use crate::expr::OpCall;
-use crate::geom_shim;
-use crate::shape::{local_bounds, reverse_faces, Shape};
+use crate::shape::{local_bounds, Shape};
 
 pub fn exec(
     cx: &mut Interp,
@@ -21,68 +20,181 @@ pub fn exec(
     let shape = &mut st.shape;
     match call.op {
         Op::Extrude => extrude(shape, args),
-        Op::PrimitiveCube => {
-            insert_fitted(shape, Arc::new(unit_cube()), InsertMode::Fit);
-            Ok(())
-        }
-        Op::PrimitiveQuad => {
-            insert_fitted(shape, Arc::new(unit_quad()), InsertMode::Fit);
-            Ok(())
-        }
-        Op::Insert => {
-            let path = args[0].text()?;
-            let up_z = match args.get(1) {
-                Some(a) => selector(a, &["yUp", "zUp"])? == "zUp",
-                None => false,
-            };
-            let mode = match args.get(2) {
-                Some(a) => match selector(
-                    a,
-                    &[
-                        "alignSizeAndPosition",
-                        "keepSizeAndPosition",
-                        "keepSizeAlignPosition",
-                    ],
-                )? {
-                    "keepSizeAndPosition" => InsertMode::Keep,
-                    "keepSizeAlignPosition" => InsertMode::KeepSizeAlign,
-                    _ => InsertMode::Fit,
-                },
-                None => InsertMode::Fit,
-            };
-            let asset = if path == "builtin:cube" {
-                Ok(Arc::new(unit_cube()))
-            } else {
-                cx.assets.mesh(call.span.file, path)
-            };
-            match asset {
-                Ok(mut mesh) => {
-                    if up_z {
-                        let rot = DAffine3::from_mat3(DMat3::from_rotation_x(-std::f64::consts::FRAC_PI_2));
-                        mesh = Arc::new(crate::shape::transformed(&mesh, &rot));
-                    }
-                    insert_fitted(shape, mesh, mode);
-                }
-                Err(message) => {
-                    // A missing asset must not lose the model: warn and go on.
-                    cx.warn_once(args[0].span, || {
-                        format!("{message}; the shape keeps its geometry")
-                    });
-                }
-            }
-            Ok(())
-        }
+        Op::PrimitiveQuad
+        | Op::PrimitiveDisk
+        | Op::PrimitiveCube
+        | Op::PrimitiveSphere
+        | Op::PrimitiveCylinder
+        | Op::PrimitiveCone => primitive(shape, call.op, args),
+        Op::Insert => insert(cx, shape, call, args),
         Op::ReverseNormals => {
             let mut mesh = (**shape.geometry.local()).clone();
-            reverse_faces(&mut mesh);
+            cga_geometry::transform::reverse_faces(&mut mesh);
             shape.set_local_mesh(mesh);
             Ok(())
         }
-        _ => {
-            cx.warn_once(call.span, || "this primitive is not supported yet".to_string());
-            Ok(())
+        _ => unreachable!("not a geometry creation operation"),
+    }
+}
+
+/// A segment count argument: at least `min`.
+fn count(arg: Option<&Arg>, default: usize, min: usize) -> Result<usize, RtError> {
+    match arg {
+        Some(a) => {
+            let n = a.num()?;
+            if !n.is_finite() || n < min as f64 {
+                return Err(RtError::new(
+                    format!("expected at least {min}, found {n}"),
+                    a.span,
+                ));
+            }
+            Ok((n as usize).min(1 << 14))
+        }
+        None => Ok(default),
+    }
+}
+
+fn primitive(shape: &mut Shape, op: Op, args: &[Arg]) -> Result<(), RtError> {
+    use cga_geometry::primitive as p;
+    let unit = DVec3::ONE;
+    // With dimensions: that size, centred in x and z, standing on y = 0;
+    // without: a unit shape fitted to the scope.
+    let (mesh, sized, flat) = match op {
+        Op::PrimitiveQuad => match args {
+            [w, l] => (p::quad(w.num()?, l.num()?), true, true),
+            _ => (p::quad(1.0, 1.0), false, true),
+        },
+        Op::PrimitiveDisk => {
+            let n = count(args.first(), 16, 3)?;
+            match args.get(1) {
+                Some(r) => {
+                    let d = 2.0 * r.num()?;
+                    (p::disk(n, d, d), true, true)
+                }
+                None => (p::disk(n, 1.0, 1.0), false, true),
+            }
+        }
+        Op::PrimitiveCube => match args {
+            [w, h, d] => (p::cube(DVec3::new(w.num()?, h.num()?, d.num()?)), true, false),
+            _ => (p::cube(unit), false, false),
+        },
+        Op::PrimitiveSphere => {
+            let sides = count(args.first(), 16, 3)?;
+            let divisions = count(args.get(1), 16, 2)?;
+            match args.get(2) {
+                Some(r) => (p::sphere(sides, divisions, DVec3::splat(2.0 * r.num()?)), true, false),
+                None => (p::sphere(sides, divisions, unit), false, false),
+            }
+        }
+        Op::PrimitiveCylinder | Op::PrimitiveCone => {
+            let sides = count(args.first(), 16, 3)?;
+            let size = match (args.get(1), args.get(2)) {
+                (Some(r), Some(h)) => {
+                    let d = 2.0 * r.num()?;
+                    Some(DVec3::new(d, h.num()?, d))
+                }
+                _ => None,
+            };
+            let make = if op == Op::PrimitiveCylinder {
+                p::cylinder
+            } else {
+                p::cone
+            };
+            (make(sides, size.unwrap_or(unit)), size.is_some(), false)
+        }
+        _ => unreachable!("not a primitive"),
+    };
+    let mut mesh = mesh;
+    if flat {
+        orient_flat(&mut mesh, shape.scope.size);
+    }
+    let mode = if sized {
+        InsertMode::KeepSizeAlign
+    } else {
+        InsertMode::Fit
+    };
+    insert_fitted(shape, Arc::new(mesh), mode);
+    Ok(())
+}
+
+/// A flat primitive (quad, disk; made in the xz-plane facing +y) goes into
+/// the plane of the scope's two non-zero sizes when exactly one size is zero.
+fn orient_flat(mesh: &mut Mesh, size: DVec3) {
+    let eps = 1e-12;
+    let zero = [size.x.abs() < eps, size.y.abs() < eps, size.z.abs() < eps];
+    if zero.iter().filter(|&&z| z).count() != 1 || zero[1] {
+        return;
+    }
+    let rot = if zero[0] {
+        // Facing +x: the yz-plane.
+        DMat3::from_rotation_z(-std::f64::consts::FRAC_PI_2)
+    } else {
+        // Facing +z: the xy-plane.
+        DMat3::from_rotation_x(std::f64::consts::FRAC_PI_2)
+    };
+    cga_geometry::transform::transform(mesh, &DAffine3::from_mat3(rot));
+}
+
+fn insert(cx: &mut Interp, shape: &mut Shape, call: &OpCall, args: &[Arg]) -> Result<(), RtError> {
+    let path = args[0].text()?;
+    let up_z = match args.get(1) {
+        Some(a) => selector(a, &["yUp", "zUp"])? == "zUp",
+        None => false,
+    };
+    let mode = match args.get(2) {
+        Some(a) => match selector(
+            a,
+            &[
+                "alignSizeAndPosition",
+                "keepSizeAndPosition",
+                "keepSizeAlignPosition",
+            ],
+        )? {
+            "keepSizeAndPosition" => InsertMode::Keep,
+            "keepSizeAlignPosition" => InsertMode::KeepSizeAlign,
+            _ => InsertMode::Fit,
+        },
+        None => InsertMode::Fit,
+    };
+    if let Some(a) = args.get(3) {
+        selector(a, &["numericalCleanup", "noCleanup"])?;
+    }
+    let asset = match builtin_asset(path) {
+        Some(m) => Ok(Arc::new(m)),
+        None => cx.assets.mesh(call.span.file, path),
+    };
+    match asset {
+        Ok(mut mesh) => {
+            if up_z {
+                let rot = DAffine3::from_mat3(DMat3::from_rotation_x(-std::f64::consts::FRAC_PI_2));
+                let mut m = (*mesh).clone();
+                cga_geometry::transform::transform(&mut m, &rot);
+                mesh = Arc::new(m);
+            }
+            insert_fitted(shape, mesh, mode);
+        }
+        Err(message) => {
+            // A missing asset must not lose the model: warn and go on.
+            cx.warn_once(args[0].span, || format!("{message}; the shape keeps its geometry"));
         }
     }
+    Ok(())
+}
+
+/// The built-in geometry assets (`builtin:cube`, ...), as unit shapes.
+fn builtin_asset(path: &str) -> Option<Mesh> {
+    use cga_geometry::primitive as p;
+    let name = path.strip_prefix("builtin:")?;
+    let name = name.strip_suffix(".obj").unwrap_or(name);
+    Some(match name {
+        "cube" => p::builtin_cube(),
+        "quad" => p::quad(1.0, 1.0),
+        "disk" => p::disk(16, 1.0, 1.0),
+        "sphere" => p::sphere(16, 16, DVec3::ONE),
+        "cylinder" => p::cylinder(16, DVec3::ONE),
+        "cone" => p::cone(16, DVec3::ONE),
+        _ => return None,
+    })
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -156,6 +268,7 @@ pub fn insert_fitted(shape: &mut Shape, asset: Arc<Mesh>, mode: InsertMode) {
 }
 
 fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {
+    use cga_geometry::Extrusion;
     let (kind, dist) = match args {
         [d] => ("face.normal", d.num()?),
         [k, d] => (
@@ -167,15 +280,22 @@ fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {
         ),
         _ => unreachable!("arity checked by the resolver"),
     };
+    // Extrude in object coordinates, where "world up" is +y.
     let mesh = shape.object_mesh();
     if mesh.faces.is_empty() {
         return Ok(());
     }
-    let dir = match kind {
-        "world.up" | "world.up.flatTop" => DVec3::Y,
-        _ => geom_shim::face_normal(&mesh, 0),
+    let how = match kind {
+        "world.up" => Extrusion::Direction(DVec3::Y),
+        "world.up.flatTop" => Extrusion::DirectionFlatTop(DVec3::Y),
+        "vertex.normal" => Extrusion::VertexNormal,
+        _ => Extrusion::FaceNormal,
     };
-    let out = extrude_mesh(&mesh, kind, dist);
+    let dir = match how {
+        Extrusion::Direction(d) | Extrusion::DirectionFlatTop(d) => d,
+        _ => cga_geometry::measure::face_normal(&mesh, 0),
+    };
+    let out = cga_geometry::extrude(&mesh, how, dist);
     // New scope: y along the extrusion, x the old x made orthogonal to it.
     let y = dir;
     let old_x = shape.scope.frame.axes.x_axis;
@@ -183,8 +303,7 @@ fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {
         .try_normalize()
         .unwrap_or_else(|| y.any_orthonormal_vector());
     let axes = DMat3::from_cols(x, y, x.cross(y));
-    let frame = shape.scope.frame;
-    let to_scope = frame.affine().inverse();
+    let to_scope = shape.scope.frame.affine().inverse();
     shape.set_local_mesh(crate::shape::transformed(&out, &to_scope));
     shape.fit_scope(axes);
     if dist < 0.0 {
@@ -197,102 +316,4 @@ fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {
         shape.scope.size.y = -sy;
     }
     Ok(())
-}
-
-/// Extrudes each face of `mesh` (object coordinates) into a closed prism:
-/// faces in the order bottom (the original face, reversed), top, then one
-/// side per boundary edge in edge order (outer boundary, then holes), each
-/// side starting with its bottom edge in the face's edge direction.
-fn extrude_mesh(mesh: &Mesh, kind: &str, dist: f64) -> Mesh {
-    let mut out = Mesh::new();
-    out.materials = mesh.materials.clone();
-    for f in 0..mesh.faces.len() {
-        let n = match kind {
-            "world.up" | "world.up.flatTop" => DVec3::Y,
-            _ => geom_shim::face_normal(mesh, f),
-        };
-        let offset = n * dist;
-        let material = mesh.faces[f].material;
-        let loops: Vec<Vec<DVec3>> = mesh
-            .face_loops(f)
-            .iter()
-            .map(|&l| mesh.loop_points(l).collect())
-            .collect();
-        let mut bottom_idx: Vec<Vec<u32>> = Vec::new();
-        let mut top_idx: Vec<Vec<u32>> = Vec::new();
-        for l in &loops {
-            let b0 = out.positions.len() as u32;
-            out.positions.extend(l.iter().copied());
-            let t0 = out.positions.len() as u32;
-            out.positions.extend(l.iter().map(|&p| p + offset));
-            bottom_idx.push((0..l.len() as u32).map(|i| b0 + i).collect());
-            top_idx.push((0..l.len() as u32).map(|i| t0 + i).collect());
-        }
-        let (bottom, top): (Vec<Vec<u32>>, Vec<Vec<u32>>) = if dist >= 0.0 {
-            (
-                bottom_idx.iter().map(|l| reversed_keep_first(l)).collect(),
-                top_idx.clone(),
-            )
-        } else {
-            (
-                bottom_idx.clone(),
-                top_idx.iter().map(|l| reversed_keep_first(l)).collect(),
-            )
-        };
-        let refs: Vec<&[u32]> = bottom.iter().map(|l| l.as_slice()).collect();
-        out.add_face(&refs, material);
-        let refs: Vec<&[u32]> = top.iter().map(|l| l.as_slice()).collect();
-        out.add_face(&refs, material);
-        for (b, t) in bottom_idx.iter().zip(&top_idx) {
-            let k = b.len();
-            for i in 0..k {
-                let j = (i + 1) % k;
-                let quad = if dist >= 0.0 {
-                    [b[i], b[j], t[j], t[i]]
-                } else {
-                    [b[j], b[i], t[i], t[j]]
-                };
-                out.add_face(&[&quad], material);
-            }
-        }
-    }
-    out
-}
-
-fn reversed_keep_first(l: &[u32]) -> Vec<u32> {
-    let mut v = l.to_vec();
-    v[1..].reverse();
-    v
-}
-
-fn unit_cube() -> Mesh {
-    let mut m = Mesh::new();
-    for z in [0.0, 1.0] {
-        for y in [0.0, 1.0] {
-            for x in [0.0, 1.0] {
-                m.positions.push(DVec3::new(x, y, z));
-            }
-        }
-    }
-    // Vertex i = x + 2y + 4z; faces counter-clockwise seen from outside.
-    for f in [
-        [0u32, 2, 3, 1], // back (z = 0)
-        [4, 5, 7, 6],    // front (z = 1)
-        [0, 1, 5, 4],    // bottom
-        [2, 6, 7, 3],    // top
-        [0, 4, 6, 2],    // left
-        [1, 3, 7, 5],    // right
-    ] {
-        m.add_face(&[&f], 0);
-    }
-    m
-}
-
-fn unit_quad() -> Mesh {
-    Mesh::polygon(&[
-        DVec3::new(0.0, 0.0, 1.0),
-        DVec3::new(1.0, 0.0, 1.0),
-        DVec3::new(1.0, 0.0, 0.0),
-        DVec3::new(0.0, 0.0, 0.0),
-    ])
 }

@@ -8,7 +8,7 @@ use super::transform::selector;
 use super::Op;
 use crate::derive::{Arg, Interp, RtError, ShapeState};
 use crate::expr::OpCall;
-use crate::geom_shim;
+use cga_geometry::measure as geom;
 use crate::shape::{euler_to_mat, Frame, Shape};
 
 pub fn exec(
@@ -74,7 +74,7 @@ pub fn exec(
             let idx = mesh.loop_indices(l);
             let a = mesh.positions[idx[edge] as usize];
             let b = mesh.positions[idx[(edge + 1) % idx.len()] as usize];
-            let n = geom_shim::face_normal(&mesh, face);
+            let n = geom::face_normal(&mesh, face);
             let x = (b - a).normalize_or(DVec3::X);
             let x = (x - n * x.dot(n)).normalize_or(x);
             let axes = match up {
@@ -155,7 +155,7 @@ fn pick_face_edge(
         cga_value::Value::Str(s) => match &**s {
             "largest" => vec![(0..nf)
                 .max_by(|&a, &b| {
-                    geom_shim::face_area(mesh, a).total_cmp(&geom_shim::face_area(mesh, b))
+                    geom::face_area(mesh, a).total_cmp(&geom::face_area(mesh, b))
                 })
                 .unwrap_or(0)],
             "world.lowest" => vec![(0..nf)

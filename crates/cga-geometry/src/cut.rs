@@ -47,13 +47,11 @@
 //! `(a, b)` and a parameter `t`, which stays exact through successive cuts of
 //! [`split_along_axis`].
 
-use std::collections::HashMap;
-
 use glam::{DVec2, DVec3};
 
 use crate::measure::face_normal;
 use crate::mesh::{Face, Loop, Mesh};
-use crate::topology::{mesh_tolerance, weld_points};
+use crate::topology::{fx_map, mesh_tolerance, weld_points, FxHashMap};
 use crate::triangulate::plane_basis;
 
 /// Cuts `mesh` with the plane `normal · p = offset` into the part below
@@ -203,7 +201,7 @@ struct Cutter<'m> {
     /// Vertex pool: welded positions, then crossing vertices.
     verts: Vec<DVec3>,
     /// Crossing vertices by (welded edge ends, plane).
-    crossings: HashMap<(u32, u32, u32), u32>,
+    crossings: FxHashMap<(u32, u32, u32), u32>,
     /// Routed faces per part.
     parts: Vec<Vec<Item>>,
     store_corners: Vec<WCorner>,
@@ -250,7 +248,7 @@ impl<'m> Cutter<'m> {
             tol,
             vid: weld.id,
             verts,
-            crossings: HashMap::new(),
+            crossings: fx_map(0),
             parts: vec![Vec::new(); nparts],
             store_corners: Vec::new(),
             store_loops: Vec::new(),
@@ -818,7 +816,7 @@ impl<'m> Cutter<'m> {
     /// direction as in the other (so cut parts can be closed with caps).
     fn input_is_closed(&self) -> bool {
         let mesh = self.mesh;
-        let mut balance: HashMap<(u32, u32), i32> = HashMap::with_capacity(mesh.corners.len());
+        let mut balance: FxHashMap<(u32, u32), i32> = fx_map(mesh.corners.len());
         let mut any = false;
         for face in 0..mesh.faces.len() {
             if mesh.outer_loop(face).len < 3 {
@@ -850,7 +848,7 @@ impl<'m> Cutter<'m> {
         let tol = self.tol;
         let on = |v: u32| self.dist(v, k).abs() <= tol;
         // Net count of directed on-plane edges per undirected edge.
-        let mut net: HashMap<(u32, u32), (i32, u32)> = HashMap::new();
+        let mut net: FxHashMap<(u32, u32), (i32, u32)> = fx_map(0);
         let mut order: Vec<(u32, u32)> = Vec::new();
         self.for_each_loop(part, &mut |face, it: &mut dyn Iterator<Item = u32>| {
             let vs: Vec<u32> = it.collect();

@@ -47,13 +47,11 @@
 //! `(a, b)` and a parameter `t`, which stays exact through successive cuts of
 //! [`split_along_axis`].
 
-use std::collections::HashMap;
-
 use glam::{DVec2, DVec3};
 
 use crate::measure::face_normal;
 use crate::mesh::{Face, Loop, Mesh};
-use crate::topology::{mesh_tolerance, weld_points};
+use crate::topology::{fx_map, mesh_tolerance, weld_points, FxHashMap};
 use crate::triangulate::plane_basis;
 
 /// Cuts `mesh` with the plane `normal · p = offset` into the part below
@@ -203,7 +201,7 @@ struct Cutter<'m> {
     /// Vertex pool: welded positions, then crossing vertices.
     verts: Vec<DVec3>,
     /// Crossing vertices by (welded edge ends, plane).
-    crossings: HashMap<(u32, u32, u32), u32>,
+    crossings: FxHashMap<(u32, u32, u32), u32>,
     /// Routed faces per part.
     parts: Vec<Vec<Item>>,
     store_corners: Vec<WCorner>,
@@ -250,7 +248,7 @@ impl<'m> Cutter<'m> {
             tol,
             vid: weld.id,
             verts,
-            crossings: HashMap::new(),
+            crossings: fx_map(0),
             parts: vec![Vec::new(); nparts],
             store_corners: Vec::new(),
             store_loops: Vec::new(),
@@ -818,7 +816,7 @@ impl<'m> Cutter<'m> {
     /// direction as in the other (so cut parts can be closed with caps).
     fn input_is_closed(&self) -> bool {
         let mesh = self.mesh;
-        let mut balance: HashMap<(u32, u32), i32> = HashMap::with_capacity(mesh.corners.len());
+        let mut balance: FxHashMap<(u32, u32), i32> = fx_map(mesh.corners.len());
         let mut any = false;
         for face in 0..mesh.faces.len() {
             if mesh.outer_loop(face).len < 3 {
@@ -850,7 +848,7 @@ impl<'m> Cutter<'m> {
         let tol = self.tol;
         let on = |v: u32| self.dist(v, k).abs() <= tol;
         // Net count of directed on-plane edges per undirected edge.
-        let mut net: HashMap<(u32, u32), (i32, u32)> = HashMap::new();
+        let mut net: FxHashMap<(u32, u32), (i32, u32)> = fx_map(0);
         let mut order: Vec<(u32, u32)> = Vec::new();
         self.for_each_loop(part, &mut |face, it: &mut dyn Iterator<Item = u32>| {
             let vs: Vec<u32> = it.collect();
@@ -1624,6 +1622,41 @@ pub(crate) mod tests {
                 .collect();
             cs.sort_by(f64::total_cmp);
             check_split(&m, axis, &cs);
+        }
+
+        #[test]
+        fn primitives_split_exactly(
+            kind in 0usize..3,
+            sides in 3usize..12,
+            axis in 0usize..3,
+            cuts in prop::collection::vec(0u8..=8, 1..4),
+        ) {
+            // Cuts at multiples of 1/8 of the size hit ring vertices, poles
+            // and caps exactly.
+            let size = DVec3::new(2.0, 3.0, 4.0);
+            let m = match kind {
+                0 => crate::primitive::sphere(sides, sides.max(2), size),
+                1 => crate::primitive::cylinder(sides, size),
+                _ => crate::primitive::cone(sides, size),
+            };
+            let mut cs: Vec<f64> = cuts.iter().map(|&c| size[axis] * c as f64 / 8.0).collect();
+            cs.sort_by(f64::total_cmp);
+            let total_a = mesh_area(&m);
+            let total_v = volume(&m);
+            let parts = split_along_axis(&m, axis, &cs);
+            let mut vsum = 0.0;
+            let mut asum = 0.0;
+            for p in &parts {
+                prop_assert!(p.is_empty() || closed(p));
+                vsum += volume(p);
+                // Primitives carry UVs; caps are the faces whose corners all
+                // have UV (0, 0) — primitives have such corners too, so
+                // count areas through normals of the faces lying in the cut
+                // planes instead: total area = original + 2 * cap areas.
+                asum += mesh_area(p);
+            }
+            prop_assert!((vsum - total_v).abs() <= 1e-9 * total_v);
+            prop_assert!(asum >= total_a * (1.0 - 1e-9));
         }
 
         #[test]

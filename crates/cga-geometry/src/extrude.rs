@@ -191,7 +191,8 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
     }
     // Directed side edges (base a, base b, top a, top b), to detect the
     // internal ones (the same edge moved identically by a neighbour).
-    let mut sides = std::collections::HashSet::new();
+    let mut sides: crate::topology::FxHashMap<(u32, u32, u32, u32), ()> =
+        crate::topology::fx_map(mesh.corners.len());
     for f in 0..mesh.faces.len() {
         if mesh.outer_loop(f).len < 3 {
             continue;
@@ -200,7 +201,7 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
             let r = mesh.loop_corners(l);
             for c in r.clone() {
                 let n = if c + 1 == r.end { r.start } else { c + 1 };
-                sides.insert((vid(c), vid(n), top_of_corner[c], top_of_corner[n]));
+                sides.insert((vid(c), vid(n), top_of_corner[c], top_of_corner[n]), ());
             }
         }
     }
@@ -303,7 +304,7 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
             for c in r.clone() {
                 let n = if c + 1 == r.end { r.start } else { c + 1 };
                 let (a, b, ta, tb) = (vid(c), vid(n), top_of_corner[c], top_of_corner[n]);
-                if a == b || sides.contains(&(b, a, tb, ta)) {
+                if a == b || sides.contains_key(&(b, a, tb, ta)) {
                     continue; // zero-length or internal edge
                 }
                 loop_buf.clear();

@@ -8,10 +8,55 @@
 //! shared with an earlier face is skipped on its second encounter.
 
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 
 use glam::DVec3;
 
 use crate::mesh::Mesh;
+
+/// A fast non-cryptographic hasher (the multiply-rotate scheme of rustc's
+/// `FxHasher`) for the integer keys of the geometry maps, which SipHash
+/// would make several times slower. Keys are not attacker-controlled.
+#[derive(Default, Clone, Copy)]
+pub(crate) struct FxHasher(u64);
+
+impl Hasher for FxHasher {
+    #[inline]
+    fn write(&mut self, bytes: &[u8]) {
+        for chunk in bytes.chunks(8) {
+            let mut b = [0u8; 8];
+            b[..chunk.len()].copy_from_slice(chunk);
+            self.write_u64(u64::from_le_bytes(b));
+        }
+    }
+    #[inline]
+    fn write_u32(&mut self, i: u32) {
+        self.write_u64(i as u64);
+    }
+    #[inline]
+    fn write_u64(&mut self, i: u64) {
+        self.0 = (self.0.rotate_left(5) ^ i).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+    #[inline]
+    fn write_i64(&mut self, i: i64) {
+        self.write_u64(i as u64);
+    }
+    #[inline]
+    fn write_usize(&mut self, i: usize) {
+        self.write_u64(i as u64);
+    }
+    #[inline]
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+/// A `HashMap` with [`FxHasher`].
+pub(crate) type FxHashMap<K, V> = HashMap<K, V, BuildHasherDefault<FxHasher>>;
+
+pub(crate) fn fx_map<K, V>(capacity: usize) -> FxHashMap<K, V> {
+    FxHashMap::with_capacity_and_hasher(capacity, Default::default())
+}
 
 /// The tolerance used by this crate to decide that two points coincide or
 /// that a point lies on a plane: 1e-9 relative to the magnitude of the
@@ -50,7 +95,7 @@ pub fn weld_points(points: &[DVec3], tol: f64) -> Weld {
     let mut id = Vec::with_capacity(points.len());
     let mut representative: Vec<u32> = Vec::new();
     if tol <= 0.0 || !tol.is_finite() {
-        let mut seen: HashMap<[u64; 3], u32> = HashMap::with_capacity(points.len());
+        let mut seen: FxHashMap<[u64; 3], u32> = fx_map(points.len());
         for (i, p) in points.iter().enumerate() {
             let key = [p.x + 0.0, p.y + 0.0, p.z + 0.0].map(f64::to_bits);
             let next = representative.len() as u32;
@@ -61,17 +106,28 @@ pub fn weld_points(points: &[DVec3], tol: f64) -> Weld {
             id.push(v);
         }
     } else {
-        // Cell of size `tol`: a point within `tol` of another lies in the same
-        // or an adjacent cell. `head` holds the first representative of each
-        // cell, `next` chains further representatives of the same cell.
-        let mut head: HashMap<[i64; 3], u32> = HashMap::with_capacity(points.len());
+        // Cells much larger than `tol`: a point within `tol` of another lies
+        // in the same cell, or in a neighbour across a cell boundary closer
+        // than `tol`, so most points need a single lookup. `head` holds the
+        // first representative of each cell, `next` chains further ones.
+        let cell = tol * 1024.0;
+        let mut head: FxHashMap<[i64; 3], u32> = fx_map(points.len());
         let mut next: Vec<u32> = Vec::new();
         for (i, &p) in points.iter().enumerate() {
-            let k = cell_key(p, tol);
+            let k = cell_key(p, cell);
+            let mut range = [(0i64, 0i64); 3];
+            for a in 0..3 {
+                let lo = k[a] as f64 * cell;
+                let c = p[a] + 0.0;
+                range[a] = (
+                    if c - lo <= tol { -1 } else { 0 },
+                    if lo + cell - c <= tol { 1 } else { 0 },
+                );
+            }
             let mut found = None;
-            'search: for dx in -1..=1 {
-                for dy in -1..=1 {
-                    for dz in -1..=1 {
+            'search: for dx in range[0].0..=range[0].1 {
+                for dy in range[1].0..=range[1].1 {
+                    for dz in range[2].0..=range[2].1 {
                         let kk = [k[0] + dx, k[1] + dy, k[2] + dz];
                         let mut r = head.get(&kk).copied().unwrap_or(u32::MAX);
                         while r != u32::MAX {
@@ -148,7 +204,7 @@ impl Topology {
 
     pub fn with_tolerance(mesh: &Mesh, tol: f64) -> Topology {
         let weld = weld_points(&mesh.positions, tol);
-        let mut index: HashMap<(u32, u32), u32> = HashMap::with_capacity(mesh.corners.len());
+        let mut index: FxHashMap<(u32, u32), u32> = fx_map(mesh.corners.len());
         let mut edges = Vec::new();
         let mut edge_of_corner = vec![u32::MAX; mesh.corners.len()];
         let mut counts: Vec<u32> = Vec::new();
@@ -260,5 +316,62 @@ impl Topology {
             let u = self.edge_uses(e);
             u.len() == 2 && u[0].reversed != u[1].reversed
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn welding_exact_and_with_tolerance() {
+        let p = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(-0.0, 0.0, 0.0),
+            DVec3::new(1.0, 2.0, 3.0),
+            DVec3::new(1.0 + 1e-12, 2.0, 3.0),
+            DVec3::new(0.0, 0.0, 0.0),
+        ];
+        let exact = weld_points(&p, 0.0);
+        assert_eq!(exact.id, vec![0, 0, 1, 2, 0]);
+        assert_eq!(exact.count, 3);
+        let tol = weld_points(&p, 1e-9);
+        assert_eq!(tol.id, vec![0, 0, 1, 1, 0]);
+        assert_eq!(tol.representative, vec![0, 2]);
+        // Points straddling a hash cell boundary still weld.
+        let t = 1e-3;
+        let cell = t * 1024.0;
+        let a = DVec3::splat(3.0 * cell - 0.25 * t);
+        let b = a + DVec3::splat(0.5 * t);
+        let c = a + DVec3::new(2.0 * t, 0.0, 0.0);
+        assert_eq!(weld_points(&[a, b, c], t).id, vec![0, 0, 1]);
+    }
+
+    #[test]
+    fn edges_in_comp_e_order_with_uses() {
+        // Two triangles sharing the edge 1-2.
+        let mut m = Mesh::new();
+        m.positions.extend([
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::new(0.0, 0.0, -1.0),
+            DVec3::new(1.0, 0.0, -1.0),
+        ]);
+        m.add_face(&[&[0, 1, 2]], 0);
+        m.add_face(&[&[1, 3, 2]], 0);
+        let t = Topology::new(&m);
+        let ends: Vec<[u32; 2]> = t.edges.iter().map(|e| e.v).collect();
+        assert_eq!(ends, vec![[0, 1], [1, 2], [2, 0], [1, 3], [3, 2]]);
+        assert_eq!(t.edge_uses(1).len(), 2);
+        assert_eq!(
+            t.edge_uses(1)[1],
+            EdgeUse {
+                face: 1,
+                corner: 5,
+                reversed: true
+            }
+        );
+        assert!(t.is_border(0) && !t.is_border(1));
+        assert_eq!(t.edge_of_corner, vec![0, 1, 2, 3, 4, 1]);
     }
 }

@@ -254,4 +254,40 @@ mod tests {
         triangulate_face(&e, 7, &mut out); // out of range: nothing, no panic
         assert!(out.is_empty());
     }
+
+    proptest::proptest! {
+        #[test]
+        fn star_polygons_with_holes_are_covered_exactly(
+            radii in proptest::collection::vec(0.5f64..2.0, 3..24),
+            hole in proptest::option::of(3usize..9),
+            tilt in -1.0f64..1.0,
+        ) {
+            // A star-shaped (generally concave) outline in a tilted plane,
+            // optionally with a clockwise regular hole well inside it.
+            let n = radii.len();
+            let frame = |x: f64, z: f64| v(x, tilt * x, z);
+            let mut m = Mesh::new();
+            for (i, r) in radii.iter().enumerate() {
+                let a = std::f64::consts::TAU * i as f64 / n as f64;
+                m.positions.push(frame(r * a.cos(), -r * a.sin()));
+            }
+            let outer: Vec<u32> = (0..n as u32).collect();
+            let mut hole_idx = Vec::new();
+            if let Some(h) = hole {
+                for i in 0..h {
+                    let a = -std::f64::consts::TAU * i as f64 / h as f64;
+                    hole_idx.push(m.positions.len() as u32);
+                    m.positions.push(frame(0.3 * a.cos(), -0.3 * a.sin()));
+                }
+            }
+            if hole_idx.is_empty() {
+                m.add_face(&[&outer], 0);
+            } else {
+                m.add_face(&[&outer, &hole_idx], 0);
+            }
+            let tris = check(&m);
+            let expected = n - 2 + if hole_idx.is_empty() { 0 } else { hole_idx.len() + 2 };
+            proptest::prop_assert_eq!(tris.len(), expected);
+        }
+    }
 }

@@ -24,7 +24,11 @@ use cga_export::{ExportOptions, Format, ModelWriter};
 use cga_syntax::{Diagnostic, SourceMap};
 
 #[derive(Parser)]
-#[command(name = "cga", version, about = "Generate 3D models from CGA shape grammar rules")]
+#[command(
+    name = "cga",
+    version,
+    about = "Generate 3D models from CGA shape grammar rules"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

@@ -62,33 +62,10 @@ impl Assets {
     }
 }
 
+/// Loads an OBJ asset; its warnings (missing MTL, unknown materials) are
+/// dropped here: the asset still loads with default materials.
 fn load_obj(path: &std::path::Path) -> Result<Mesh, String> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("cannot read asset {}: {e}", path.display()))?;
-    let mut m = Mesh::new();
-    for line in text.lines() {
-        let mut it = line.split_whitespace();
-        match it.next() {
-            Some("v") => {
-                let c: Vec<f64> = it.take(3).filter_map(|t| t.parse().ok()).collect();
-                if c.len() == 3 {
-                    m.positions.push(cga_geometry::DVec3::new(c[0], c[1], c[2]));
-                }
-            }
-            Some("f") => {
-                let n = m.positions.len() as i64;
-                let idx: Vec<u32> = it
-                    .filter_map(|t| t.split('/').next()?.parse::<i64>().ok())
-                    .map(|i| if i < 0 { n + i } else { i - 1 })
-                    .filter(|&i| i >= 0 && i < n)
-                    .map(|i| i as u32)
-                    .collect();
-                if idx.len() >= 3 {
-                    m.add_face(&[&idx], 0);
-                }
-            }
-            _ => {}
-        }
-    }
-    Ok(m)
+    cga_geometry::load_obj(path)
+        .map(|asset| asset.mesh)
+        .map_err(|e| format!("cannot load asset {}: {e}", path.display()))
 }

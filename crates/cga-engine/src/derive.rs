@@ -124,10 +124,7 @@ impl Arg {
         match &self.value {
             Value::Bool(b) => Ok(*b),
             other => Err(RtError::new(
-                format!(
-                    "expected a bool, found {}",
-                    crate::values::type_name(other)
-                ),
+                format!("expected a bool, found {}", crate::values::type_name(other)),
                 self.span,
             )),
         }
@@ -229,7 +226,12 @@ impl<'a> Interp<'a> {
     pub fn run(&mut self, rule: RuleId) -> Result<(), RtError> {
         let shape = self.initial.clone();
         self.out.shapes += 1;
-        self.run_rule(rule, Vec::new(), shape, self.program.rules[rule as usize].span)
+        self.run_rule(
+            rule,
+            Vec::new(),
+            shape,
+            self.program.rules[rule as usize].span,
+        )
     }
 
     pub fn warn_once(&mut self, span: Span, message: impl FnOnce() -> String) {
@@ -350,7 +352,8 @@ impl<'a> Interp<'a> {
                 branches,
                 otherwise,
             } => {
-                let pick = self.stochastic_pick(branches.iter().map(|(p, _)| p), frame, &st.shape)?;
+                let pick =
+                    self.stochastic_pick(branches.iter().map(|(p, _)| p), frame, &st.shape)?;
                 match pick {
                     Some(i) => self.exec_body(&branches[i].1, frame, st),
                     None => match otherwise {
@@ -381,7 +384,12 @@ impl<'a> Interp<'a> {
         Ok(None)
     }
 
-    fn exec_stmt(&mut self, s: &RStmt, frame: &[Value], st: &mut ShapeState) -> Result<(), RtError> {
+    fn exec_stmt(
+        &mut self,
+        s: &RStmt,
+        frame: &[Value],
+        st: &mut ShapeState,
+    ) -> Result<(), RtError> {
         match s {
             RStmt::Op(call) => {
                 let mut args = Vec::with_capacity(call.args.len());

@@ -27,7 +27,8 @@ impl Interp<'_> {
                 for a in args {
                     values.push(self.eval(a, frame, shape)?);
                 }
-                (b.f)(&values).map_err(|m| RtError::new(format!("{}: {}", b.name, m.message), e.span))
+                (b.f)(&values)
+                    .map_err(|m| RtError::new(format!("{}: {}", b.name, m.message), e.span))
             }
             RExprKind::Shape(f, args) => {
                 let mut values = Vec::with_capacity(args.len());
@@ -168,7 +169,10 @@ impl Interp<'_> {
             Value::Bool(b) => Ok(b),
             Value::Float(x) => Ok(x != 0.0),
             other => Err(RtError::new(
-                format!("a condition must be a bool, found {}", vs::type_name(&other)),
+                format!(
+                    "a condition must be a bool, found {}",
+                    vs::type_name(&other)
+                ),
                 e.span,
             )),
         }

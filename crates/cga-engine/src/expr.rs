@@ -148,5 +148,8 @@ pub enum RPart<T> {
     },
     Group(RBlock<T>),
     /// A part without head (`union { A | B }`, `scatter(...) { Leaf }`).
-    Unlabeled { body: T, span: Span },
+    Unlabeled {
+        body: T,
+        span: Span,
+    },
 }

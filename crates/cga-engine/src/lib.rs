@@ -16,7 +16,7 @@ pub mod shape_fns;
 pub mod split_layout;
 pub mod values;
 
-pub use generate::{generate_lot, GenerateOptions};
 pub use derive::{InitialInfo, Interp, Limits, LotOutput, RtError};
+pub use generate::{generate_lot, GenerateOptions};
 pub use program::Program;
 pub use resolve::{load, Loaded};

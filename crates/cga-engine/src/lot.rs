@@ -194,7 +194,10 @@ mod tests {
         assert!((s.scope.frame.axes.y_axis - DVec3::Y).length() < 1e-12);
         assert!((s.scope.frame.origin - DVec3::new(0.0, 0.0, -30.0)).length() < 1e-12);
         let m = s.object_mesh();
-        assert!(m.positions.iter().any(|p| (*p - DVec3::new(20.0, 0.0, -30.0)).length() < 1e-12));
+        assert!(m
+            .positions
+            .iter()
+            .any(|p| (*p - DVec3::new(20.0, 0.0, -30.0)).length() < 1e-12));
     }
 
     #[test]

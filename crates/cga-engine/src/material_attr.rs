@@ -164,7 +164,9 @@ impl MatField {
                 m.double_sided = match v {
                     Value::Bool(b) => *b,
                     Value::Str(s) => &**s == "true",
-                    other => num().map(|x| x != 0.0).unwrap_or(matches!(other, Value::Bool(true))),
+                    other => num()
+                        .map(|x| x != 0.0)
+                        .unwrap_or(matches!(other, Value::Bool(true))),
                 }
             }
             MatField::Name => m.name = text()?,
@@ -264,7 +266,11 @@ pub fn parse_hex_color(s: &str) -> Option<([f64; 3], Option<f64>)> {
     if !(h.len() == 6 || h.len() == 8) || !h.is_ascii() {
         return None;
     }
-    let byte = |i: usize| u8::from_str_radix(&h[i..i + 2], 16).ok().map(|b| b as f64 / 255.0);
+    let byte = |i: usize| {
+        u8::from_str_radix(&h[i..i + 2], 16)
+            .ok()
+            .map(|b| b as f64 / 255.0)
+    };
     let rgb = [byte(0)?, byte(2)?, byte(4)?];
     let o = if h.len() == 8 { Some(byte(6)?) } else { None };
     Some((rgb, o))
@@ -281,7 +287,10 @@ mod tests {
 
     #[test]
     fn parses_field_names() {
-        assert_eq!(MatField::parse("material.color.r"), Some(MatField::Color(0)));
+        assert_eq!(
+            MatField::parse("material.color.r"),
+            Some(MatField::Color(0))
+        );
         assert_eq!(MatField::parse("material.dirtmap"), Some(MatField::Map(2)));
         assert_eq!(
             MatField::parse("material.colormap.su"),

@@ -13,8 +13,8 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use cga_syntax::ast::{self, Body, BlockPart, Expr, ExprKind, Item, Stmt};
-use cga_syntax::{Diagnostic, FileId, SourceMap, Span};
+use cga_syntax::ast::{self, BlockPart, Body, Expr, ExprKind, Item, Stmt};
+use cga_syntax::{Diagnostic, SourceMap, Span};
 use cga_value::Value;
 
 use crate::expr::{OpCall, RBlock, RBody, RExpr, RExprKind, RPart, RStmt, RuleCall};
@@ -99,7 +99,6 @@ fn plain_error(message: String) -> Diagnostic {
 }
 
 struct ParsedFile {
-    file: FileId,
     path: PathBuf,
     module: Arc<ast::Module>,
 }
@@ -107,7 +106,6 @@ struct ParsedFile {
 /// Names visible in one rule set.
 #[derive(Default)]
 struct Tables {
-    file: usize,
     attrs: HashMap<String, AttrId>,
     funcs: HashMap<String, Vec<FuncId>>,
     rules: HashMap<String, Vec<RuleId>>,
@@ -177,7 +175,10 @@ struct Cx {
 
 impl Cx {
     fn local(&self, name: &str) -> Option<u16> {
-        self.locals.iter().rposition(|l| l == name).map(|i| i as u16)
+        self.locals
+            .iter()
+            .rposition(|l| l == name)
+            .map(|i| i as u16)
     }
 }
 
@@ -209,7 +210,6 @@ impl Resolver<'_> {
         self.diags.extend(diags);
         let idx = self.parsed_files.len();
         self.parsed_files.push(ParsedFile {
-            file,
             path: key.clone(),
             module: Arc::new(module),
         });
@@ -232,16 +232,15 @@ impl Resolver<'_> {
             prefix: prefix.clone(),
             path: path.clone(),
         });
-        self.tables.push(Tables {
-            file: file_idx,
-            ..Tables::default()
-        });
+        self.tables.push(Tables::default());
         let overrides: Option<Vec<ast::ImportOverride>> =
             importer.as_ref().and_then(|(_, d)| d.overrides.clone());
 
         for item in default_style_items(&module) {
             match item {
-                Item::Attr(decl) => self.declare_attr(rs, decl, importer.as_ref().map(|i| i.0), &overrides),
+                Item::Attr(decl) => {
+                    self.declare_attr(rs, decl, importer.as_ref().map(|i| i.0), &overrides)
+                }
                 Item::Function(decl) => {
                     let id = self.program.functions.len() as FuncId;
                     self.program.functions.push(FunctionDef {
@@ -278,7 +277,9 @@ impl Resolver<'_> {
                         decl: decl.clone(),
                     });
                 }
-                Item::Rule(decl) => self.declare_rule(rs, decl, importer.as_ref().map(|i| i.0), &overrides),
+                Item::Rule(decl) => {
+                    self.declare_rule(rs, decl, importer.as_ref().map(|i| i.0), &overrides)
+                }
                 _ => {}
             }
         }
@@ -376,7 +377,10 @@ impl Resolver<'_> {
     ) {
         let name = &decl.name.name;
         if self.tables[rs as usize].attrs.contains_key(name) {
-            self.error(format!("attribute `{name}` is defined twice"), decl.name.span);
+            self.error(
+                format!("attribute `{name}` is defined twice"),
+                decl.name.span,
+            );
             return;
         }
         let explicit = overrides.as_ref().and_then(|list| {
@@ -444,7 +448,10 @@ impl Resolver<'_> {
             symbol,
             span: decl.name.span,
         });
-        let same = self.tables[rs as usize].rules.entry(name.clone()).or_default();
+        let same = self.tables[rs as usize]
+            .rules
+            .entry(name.clone())
+            .or_default();
         let dup = same
             .iter()
             .any(|&r| self.program.rules[r as usize].arity == decl.params.len());
@@ -467,9 +474,11 @@ impl Resolver<'_> {
             .then(|| {
                 overrides.as_ref().and_then(|list| {
                     list.iter().find_map(|o| match o {
-                        ast::ImportOverride::Rule { name: n, params, body } if &n.name == name => {
-                            Some((params.clone(), body.clone()))
-                        }
+                        ast::ImportOverride::Rule {
+                            name: n,
+                            params,
+                            body,
+                        } if &n.name == name => Some((params.clone(), body.clone())),
                         _ => None,
                     })
                 })
@@ -1026,21 +1035,29 @@ impl Resolver<'_> {
         let args = call.args.as_deref().unwrap_or(&[]);
         if args.len() != 2 {
             self.error(
-                format!("`set` takes 2 arguments (attribute, value), found {}", args.len()),
+                format!(
+                    "`set` takes 2 arguments (attribute, value), found {}",
+                    args.len()
+                ),
                 span,
             );
             return RStmt::Nil;
         }
         let ExprKind::Name(target) = &args[0].kind else {
             self.diags.push(
-                Diagnostic::error("the first argument of `set` must be an attribute name", args[0].span)
-                    .with_label("expected an attribute name"),
+                Diagnostic::error(
+                    "the first argument of `set` must be an attribute name",
+                    args[0].span,
+                )
+                .with_label("expected an attribute name"),
             );
             return RStmt::Nil;
         };
         let t = if let Some(id) = self.find_attr(cx.rs, &target.name) {
             SetTarget::Attr(id)
-        } else if let Some(f) = shape_fns::lookup(&target.name, 0).filter(|&f| shape_fns::is_settable(f)) {
+        } else if let Some(f) =
+            shape_fns::lookup(&target.name, 0).filter(|&f| shape_fns::is_settable(f))
+        {
             SetTarget::Shape(f)
         } else {
             let d = Diagnostic::error(
@@ -1086,12 +1103,11 @@ impl Resolver<'_> {
                         n.span,
                     ),
                 },
-                ast::ImportOverride::Protect(n) | ast::ImportOverride::Rule { name: n, .. } => {
-                    self.error(
+                ast::ImportOverride::Protect(n) | ast::ImportOverride::Rule { name: n, .. } => self
+                    .error(
                         "only attribute values (`name = value`) can be set in a rule call",
                         n.span,
-                    )
-                }
+                    ),
             }
         }
         out

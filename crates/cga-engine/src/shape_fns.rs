@@ -340,7 +340,9 @@ mod eval {
                 ShapeFn::Context(c) => {
                     // Without other shapes to query, nothing is occluded.
                     self.warn_once(at.span, || {
-                        format!("context query {c:?} is not supported yet; it finds no other shapes")
+                        format!(
+                            "context query {c:?} is not supported yet; it finds no other shapes"
+                        )
                     });
                     match c {
                         ContextFn::ContextCount | ContextFn::ContextCompare => fl(0.0),
@@ -371,15 +373,17 @@ mod eval {
                         if (0.0..10.0).contains(&k) {
                             Ok(k as usize)
                         } else {
-                            Err(RtError::new(format!("uv set {k} is not in [0, 9]"), at.span))
+                            Err(RtError::new(
+                                format!("uv set {k} is not in [0, 9]"),
+                                at.span,
+                            ))
                         }
                     }
                     None => Ok(0),
                 }
             };
-            let tolerance = |i: usize| -> Result<f64, RtError> {
-                args.get(i).map_or(Ok(0.0), |v| num(v, at))
-            };
+            let tolerance =
+                |i: usize| -> Result<f64, RtError> { args.get(i).map_or(Ok(0.0), |v| num(v, at)) };
             Ok(match g {
                 GeometryFn::Area => {
                     if let Some(Value::Str(sel)) = args.first() {
@@ -410,9 +414,7 @@ mod eval {
                 GeometryFn::IsPlanar => Value::Bool(m::is_planar(&mesh, tolerance(0)?)),
                 GeometryFn::IsRectangular => Value::Bool(m::is_rectangular(&mesh, tolerance(0)?)),
                 GeometryFn::IsConcave => Value::Bool(m::is_concave(&mesh)),
-                GeometryFn::BoundaryLength => {
-                    fl(m::boundary_length(&mesh, &Topology::new(&mesh)))
-                }
+                GeometryFn::BoundaryLength => fl(m::boundary_length(&mesh, &Topology::new(&mesh))),
                 GeometryFn::Height => fl(m::height(&mesh)),
                 GeometryFn::HasUVs => Value::Bool(match args.first() {
                     Some(_) => mesh.uvs[uv_set(0)?].is_some(),
@@ -430,13 +432,18 @@ mod eval {
                 GeometryFn::Du | GeometryFn::Dv => {
                     let set = uv_set(0)?;
                     let unit = matches!(args.get(1), Some(Value::Str(s)) if &**s == "unitSpace");
-                    let range = m::uv_bounds(&mesh, set).map_or(cga_geometry::DVec2::ZERO, |(lo, hi)| hi - lo);
+                    let range = m::uv_bounds(&mesh, set)
+                        .map_or(cga_geometry::DVec2::ZERO, |(lo, hi)| hi - lo);
                     let range = if unit {
                         range * m::uv_unit_scale(&mesh, set).unwrap_or(cga_geometry::DVec2::ZERO)
                     } else {
                         range
                     };
-                    fl(if g == GeometryFn::Du { range.x } else { range.y })
+                    fl(if g == GeometryFn::Du {
+                        range.x
+                    } else {
+                        range.y
+                    })
                 }
             })
         }

@@ -42,10 +42,8 @@ use crate::faces::{face_is_finite, face_normal};
 use crate::materials::MaterialTable;
 use crate::textures::Textures;
 
-/// The triangulation every writer uses. It must become
-/// `cga_geometry::triangulate::triangulate_face` once the geometry crate has
-/// it (same signature); until then a local stand-in is used.
-use crate::faces::fallback_triangulate_face as triangulate_face;
+/// The triangulation every writer uses.
+use cga_geometry::triangulate_face;
 
 /// Output file format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -28,7 +28,9 @@ pub fn exec(
                     let s = hex.text()?;
                     let (rgb, o) = parse_hex_color(s).ok_or_else(|| {
                         RtError::new(
-                            format!("\"{s}\" is not a colour: expected \"#rrggbb\" or \"#rrggbboo\""),
+                            format!(
+                                "\"{s}\" is not a colour: expected \"#rrggbb\" or \"#rrggbboo\""
+                            ),
                             hex.span,
                         )
                     })?;
@@ -175,7 +177,8 @@ fn set(cx: &mut Interp, shape: &mut Shape, target: SetTarget, arg: &Arg) -> Resu
                     p[k] = x;
                     shape.pivot.origin = init.to_object(p);
                 } else {
-                    let mut o = crate::shape::mat_to_euler(&(init.axes.transpose() * shape.pivot.axes));
+                    let mut o =
+                        crate::shape::mat_to_euler(&(init.axes.transpose() * shape.pivot.axes));
                     o[k] = x;
                     shape.pivot.axes = init.axes * euler_to_mat(o);
                 }
@@ -184,12 +187,7 @@ fn set(cx: &mut Interp, shape: &mut Shape, target: SetTarget, arg: &Arg) -> Resu
                 let axes = shape.scope.frame.axes;
                 shape.scope.set_axes(&pivot_axes, axes);
             }
-            other => {
-                return Err(RtError::new(
-                    format!("{other:?} cannot be set"),
-                    arg.span,
-                ))
-            }
+            other => return Err(RtError::new(format!("{other:?} cannot be set"), arg.span)),
         },
     }
     Ok(())

@@ -75,14 +75,22 @@ fn primitive(shape: &mut Shape, op: Op, args: &[Arg]) -> Result<(), RtError> {
             }
         }
         Op::PrimitiveCube => match args {
-            [w, h, d] => (p::cube(DVec3::new(w.num()?, h.num()?, d.num()?)), true, false),
+            [w, h, d] => (
+                p::cube(DVec3::new(w.num()?, h.num()?, d.num()?)),
+                true,
+                false,
+            ),
             _ => (p::cube(unit), false, false),
         },
         Op::PrimitiveSphere => {
             let sides = count(args.first(), 16, 3)?;
             let divisions = count(args.get(1), 16, 2)?;
             match args.get(2) {
-                Some(r) => (p::sphere(sides, divisions, DVec3::splat(2.0 * r.num()?)), true, false),
+                Some(r) => (
+                    p::sphere(sides, divisions, DVec3::splat(2.0 * r.num()?)),
+                    true,
+                    false,
+                ),
                 None => (p::sphere(sides, divisions, unit), false, false),
             }
         }
@@ -175,7 +183,9 @@ fn insert(cx: &mut Interp, shape: &mut Shape, call: &OpCall, args: &[Arg]) -> Re
         }
         Err(message) => {
             // A missing asset must not lose the model: warn and go on.
-            cx.warn_once(args[0].span, || format!("{message}; the shape keeps its geometry"));
+            cx.warn_once(args[0].span, || {
+                format!("{message}; the shape keeps its geometry")
+            });
         }
     }
     Ok(())
@@ -274,7 +284,12 @@ fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {
         [k, d] => (
             selector(
                 k,
-                &["world.up", "world.up.flatTop", "face.normal", "vertex.normal"],
+                &[
+                    "world.up",
+                    "world.up.flatTop",
+                    "face.normal",
+                    "vertex.normal",
+                ],
             )?,
             d.num()?,
         ),

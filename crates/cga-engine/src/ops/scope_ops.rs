@@ -8,8 +8,8 @@ use super::transform::selector;
 use super::Op;
 use crate::derive::{Arg, Interp, RtError, ShapeState};
 use crate::expr::OpCall;
-use cga_geometry::measure as geom;
 use crate::shape::{euler_to_mat, Frame, Shape};
+use cga_geometry::measure as geom;
 
 pub fn exec(
     cx: &mut Interp,
@@ -24,8 +24,17 @@ pub fn exec(
                 Some(a) => selector(
                     a,
                     &[
-                        "x", "y", "z", "world.x", "world.y", "world.z", "world.xyz", "object.x",
-                        "object.y", "object.z", "object.xyz",
+                        "x",
+                        "y",
+                        "z",
+                        "world.x",
+                        "world.y",
+                        "world.z",
+                        "world.xyz",
+                        "object.x",
+                        "object.y",
+                        "object.z",
+                        "object.xyz",
                     ],
                 )?,
                 None => "world.xyz",
@@ -97,7 +106,11 @@ pub fn exec(
         Op::MirrorScope => {
             let flips = [args[0].boolean()?, args[1].boolean()?, args[2].boolean()?];
             let mut scope = shape.scope;
-            let mut cols = [scope.frame.axes.x_axis, scope.frame.axes.y_axis, scope.frame.axes.z_axis];
+            let mut cols = [
+                scope.frame.axes.x_axis,
+                scope.frame.axes.y_axis,
+                scope.frame.axes.z_axis,
+            ];
             for i in 0..3 {
                 if flips[i] {
                     scope.frame.origin += cols[i] * scope.size[i];
@@ -151,33 +164,32 @@ fn pick_face_edge(
     let modulo = |i: f64, n: usize| ((i.round() as i64).rem_euclid(n.max(1) as i64)) as usize;
     let edge_sel = edge_arg.map(|a| (a, matches!(a.value, cga_value::Value::Str(_))));
     // Candidate faces.
-    let faces: Vec<usize> = match &face_arg.value {
-        cga_value::Value::Str(s) => match &**s {
-            "largest" => vec![(0..nf)
-                .max_by(|&a, &b| {
-                    geom::face_area(mesh, a).total_cmp(&geom::face_area(mesh, b))
-                })
-                .unwrap_or(0)],
-            "world.lowest" => vec![(0..nf)
-                .min_by(|&a, &b| {
-                    let low = |f: usize| {
-                        mesh.loop_points(mesh.outer_loop(f))
-                            .map(|p| p.y)
-                            .fold(f64::INFINITY, f64::min)
-                    };
-                    low(a).total_cmp(&low(b))
-                })
-                .unwrap_or(0)],
-            "any" => (0..nf).collect(),
-            other => {
-                return Err(RtError::new(
-                    format!("unknown face selector `{other}`: expected largest, world.lowest or any"),
+    let faces: Vec<usize> =
+        match &face_arg.value {
+            cga_value::Value::Str(s) => match &**s {
+                "largest" => vec![(0..nf)
+                    .max_by(|&a, &b| geom::face_area(mesh, a).total_cmp(&geom::face_area(mesh, b)))
+                    .unwrap_or(0)],
+                "world.lowest" => vec![(0..nf)
+                    .min_by(|&a, &b| {
+                        let low = |f: usize| {
+                            mesh.loop_points(mesh.outer_loop(f))
+                                .map(|p| p.y)
+                                .fold(f64::INFINITY, f64::min)
+                        };
+                        low(a).total_cmp(&low(b))
+                    })
+                    .unwrap_or(0)],
+                "any" => (0..nf).collect(),
+                other => return Err(RtError::new(
+                    format!(
+                        "unknown face selector `{other}`: expected largest, world.lowest or any"
+                    ),
                     face_arg.span,
-                ))
-            }
-        },
-        _ => vec![modulo(face_arg.num()?, nf)],
-    };
+                )),
+            },
+            _ => vec![modulo(face_arg.num()?, nf)],
+        };
     match edge_sel {
         Some((a, true)) => {
             let which = selector(a, &["world.lowest", "longest"])?;
@@ -210,7 +222,11 @@ fn pick_face_edge(
 /// with axes along the scope's (permuted by `map`), pointing into the scope.
 fn set_pivot(shape: &mut Shape, map: &str, corner: usize) {
     let s = shape.scope;
-    let a = [s.frame.axes.x_axis, s.frame.axes.y_axis, s.frame.axes.z_axis];
+    let a = [
+        s.frame.axes.x_axis,
+        s.frame.axes.y_axis,
+        s.frame.axes.z_axis,
+    ];
     // Corner bits: 1 = far in x, 2 = far in z, 4 = far in y.
     let far = [corner & 1 != 0, corner & 4 != 0, corner & 2 != 0];
     let mut origin = s.frame.origin;

@@ -39,7 +39,10 @@ pub fn exec(
         }
         Op::R => {
             let (center, angles) = match args.len() {
-                4 => (selector(&args[0], &["scopeOrigin", "scopeCenter"])?, &args[1..]),
+                4 => (
+                    selector(&args[0], &["scopeOrigin", "scopeCenter"])?,
+                    &args[1..],
+                ),
                 _ => ("scopeOrigin", args),
             };
             // `r` adds to the scope's Euler angles (relative to the pivot).
@@ -139,7 +142,10 @@ pub fn selector<'a>(arg: &'a Arg, allowed: &[&str]) -> Result<&'a str, RtError> 
         Ok(s)
     } else {
         Err(RtError::new(
-            format!("unknown selector `{s}`: expected one of {}", allowed.join(", ")),
+            format!(
+                "unknown selector `{s}`: expected one of {}",
+                allowed.join(", ")
+            ),
             arg.span,
         ))
     }

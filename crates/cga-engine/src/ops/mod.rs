@@ -5,6 +5,7 @@
 mod attrs;
 mod create;
 mod scope_ops;
+pub mod split;
 mod transform;
 
 use cga_value::Value;
@@ -51,6 +52,7 @@ pub enum Op {
     MirrorScope,
     ResetGeometry,
     ReverseNormals,
+    Split,
 }
 
 /// How an operation's arguments are read by the resolver.
@@ -134,6 +136,12 @@ pub fn lookup(name: &str) -> Option<OpInfo> {
         "mirrorScope" => info(Op::MirrorScope, 3, 3),
         "resetGeometry" => info(Op::ResetGeometry, 0, 0),
         "reverseNormals" => info(Op::ReverseNormals, 0, 0),
+        "split" => Some(OpInfo {
+            op: Op::Split,
+            min_args: 1,
+            max_args: 3,
+            block: true,
+        }),
         _ => None,
     }
 }
@@ -231,8 +239,8 @@ pub fn exec(
     args: &[Arg],
     frame: &[Value],
 ) -> Result<(), RtError> {
-    let _ = frame;
     match call.op {
+        Op::Split => split::exec(cx, st, call, args, frame),
         Op::T | Op::Translate | Op::S | Op::R | Op::Rotate | Op::Center => {
             transform::exec(cx, st, call, args)
         }

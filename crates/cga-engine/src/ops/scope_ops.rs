@@ -164,32 +164,33 @@ fn pick_face_edge(
     let modulo = |i: f64, n: usize| ((i.round() as i64).rem_euclid(n.max(1) as i64)) as usize;
     let edge_sel = edge_arg.map(|a| (a, matches!(a.value, cga_value::Value::Str(_))));
     // Candidate faces.
-    let faces: Vec<usize> =
-        match &face_arg.value {
-            cga_value::Value::Str(s) => match &**s {
-                "largest" => vec![(0..nf)
-                    .max_by(|&a, &b| geom::face_area(mesh, a).total_cmp(&geom::face_area(mesh, b)))
-                    .unwrap_or(0)],
-                "world.lowest" => vec![(0..nf)
-                    .min_by(|&a, &b| {
-                        let low = |f: usize| {
-                            mesh.loop_points(mesh.outer_loop(f))
-                                .map(|p| p.y)
-                                .fold(f64::INFINITY, f64::min)
-                        };
-                        low(a).total_cmp(&low(b))
-                    })
-                    .unwrap_or(0)],
-                "any" => (0..nf).collect(),
-                other => return Err(RtError::new(
+    let faces: Vec<usize> = match &face_arg.value {
+        cga_value::Value::Str(s) => match &**s {
+            "largest" => vec![(0..nf)
+                .max_by(|&a, &b| geom::face_area(mesh, a).total_cmp(&geom::face_area(mesh, b)))
+                .unwrap_or(0)],
+            "world.lowest" => vec![(0..nf)
+                .min_by(|&a, &b| {
+                    let low = |f: usize| {
+                        mesh.loop_points(mesh.outer_loop(f))
+                            .map(|p| p.y)
+                            .fold(f64::INFINITY, f64::min)
+                    };
+                    low(a).total_cmp(&low(b))
+                })
+                .unwrap_or(0)],
+            "any" => (0..nf).collect(),
+            other => {
+                return Err(RtError::new(
                     format!(
                         "unknown face selector `{other}`: expected largest, world.lowest or any"
                     ),
                     face_arg.span,
-                )),
-            },
-            _ => vec![modulo(face_arg.num()?, nf)],
-        };
+                ))
+            }
+        },
+        _ => vec![modulo(face_arg.num()?, nf)],
+    };
     match edge_sel {
         Some((a, true)) => {
             let which = selector(a, &["world.lowest", "longest"])?;

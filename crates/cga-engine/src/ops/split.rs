@@ -1,0 +1,186 @@
+//! `split(axis) { size : operations | ... }` (and `{ ... }*`): cuts the
+//! current shape along a scope axis into parts whose sizes the pattern gives.
+//!
+//! The 1D arithmetic (absolute, relative, floating sizes, repeats) is in
+//! `split_layout`; this module evaluates the sizes, cuts the geometry once
+//! at all part boundaries (closed meshes get caps, see
+//! `cga_geometry::split_along_axis`), and runs each part's operations on a
+//! new shape whose scope is the part's (`noAdjust`) or the bounding box of
+//! its geometry in the parent's orientation (`adjust`, the default).
+
+use std::sync::Arc;
+
+use cga_geometry::{DAffine3, DVec3, Mesh};
+use cga_value::Value;
+
+use super::transform::selector;
+use crate::derive::{Arg, Interp, RtError, ShapeState, SizeKind};
+use crate::expr::{OpCall, RBlock, RBody, RPart};
+use crate::shape::{Geometry, Shape};
+use crate::split_layout::{Placed, Size, SplitPattern};
+
+/// Parts thinner than this (in scene units) are not created. Relative
+/// splits that recurse forever (the golden-ratio example "stops when the
+/// geometry gets too small for a further split") end here.
+pub const MIN_PART_SIZE: f64 = 1e-4;
+
+pub fn exec(
+    cx: &mut Interp,
+    st: &mut ShapeState,
+    call: &OpCall,
+    args: &[Arg],
+    frame: &[Value],
+) -> Result<(), RtError> {
+    let Some(block) = &call.block else {
+        return Err(RtError::new("`split` needs a `{ ... }` block", call.span));
+    };
+    let axis_name = selector(&args[0], &["x", "y", "z", "u", "v"])?;
+    if matches!(axis_name, "u" | "v") {
+        cx.warn_once(call.span, || {
+            "the uv split (`split(u|v, ...)`) is not supported yet; the shape is left unchanged"
+                .to_string()
+        });
+        return Ok(());
+    }
+    let axis = match axis_name {
+        "x" => 0,
+        "y" => 1,
+        _ => 2,
+    };
+    let adjust = match args.get(1) {
+        Some(a) => selector(a, &["adjust", "noAdjust"])? == "adjust",
+        None => true,
+    };
+
+    let mut pattern = SplitPattern::new(block.repeat);
+    let mut bodies: Vec<&RBody> = Vec::new();
+    add_parts(cx, frame, &st.shape, block, &mut pattern, &mut bodies)?;
+    let size = st.shape.scope.size[axis];
+    let placed: Vec<Placed> = crate::split_layout::layout(&pattern, size.abs())
+        .map_err(|e| RtError::new(format!("split: {e:?}"), call.span))?
+        .into_iter()
+        .filter(|p| p.end - p.start >= MIN_PART_SIZE)
+        .collect();
+    st.has_successor = true;
+    if placed.is_empty() {
+        return Ok(());
+    }
+
+    let sign = if size < 0.0 { -1.0 } else { 1.0 };
+    let pieces = cut_parts(st.shape.geometry.local(), axis, sign, &placed);
+    let total = placed.len() as f64;
+    for (part, piece) in placed.iter().zip(pieces) {
+        let mut child = cx.child(&st.shape, call.span)?;
+        place_part(
+            &mut child,
+            piece,
+            axis,
+            sign * part.start,
+            sign * (part.end - part.start),
+            adjust,
+        );
+        child.split_index = part.index as f64;
+        child.split_total = total;
+        let mut cst = ShapeState::new(child);
+        cx.exec_body(bodies[part.part], frame, &mut cst)?;
+        cx.finish(cst);
+    }
+    Ok(())
+}
+
+/// Evaluates the sizes of a split block into `pattern`, in source order;
+/// `bodies[k]` is the operations of part `k`.
+fn add_parts<'b>(
+    cx: &mut Interp,
+    frame: &[Value],
+    shape: &Shape,
+    block: &'b RBlock<RBody>,
+    pattern: &mut SplitPattern,
+    bodies: &mut Vec<&'b RBody>,
+) -> Result<(), RtError> {
+    for part in &block.parts {
+        match part {
+            RPart::Entry { head, body, .. } => {
+                let arg = cx.eval_arg(head, frame, shape)?;
+                let x = arg.num()?;
+                pattern.push(match arg.kind {
+                    SizeKind::Absolute => Size::Absolute(x),
+                    SizeKind::Relative => Size::Relative(x),
+                    SizeKind::Floating => Size::Floating(x),
+                });
+                bodies.push(body);
+            }
+            RPart::Group(g) => {
+                pattern.open();
+                add_parts(cx, frame, shape, g, pattern, bodies)?;
+                pattern
+                    .close(g.repeat)
+                    .map_err(|e| RtError::new(format!("split: {e:?}"), g.span))?;
+            }
+            RPart::Unlabeled { span, .. } => {
+                return Err(RtError::new(
+                    "a split part needs a size: `size : operations`",
+                    *span,
+                ))
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The geometry of each placed part, cut from `mesh` (scope-local) in one
+/// pass. Positions along the axis are `sign * distance` from the origin.
+fn cut_parts(mesh: &Arc<Mesh>, axis: usize, sign: f64, placed: &[Placed]) -> Vec<Mesh> {
+    let coord = |d: f64| sign * d;
+    let mut cuts: Vec<f64> = placed
+        .iter()
+        .flat_map(|p| [coord(p.start), coord(p.end)])
+        .collect();
+    cuts.sort_by(f64::total_cmp);
+    cuts.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * (1.0 + a.abs()));
+    if mesh.faces.is_empty() {
+        return placed.iter().map(|_| Mesh::new()).collect();
+    }
+    let slabs = cga_geometry::split_along_axis(mesh, axis, &cuts);
+    // Slab i lies between cuts[i-1] and cuts[i].
+    let slab_index = |c: f64| cuts.partition_point(|&x| x < c - 1e-12 * (1.0 + c.abs()));
+    placed
+        .iter()
+        .map(|p| {
+            let (a, b) = {
+                let (a, b) = (coord(p.start), coord(p.end));
+                (a.min(b), a.max(b))
+            };
+            let first = slab_index(a) + 1;
+            let last = slab_index(b);
+            let mut out = Mesh::new();
+            for (k, slab) in slabs.iter().enumerate().take(last + 1).skip(first) {
+                if k == first && first == last {
+                    return slab.clone();
+                }
+                cga_geometry::transform::merge(&mut out, slab);
+            }
+            out
+        })
+        .collect()
+}
+
+/// Gives `child` the part's geometry (in the parent's scope-local frame)
+/// and its scope: the slab `[start, start + size]` along the axis, or the
+/// geometry's bounding box (`adjust`).
+fn place_part(child: &mut Shape, piece: Mesh, axis: usize, start: f64, size: f64, adjust: bool) {
+    let mut offset = DVec3::ZERO;
+    offset[axis] = start;
+    let axes = child.scope.frame.axes;
+    let mut scope = child.scope;
+    scope.frame.origin += axes * offset;
+    scope.size[axis] = size;
+    let empty = piece.faces.is_empty();
+    let mut g = Geometry::new(Arc::new(piece));
+    g.transform(DAffine3::from_translation(-offset));
+    child.geometry = g;
+    child.scope = scope;
+    if adjust && !empty {
+        child.fit_scope(axes);
+    }
+}

@@ -19,6 +19,7 @@ pub struct Assets {
     /// The rule file of each source file id.
     files: Vec<PathBuf>,
     meshes: Mutex<HashMap<PathBuf, Result<Arc<Mesh>, String>>>,
+    texts: Mutex<HashMap<PathBuf, Option<Arc<str>>>>,
 }
 
 impl Assets {
@@ -26,6 +27,7 @@ impl Assets {
         Assets {
             files: sources.files().map(|(_, f)| f.path.clone()).collect(),
             meshes: Mutex::new(HashMap::new()),
+            texts: Mutex::new(HashMap::new()),
         }
     }
 
@@ -34,6 +36,7 @@ impl Assets {
         Assets {
             files: Vec::new(),
             meshes: Mutex::new(HashMap::new()),
+            texts: Mutex::new(HashMap::new()),
         }
     }
 
@@ -68,4 +71,101 @@ fn load_obj(path: &std::path::Path) -> Result<Mesh, String> {
     cga_geometry::load_obj(path)
         .map(|asset| asset.mesh)
         .map_err(|e| format!("cannot load asset {}: {e}", path.display()))
+}
+
+impl Assets {
+    /// The text of a file found like an asset (`readTextFile`, tables),
+    /// with line endings normalised; cached.
+    pub fn text(&self, from: FileId, path: &str) -> Option<Arc<str>> {
+        let file = self.resolve(from, path)?;
+        let mut cache = self.texts.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(t) = cache.get(&file) {
+            return t.clone();
+        }
+        let t = std::fs::read(&file).ok().map(|bytes| {
+            let s = String::from_utf8_lossy(&bytes).replace("\r\n", "\n");
+            Arc::from(s.as_str())
+        });
+        cache.insert(file, t.clone());
+        t
+    }
+
+    /// Files of the rule file's project matching a search query (`*` and `?`
+    /// wildcards, `$regex`, whitespace = and), as paths relative to the
+    /// project's `assets/` folder (or to the project folder), sorted.
+    pub fn search(&self, from: FileId, query: &str) -> Vec<String> {
+        let Some(rule_file) = self.files.get(from.0 as usize) else {
+            return Vec::new();
+        };
+        let root = project_root(rule_file);
+        let mut files = Vec::new();
+        list_files(&root, &mut files, 0);
+        let terms: Vec<fancy_regex::Regex> = query
+            .split_whitespace()
+            .filter_map(|t| {
+                let pattern = match t.strip_prefix('$') {
+                    Some(re) => re.to_string(),
+                    None => wildcard_regex(t.trim_matches('\'')),
+                };
+                fancy_regex::Regex::new(&format!("^(?:.*/)?{pattern}$")).ok()
+            })
+            .collect();
+        let assets = root.join("assets");
+        let mut found: Vec<String> = files
+            .into_iter()
+            .filter_map(|f| {
+                let rel = f
+                    .strip_prefix(&assets)
+                    .or_else(|_| f.strip_prefix(&root))
+                    .ok()?
+                    .to_string_lossy()
+                    .replace('\\', "/");
+                terms
+                    .iter()
+                    .all(|re| re.is_match(&rel).unwrap_or(false))
+                    .then_some(rel)
+            })
+            .collect();
+        found.sort();
+        found
+    }
+}
+
+/// The project folder of a rule file: the nearest ancestor holding an
+/// `assets/` or `rules/` folder, else the rule file's folder.
+fn project_root(rule_file: &std::path::Path) -> PathBuf {
+    let dir = rule_file.parent().unwrap_or(std::path::Path::new("."));
+    dir.ancestors()
+        .find(|d| d.join("assets").is_dir() || d.join("rules").is_dir())
+        .unwrap_or(dir)
+        .to_path_buf()
+}
+
+fn list_files(dir: &std::path::Path, out: &mut Vec<PathBuf>, depth: usize) {
+    if depth > 16 {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            list_files(&p, out, depth + 1);
+        } else {
+            out.push(p);
+        }
+    }
+}
+
+fn wildcard_regex(glob: &str) -> String {
+    let mut re = String::new();
+    for c in glob.chars() {
+        match c {
+            '*' => re.push_str("[^/]*"),
+            '?' => re.push_str("[^/]"),
+            c => re.push_str(&fancy_regex::escape(&c.to_string())),
+        }
+    }
+    re
 }

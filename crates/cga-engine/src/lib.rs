@@ -5,6 +5,7 @@ pub mod assets;
 pub mod derive;
 mod eval;
 pub mod expr;
+pub mod file_fns;
 pub mod generate;
 pub mod lot;
 pub mod material_attr;

@@ -34,6 +34,8 @@ pub enum ShapeFn {
     /// Occlusion and context queries (`inside`, `overlaps`, `touches`,
     /// `contextCount`, `contextCompare`, `minimumDistance`).
     Context(ContextFn),
+    /// File and coordinate functions (`file_fns.rs`).
+    File(crate::file_fns::FileFn),
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -185,6 +187,9 @@ pub fn lookup(name: &str, arity: usize) -> Option<ShapeFn> {
         ("contextCount", 1..=3) => ShapeFn::Context(ContextFn::ContextCount),
         ("contextCompare", 1..=4) => ShapeFn::Context(ContextFn::ContextCompare),
         ("minimumDistance", 1..=3) => ShapeFn::Context(ContextFn::MinimumDistance),
+        _ if crate::file_fns::lookup(name, arity).is_some() => {
+            ShapeFn::File(crate::file_fns::lookup(name, arity)?)
+        }
         _ => return None,
     };
     Some(f)
@@ -337,6 +342,7 @@ mod eval {
                     args[0].clone()
                 }
                 ShapeFn::Geometry(g) => self.geometry_fn(g, args, shape, at)?,
+                ShapeFn::File(f) => self.file_fn(f, args, shape, at)?,
                 ShapeFn::Context(c) => {
                     // Without other shapes to query, nothing is occluded.
                     self.warn_once(at.span, || {

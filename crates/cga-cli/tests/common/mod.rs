@@ -1,0 +1,197 @@
+//! Helpers shared by the `cga` command's tests: running the binary and
+//! summarising an OBJ model the way the conformance goldens do.
+
+#![allow(dead_code)]
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+pub fn cga() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_cga"))
+}
+
+pub fn run(args: &[&str]) -> Output {
+    cga().args(args).output().expect("the cga binary runs")
+}
+
+pub fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A fresh, empty directory for one test's files.
+pub fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("cga-cli-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Writes a rule file into `dir` and returns its path.
+pub fn rule_file(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+pub fn manifest_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The engine-neutral summary of an OBJ model: bounding box, face count,
+/// total area and area per appearance (diffuse colour with 3 decimals and
+/// the diffuse texture's file name, or `-`).
+#[derive(Debug, Default)]
+pub struct Summary {
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+    pub faces: usize,
+    pub area: f64,
+    pub by_appearance: BTreeMap<String, f64>,
+}
+
+pub fn summarize(obj: &Path) -> Summary {
+    let dir = obj.parent().unwrap();
+    let text = std::fs::read_to_string(obj).expect("the OBJ file exists");
+    let mut mats: BTreeMap<String, ([f64; 3], String)> = BTreeMap::new();
+    let mut verts: Vec<[f64; 3]> = Vec::new();
+    let mut s = Summary {
+        min: [f64::INFINITY; 3],
+        max: [f64::NEG_INFINITY; 3],
+        ..Summary::default()
+    };
+    let mut look = "1.000,1.000,1.000|-".to_string();
+    for line in text.lines() {
+        let p: Vec<&str> = line.split_whitespace().collect();
+        match p.first().copied() {
+            Some("mtllib") => {
+                let mtl = std::fs::read_to_string(dir.join(p[1..].join(" "))).unwrap_or_default();
+                let mut cur = String::new();
+                for l in mtl.lines() {
+                    let q: Vec<&str> = l.split_whitespace().collect();
+                    match q.first().copied() {
+                        Some("newmtl") => {
+                            cur = q[1..].join(" ");
+                            mats.insert(cur.clone(), ([1.0; 3], "-".into()));
+                        }
+                        Some("Kd") if q.len() >= 4 => {
+                            let e = mats.get_mut(&cur).unwrap();
+                            for k in 0..3 {
+                                e.0[k] = q[k + 1].parse().unwrap();
+                            }
+                        }
+                        Some("map_Kd") => {
+                            let name = Path::new(q.last().unwrap())
+                                .file_name()
+                                .unwrap()
+                                .to_string_lossy()
+                                .into_owned();
+                            mats.get_mut(&cur).unwrap().1 = name;
+                        }
+                        _ => {}
+                    }
+                }
+            }
+            Some("v") => {
+                let v = [0, 1, 2].map(|k| p[k + 1].parse::<f64>().unwrap());
+                for k in 0..3 {
+                    s.min[k] = s.min[k].min(v[k]);
+                    s.max[k] = s.max[k].max(v[k]);
+                }
+                verts.push(v);
+            }
+            Some("usemtl") => {
+                let (kd, map) = mats
+                    .get(&p[1..].join(" "))
+                    .cloned()
+                    .unwrap_or(([1.0; 3], "-".into()));
+                look = format!("{:.3},{:.3},{:.3}|{}", kd[0], kd[1], kd[2], map);
+            }
+            Some("f") => {
+                let pts: Vec<[f64; 3]> = p[1..]
+                    .iter()
+                    .map(|t| {
+                        let i: i64 = t.split('/').next().unwrap().parse().unwrap();
+                        let i = if i > 0 {
+                            i as usize - 1
+                        } else {
+                            (verts.len() as i64 + i) as usize
+                        };
+                        verts[i]
+                    })
+                    .collect();
+                let mut n = [0.0; 3];
+                for i in 0..pts.len() {
+                    let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
+                    n[0] += (a[1] - b[1]) * (a[2] + b[2]);
+                    n[1] += (a[2] - b[2]) * (a[0] + b[0]);
+                    n[2] += (a[0] - b[0]) * (a[1] + b[1]);
+                }
+                let a = 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+                s.faces += 1;
+                s.area += a;
+                *s.by_appearance.entry(look.clone()).or_default() += a;
+            }
+            _ => {}
+        }
+    }
+    s
+}
+
+/// Reads a golden `summary.json`.
+pub fn golden_summary(path: &Path) -> Summary {
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let arr = |k: &str| {
+        let a = v["bbox"][k].as_array().unwrap();
+        [0, 1, 2].map(|i| a[i].as_f64().unwrap())
+    };
+    Summary {
+        min: arr("min"),
+        max: arr("max"),
+        faces: v["totals"]["faces"].as_u64().unwrap() as usize,
+        area: v["totals"]["area"].as_f64().unwrap(),
+        by_appearance: v["area_by_appearance"]
+            .as_object()
+            .unwrap()
+            .iter()
+            .map(|(k, x)| (k.clone(), x.as_f64().unwrap()))
+            .collect(),
+    }
+}
+
+/// The differences between two summaries beyond a relative tolerance (the
+/// comparison of `summary.py --compare`).
+pub fn compare(golden: &Summary, ours: &Summary, tol: f64) -> Vec<String> {
+    let mut bad = Vec::new();
+    let close = |a: f64, b: f64| (a - b).abs() <= tol * 1f64.max(a.abs()).max(b.abs());
+    for k in 0..3 {
+        if !close(golden.min[k], ours.min[k]) || !close(golden.max[k], ours.max[k]) {
+            bad.push(format!(
+                "bbox {:?}..{:?} vs {:?}..{:?}",
+                golden.min, golden.max, ours.min, ours.max
+            ));
+            break;
+        }
+    }
+    if !close(golden.area, ours.area) {
+        bad.push(format!("total area {} vs {}", golden.area, ours.area));
+    }
+    let keys: std::collections::BTreeSet<&String> = golden
+        .by_appearance
+        .keys()
+        .chain(ours.by_appearance.keys())
+        .collect();
+    for k in keys {
+        let a = golden.by_appearance.get(k).copied().unwrap_or(0.0);
+        let b = ours.by_appearance.get(k).copied().unwrap_or(0.0);
+        if !close(a, b) {
+            bad.push(format!("area of {k}: {a} vs {b}"));
+        }
+    }
+    bad
+}

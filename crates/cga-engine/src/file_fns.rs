@@ -1,0 +1,301 @@
+//! Built-in functions that read files or convert coordinates: `convert`,
+//! `assetInfo`, `imageInfo`, `readTextFile`, `readStringTable`,
+//! `readFloatTable`, `fileExists`, `fileSearch`, `filesSearch`, `fileRandom`.
+//! Files are searched like assets, from the rule file that calls the
+//! function (see `assets.rs`).
+
+use std::sync::Arc;
+
+use cga_geometry::DVec3;
+use cga_value::{Array, Value};
+
+use crate::derive::{Interp, RtError};
+use crate::expr::RExpr;
+use crate::shape::{euler_to_mat, mat_to_euler, Frame, Shape};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FileFn {
+    Convert,
+    AssetInfo,
+    ImageInfo,
+    ReadTextFile,
+    ReadStringTable,
+    ReadFloatTable,
+    FileExists,
+    FileSearch,
+    FilesSearch,
+    FileRandom,
+}
+
+pub fn lookup(name: &str, arity: usize) -> Option<FileFn> {
+    Some(match (name, arity) {
+        ("convert", 4 | 7) => FileFn::Convert,
+        ("assetInfo", 2) => FileFn::AssetInfo,
+        ("imageInfo", 2) => FileFn::ImageInfo,
+        ("readTextFile", 1) => FileFn::ReadTextFile,
+        ("readStringTable", 1) => FileFn::ReadStringTable,
+        ("readFloatTable", 1) => FileFn::ReadFloatTable,
+        ("fileExists", 1) => FileFn::FileExists,
+        ("fileSearch", 1) => FileFn::FileSearch,
+        ("filesSearch", 1) => FileFn::FilesSearch,
+        ("fileRandom", 1) => FileFn::FileRandom,
+        _ => return None,
+    })
+}
+
+fn text<'a>(v: &'a Value, at: &RExpr) -> Result<&'a str, RtError> {
+    match v {
+        Value::Str(s) => Ok(s),
+        other => Err(RtError::new(
+            format!("expected a string, found {}", other.type_name()),
+            at.span,
+        )),
+    }
+}
+
+fn num(v: &Value, at: &RExpr) -> Result<f64, RtError> {
+    match v {
+        Value::Float(x) => Ok(*x),
+        other => Err(RtError::new(
+            format!("expected a float, found {}", other.type_name()),
+            at.span,
+        )),
+    }
+}
+
+impl Interp<'_> {
+    pub(crate) fn file_fn(
+        &mut self,
+        f: FileFn,
+        args: &[Value],
+        shape: &Shape,
+        at: &RExpr,
+    ) -> Result<Value, RtError> {
+        let file = at.span.file;
+        Ok(match f {
+            FileFn::Convert => self.convert(args, shape, at)?,
+            FileFn::AssetInfo => {
+                let path = text(&args[0], at)?;
+                let which = text(&args[1], at)?;
+                let mesh = match self.assets.mesh(file, path) {
+                    Ok(m) => m,
+                    Err(e) => {
+                        self.warn_once(at.span, || format!("{e}; assetInfo returns 0"));
+                        return Ok(Value::Float(0.0));
+                    }
+                };
+                let (lo, hi) = cga_geometry::measure::bounds(&mesh).unwrap_or_default();
+                let k = |c: &str| match c {
+                    "x" => 0,
+                    "y" => 1,
+                    _ => 2,
+                };
+                match which.split_at(1) {
+                    ("s", c) => Value::Float((hi - lo)[k(c)]),
+                    ("t", c) => Value::Float(lo[k(c)]),
+                    _ => {
+                        return Err(RtError::new(
+                            format!("unknown assetInfo attribute `{which}`: expected sx, sy, sz, tx, ty or tz"),
+                            at.span,
+                        ))
+                    }
+                }
+            }
+            FileFn::ImageInfo => {
+                let path = text(&args[0], at)?;
+                let which = text(&args[1], at)?;
+                let size = self
+                    .assets
+                    .resolve(file, path)
+                    .and_then(|p| imagesize::size(p).ok());
+                match size {
+                    Some(s) => Value::Float(if which == "sy" { s.height } else { s.width } as f64),
+                    None => {
+                        self.warn_once(at.span, || {
+                            format!(
+                                "image \"{path}\" not found or not readable; imageInfo returns 0"
+                            )
+                        });
+                        Value::Float(0.0)
+                    }
+                }
+            }
+            FileFn::ReadTextFile => {
+                let path = text(&args[0], at)?;
+                match self.assets.text(file, path) {
+                    Some(t) => Value::Str(t),
+                    None => {
+                        self.warn_once(at.span, || format!("text file \"{path}\" not found"));
+                        Value::str("")
+                    }
+                }
+            }
+            FileFn::ReadStringTable | FileFn::ReadFloatTable => {
+                let path = text(&args[0], at)?;
+                let table = match self.assets.text(file, path) {
+                    Some(t) => parse_table(&t),
+                    None => {
+                        self.warn_once(at.span, || format!("table file \"{path}\" not found"));
+                        Array::row(Vec::new())
+                    }
+                };
+                if f == FileFn::ReadStringTable {
+                    Value::StrArray(Arc::new(table))
+                } else {
+                    Value::FloatArray(Arc::new(Array {
+                        rows: table.rows,
+                        cols: table.cols,
+                        data: table
+                            .data
+                            .iter()
+                            .map(|s| s.trim().parse::<f64>().unwrap_or(f64::NAN))
+                            .collect(),
+                    }))
+                }
+            }
+            FileFn::FileExists => {
+                Value::Bool(self.assets.resolve(file, text(&args[0], at)?).is_some())
+            }
+            FileFn::FileSearch | FileFn::FilesSearch | FileFn::FileRandom => {
+                let found = self.assets.search(file, text(&args[0], at)?);
+                match f {
+                    FileFn::FileSearch => Value::Str(Arc::from(
+                        found.iter().map(|s| format!("{s};")).collect::<String>(),
+                    )),
+                    FileFn::FilesSearch => Value::StrArray(Arc::new(Array::row(
+                        found.iter().map(|s| Arc::from(s.as_str())).collect(),
+                    ))),
+                    _ => {
+                        if found.is_empty() {
+                            Value::str("")
+                        } else {
+                            let i = (shape.next_random() * found.len() as f64) as usize;
+                            Value::str(&found[i.min(found.len() - 1)])
+                        }
+                    }
+                }
+            }
+        })
+    }
+
+    /// `convert(coordinate, from, to, type, x, y, z)` and
+    /// `convert(from, to, type, [x, y, z])`.
+    fn convert(&mut self, args: &[Value], shape: &Shape, at: &RExpr) -> Result<Value, RtError> {
+        let (component, rest) = if args.len() == 7 {
+            (Some(text(&args[0], at)?), &args[1..])
+        } else {
+            (None, args)
+        };
+        let from = self.frame_of(text(&rest[0], at)?, shape, at)?;
+        let to = self.frame_of(text(&rest[1], at)?, shape, at)?;
+        let orient = match text(&rest[2], at)? {
+            "orient" => true,
+            "pos" => false,
+            other => {
+                return Err(RtError::new(
+                    format!("unknown conversion type `{other}`: expected pos or orient"),
+                    at.span,
+                ))
+            }
+        };
+        let v = if component.is_some() {
+            DVec3::new(num(&rest[3], at)?, num(&rest[4], at)?, num(&rest[5], at)?)
+        } else {
+            match &rest[3] {
+                Value::FloatArray(a) if a.data.len() == 3 => {
+                    DVec3::new(a.data[0], a.data[1], a.data[2])
+                }
+                _ => {
+                    return Err(RtError::new(
+                        "convert expects an array of 3 coordinates",
+                        at.span,
+                    ))
+                }
+            }
+        };
+        let out = if orient {
+            mat_to_euler(&(to.axes.transpose() * from.axes * euler_to_mat(v)))
+        } else {
+            to.to_local(from.to_object(v))
+        };
+        Ok(match component {
+            Some(c) => Value::Float(match c {
+                "x" => out.x,
+                "y" => out.y,
+                _ => out.z,
+            }),
+            None => Value::FloatArray(Arc::new(Array::row(vec![out.x, out.y, out.z]))),
+        })
+    }
+
+    fn frame_of(&self, system: &str, shape: &Shape, at: &RExpr) -> Result<Frame, RtError> {
+        Ok(match system {
+            "scope" => shape.scope.frame,
+            "pivot" => shape.pivot,
+            "object" => self.initial.pivot,
+            "world" => Frame::IDENTITY,
+            other => return Err(RtError::new(
+                format!(
+                    "unknown coordinate system `{other}`: expected scope, pivot, object or world"
+                ),
+                at.span,
+            )),
+        })
+    }
+}
+
+/// A CSV-like table; the delimiter (`,` `;` tab or space) is the one that
+/// splits the first line into the most fields.
+pub fn parse_table(text: &str) -> Array<Arc<str>> {
+    let lines: Vec<&str> = text
+        .lines()
+        .map(|l| l.trim_end_matches('\r'))
+        .filter(|l| !l.trim().is_empty())
+        .collect();
+    let first = lines.first().copied().unwrap_or("");
+    let delimiter = [',', ';', '\t', ' ']
+        .into_iter()
+        .max_by_key(|&d| first.matches(d).count())
+        .unwrap_or(',');
+    let rows: Vec<Vec<&str>> = lines
+        .iter()
+        .map(|l| {
+            if delimiter == ' ' {
+                l.split_whitespace().collect()
+            } else {
+                l.split(delimiter).map(|c| c.trim()).collect()
+            }
+        })
+        .collect();
+    let cols = rows.iter().map(|r| r.len()).max().unwrap_or(0);
+    let mut data = Vec::with_capacity(rows.len() * cols);
+    for r in &rows {
+        for c in 0..cols {
+            data.push(Arc::from(
+                r.get(c).map(|s| s.trim_matches('"')).unwrap_or(""),
+            ));
+        }
+    }
+    if rows.len() <= 1 {
+        return Array::row(data);
+    }
+    Array {
+        rows: rows.len(),
+        cols,
+        data,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn table_detects_delimiter_and_pads_rows() {
+        let t = parse_table("a;b;c\nd;e\n");
+        assert_eq!((t.rows, t.cols), (2, 3));
+        assert_eq!(&*t.data[5], "");
+        let t = parse_table("1,2\n3,4\n");
+        assert_eq!(&*t.data[3], "4");
+    }
+}

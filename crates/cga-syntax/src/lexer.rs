@@ -352,21 +352,55 @@ pub(crate) fn lex(file: FileId, text: &str) -> Lexed {
                     }
                 }
             }
-            b if is_ident_start(b) => {
+            b if is_ident_start(b) || (b >= 0x80 && char_at(text, i).is_alphabetic()) => {
                 flush_stray(&mut stray, i, &mut diagnostics);
-                i += 1;
+                // Letters outside ASCII are not allowed in names, but a word
+                // such as `höhe` is still lexed as one identifier so that it
+                // gets one diagnostic and the parser goes on undisturbed.
+                let mut non_ascii = false;
+                let mut word_char = |i: usize| -> usize {
+                    match bytes.get(i) {
+                        Some(&c) if is_ident_char(c) => 1,
+                        Some(&c) if c >= 0x80 => {
+                            let c = char_at(text, i);
+                            if c.is_alphanumeric() {
+                                non_ascii = true;
+                                c.len_utf8()
+                            } else {
+                                0
+                            }
+                        }
+                        _ => 0,
+                    }
+                };
                 loop {
-                    while i < bytes.len() && is_ident_char(bytes[i]) {
-                        i += 1;
+                    loop {
+                        let len = word_char(i);
+                        if len == 0 {
+                            break;
+                        }
+                        i += len;
                     }
                     // A dot followed by an identifier start continues the name.
                     if bytes.get(i) == Some(&b'.')
-                        && bytes.get(i + 1).is_some_and(|&c| is_ident_start(c))
+                        && bytes
+                            .get(i + 1)
+                            .is_some_and(|&c| is_ident_start(c) || c >= 0x80)
+                        && word_char(i + 1) > 0
                     {
-                        i += 2;
+                        i += 1;
                     } else {
                         break;
                     }
+                }
+                if non_ascii {
+                    diagnostics.push(
+                        Diagnostic::error(
+                            format!("identifier `{}` contains characters other than ASCII letters, digits and `_`", &text[start..i]),
+                            span(start, i),
+                        )
+                        .with_label("not a valid name"),
+                    );
                 }
                 keyword(&bytes[start..i]).unwrap_or(Tok::Ident)
             }
@@ -407,7 +441,7 @@ pub(crate) fn lex(file: FileId, text: &str) -> Lexed {
                         // Not ASCII punctuation: Unicode whitespace (a
                         // non-breaking space pasted from a web page) is
                         // whitespace, anything else is a stray character.
-                        let c = text[i..].chars().next().unwrap_or('\u{fffd}');
+                        let c = char_at(text, i);
                         if c.is_whitespace() || c == '\u{feff}' {
                             flush_stray(&mut stray, i, &mut diagnostics);
                         } else if stray.is_none() {
@@ -438,6 +472,13 @@ pub(crate) fn lex(file: FileId, text: &str) -> Lexed {
         tokens,
         diagnostics,
     }
+}
+
+/// The character starting at byte `i` (which must be a character boundary).
+fn char_at(text: &str, i: usize) -> char {
+    text.get(i..)
+        .and_then(|t| t.chars().next())
+        .unwrap_or('\u{fffd}')
 }
 
 fn skip_line(bytes: &[u8], mut i: usize) -> usize {

@@ -8,7 +8,7 @@ use crate::span::Span;
 
 /// Binary operators by token: (operator, element-wise, precedence).
 /// Higher precedence binds tighter.
-fn binary_op(kind: Tok) -> Option<(BinaryOp, bool, u8)> {
+pub(super) fn binary_op(kind: Tok) -> Option<(BinaryOp, bool, u8)> {
     use BinaryOp::*;
     Some(match kind {
         Tok::OrOr => (Or, false, 1),
@@ -41,12 +41,7 @@ fn binary_op(kind: Tok) -> Option<(BinaryOp, bool, u8)> {
     })
 }
 
-/// Whether the token is a unary or binary operator.
-pub(super) fn is_operator(kind: Tok) -> bool {
-    binary_op(kind).is_some() || unary_op(kind).is_some()
-}
-
-fn unary_op(kind: Tok) -> Option<(UnaryOp, bool)> {
+pub(super) fn unary_op(kind: Tok) -> Option<(UnaryOp, bool)> {
     Some(match kind {
         Tok::Minus => (UnaryOp::Neg, false),
         Tok::Plus => (UnaryOp::Plus, false),

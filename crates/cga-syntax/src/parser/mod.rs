@@ -49,11 +49,19 @@ pub(crate) struct Parser<'t> {
     /// Set when nesting exceeded [`MAX_DEPTH`]: the parser then sees end of
     /// file (and reports nothing) until the top level skips to the next item.
     bail: bool,
+    /// Start offsets of the lexer's errors, ascending. An unclosed bracket
+    /// after an unterminated string is the string's fault and not reported.
+    lex_errors: Vec<u32>,
 }
 
 pub(crate) fn parse(file: FileId, text: &str) -> (Module, Vec<Diagnostic>) {
     let lexed = lexer::lex(file, text);
     let mut parser = Parser::new(file, text, lexed.tokens);
+    parser.lex_errors = lexed
+        .diagnostics
+        .iter()
+        .filter_map(|d| d.span.map(|s| s.start))
+        .collect();
     let module = parser.parse_module();
     let mut diags = lexed.diagnostics;
     diags.extend(parser.diags);
@@ -74,6 +82,7 @@ impl<'t> Parser<'t> {
             diags: Vec::new(),
             depth: 0,
             bail: false,
+            lex_errors: Vec::new(),
         }
     }
 
@@ -210,6 +219,16 @@ impl<'t> Parser<'t> {
         self.error(message, span, label);
     }
 
+    /// Whether the lexer reported an error between token `from` and the
+    /// current token: errors about brackets in that stretch are then
+    /// consequences (an unterminated string swallowed the closing bracket).
+    fn lex_error_since(&self, from: usize) -> bool {
+        let start = self.tok_at(from).start;
+        let end = self.tok_at(self.pos).start;
+        let i = self.lex_errors.partition_point(|&e| e < start);
+        self.lex_errors.get(i).is_some_and(|&e| e <= end)
+    }
+
     /// Appends a note to the last diagnostic.
     fn note(&mut self, note: String) {
         if let Some(d) = self.diags.last_mut() {
@@ -327,6 +346,11 @@ impl<'t> Parser<'t> {
                 items.push(item);
             }
             self.bail = false;
+            if self.diags.len() == errors && Self::is_name(self.cur()) && self.pos != start {
+                // `attr h = 10  Lot extrude(10)`: let the next round read
+                // `Lot` as a definition and report its missing `-->`.
+                continue;
+            }
             if self.cur() != Tok::Eof && !self.is_item_start(true) {
                 if self.diags.len() == errors {
                     self.expected("an operator or the next declaration", "unexpected here");
@@ -482,7 +506,7 @@ impl<'t> Parser<'t> {
     /// closing bracket: report (unless the element already did) and continue
     /// after the matching closing bracket if there is one.
     fn close_list_after_error(&mut self, open: usize, mark: usize, what: &str, label: &str) {
-        if self.diags.len() == mark {
+        if self.diags.len() == mark && !self.lex_error_since(open) {
             self.expected(what, &format!("expected {label}"));
             if self.partner_of(open).is_none() {
                 let kind = self.kind_at(open).describe();

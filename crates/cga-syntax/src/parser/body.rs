@@ -172,7 +172,23 @@ impl Parser<'_> {
             prev_errored = self.diags.len() > stmt_mark;
         }
         if stmts.is_empty() && self.diags.len() == mark {
-            self.expected(&format!("operations after {after}"), "expected operations");
+            if self.pos > 0 && (self.cur() == Tok::Eof || self.is_item_start(true)) {
+                // `R -->` at the end of its line: point at the arrow, not
+                // at the next declaration.
+                let next = if self.cur() == Tok::Eof {
+                    "end of file"
+                } else {
+                    "the next declaration"
+                };
+                let span = self.span_at(self.pos - 1);
+                self.error(
+                    format!("expected operations after {after}, found {next}"),
+                    span,
+                    "empty body",
+                );
+            } else {
+                self.expected(&format!("operations after {after}"), "expected operations");
+            }
             self.note(
                 "write `NIL` to delete the shape or `Name.` to keep it as a leaf".to_string(),
             );

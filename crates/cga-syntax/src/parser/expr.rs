@@ -58,6 +58,15 @@ impl Parser<'_> {
     /// expression. Used wherever a value stands on its own (definitions,
     /// arguments, array elements, branch values, parentheses).
     pub(super) fn parse_expr(&mut self) -> Expr {
+        if !self.enter() {
+            return self.missing_expr();
+        }
+        let expr = self.parse_expr_inner();
+        self.leave();
+        expr
+    }
+
+    fn parse_expr_inner(&mut self) -> Expr {
         match self.cur() {
             Tok::Case => {
                 let chain = self.parse_case_chain(&mut |p: &mut Parser| p.parse_expr());
@@ -84,11 +93,16 @@ impl Parser<'_> {
     /// to the whole expression (`'1.85*8` is relative 14.8).
     pub(super) fn parse_arg(&mut self) -> Expr {
         let mut prefixes = Vec::new();
-        while matches!(self.cur(), Tok::Quote | Tok::Tilde) {
+        // Each prefix nests the tree one level deeper: count it against the
+        // depth limit (dropping a tree recurses too).
+        while matches!(self.cur(), Tok::Quote | Tok::Tilde) && self.enter() {
             prefixes.push((self.cur(), self.tok_at(self.pos).start));
             self.bump();
         }
         let mut expr = self.parse_expr();
+        for _ in &prefixes {
+            self.leave();
+        }
         for (kind, start) in prefixes.into_iter().rev() {
             let span = Span::new(self.file, start, expr.span.end);
             let inner = Box::new(expr);
@@ -176,6 +190,9 @@ impl Parser<'_> {
     /// Operator expressions by precedence climbing (left associative).
     fn parse_binary(&mut self, min_prec: u8) -> Expr {
         let mut lhs = self.parse_unary();
+        // Every operator of a chain `a + b + c ...` nests the left operand
+        // one level deeper: count the levels against the depth limit.
+        let mut levels = 0;
         while let Some((op, elementwise, prec)) = binary_op(self.cur()) {
             if prec < min_prec {
                 break;
@@ -184,6 +201,10 @@ impl Parser<'_> {
             if op == BinaryOp::Rem && !elementwise && self.nth(1) == Tok::Colon {
                 break;
             }
+            if !self.enter() {
+                break;
+            }
+            levels += 1;
             self.bump();
             let rhs = self.parse_binary(prec + 1);
             let span = lhs.span.to(rhs.span);
@@ -196,6 +217,9 @@ impl Parser<'_> {
                 },
                 span,
             };
+        }
+        for _ in 0..levels {
+            self.leave();
         }
         lhs
     }
@@ -234,7 +258,9 @@ impl Parser<'_> {
 
     fn parse_postfix(&mut self) -> Expr {
         let mut expr = self.parse_primary();
-        while self.cur() == Tok::LBracket {
+        let mut levels = 0;
+        while self.cur() == Tok::LBracket && self.enter() {
+            levels += 1;
             let open = self.pos;
             self.bump();
             let mut indices = Vec::new();
@@ -264,6 +290,9 @@ impl Parser<'_> {
                 },
                 span,
             };
+        }
+        for _ in 0..levels {
+            self.leave();
         }
         expr
     }

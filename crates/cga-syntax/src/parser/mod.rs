@@ -780,12 +780,12 @@ impl<'t> Parser<'t> {
             );
             self.parse_params();
         }
+        let mark = self.diags.len();
         let locals = self.parse_with();
-        if !self.expect(
-            Tok::Eq,
-            &format!("`=` after `attr {}`", name.name),
-            "expected `=`",
-        ) {
+        if !self.eat(Tok::Eq) {
+            if self.diags.len() == mark {
+                self.expected(&format!("`=` after `attr {}`", name.name), "expected `=`");
+            }
             return None;
         }
         let value = self.parse_expr();
@@ -823,6 +823,7 @@ impl<'t> Parser<'t> {
         } else {
             Vec::new()
         };
+        let mark = self.diags.len();
         let locals = self.parse_with();
         match self.cur() {
             Tok::Arrow if !is_const => {
@@ -851,6 +852,7 @@ impl<'t> Parser<'t> {
                     span: self.span_from(start),
                 }))
             }
+            _ if self.diags.len() > mark => None,
             _ => {
                 let (what, label) = if is_const {
                     (format!("`=` after `const {}`", name.name), "expected `=`")

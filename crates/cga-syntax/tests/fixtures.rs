@@ -1,7 +1,11 @@
 //! The rule examples of the seed pages (split, subdivision split, splitArea,
 //! comp) and of the CGA reference pages, as small complete files under
-//! `tests/fixtures/` (`seed_*` and `ref_*`). Each must parse without a
-//! diagnostic, and the tricky ones must give exactly the expected tree.
+//! `tests/fixtures/`: `seed_*` (seed pages), `ref_*` (reference examples
+//! gathered by topic, fragments wrapped into rules) and `ref_page_*` (every
+//! complete example of one reference page, in page order; examples that the
+//! page prints on one line are broken before each declaration). Each must
+//! parse without a diagnostic, and the tricky ones must give exactly the
+//! expected tree.
 
 use std::path::{Path, PathBuf};
 

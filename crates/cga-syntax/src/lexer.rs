@@ -695,7 +695,7 @@ mod tests {
         let lexed = lex(FileId(0), "höhe.wert + x");
         let kinds: Vec<Tok> = lexed.tokens.iter().map(|t| t.kind).collect();
         assert_eq!(kinds, [Tok::Ident, Tok::Plus, Tok::Ident, Tok::Eof]);
-        assert_eq!(lexed.tokens[0].end, 11);
+        assert_eq!(lexed.tokens[0].end, 10);
         assert_eq!(lexed.diagnostics.len(), 1);
         assert_eq!(
             lexed.diagnostics[0].message,

@@ -284,6 +284,16 @@ fn where_rule_bodies_end() {
             "(rule N O)",
         ]
     );
+    // `start` as a rule name and as a call.
+    assert_eq!(
+        items("A --> X\nstart --> B\nstart(x) = x\nC --> start(1) start"),
+        [
+            "(rule A X)",
+            "(rule start B)",
+            "(fn start(x) x)",
+            "(rule C (start 1) start)"
+        ]
+    );
     // Inside braces `side = X` is a comp entry, not a function.
     assert_eq!(
         one("R --> comp(f) { top : A |\n side = B }"),

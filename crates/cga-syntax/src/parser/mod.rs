@@ -297,7 +297,11 @@ impl<'t> Parser<'t> {
             | Tok::Style
             | Tok::Version
             | Tok::Extension => true,
-            Tok::Start => Self::is_name(self.kind_at(i + 1)) && self.is_head_tail(i + 2, false),
+            // `start Name -->`, or a rule or function named `start`.
+            Tok::Start => {
+                (Self::is_name(self.kind_at(i + 1)) && self.is_head_tail(i + 2, false))
+                    || self.is_head_tail(i + 1, soft)
+            }
             Tok::Ident => self.is_head_tail(i + 1, soft),
             _ => false,
         }

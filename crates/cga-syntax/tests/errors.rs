@@ -353,3 +353,35 @@ fn too_deep_nesting() {
     ));
     assert_eq!(out.matches("error:").count(), 1);
 }
+
+#[test]
+fn unclosed_brackets_before_a_function_definition() {
+    let src = "Lot --> [ A\nf = 3\nB --> split(x) { 1 : A\ng = 2\n";
+    assert_eq!(
+        rendered(src),
+        r#"error: expected `]` to close the push, found identifier `f`
+ --> broken.cga:2:1
+  |
+2 | f = 3
+  | ^ expected `]`
+  = the `[` was opened at line 1, column 9
+error: expected `}` to close the block, found identifier `g`
+ --> broken.cga:4:1
+  |
+4 | g = 2
+  | ^ expected `}`
+  = the `{` was opened at line 3, column 16
+"#
+    );
+    let (module, _) = parse(FileId(0), src);
+    let items: Vec<String> = module.items.iter().map(sexpr::item).collect();
+    assert_eq!(
+        items,
+        [
+            "(rule Lot [A])",
+            "(fn f 3)",
+            "(rule B (split x {1 : A}))",
+            "(fn g 2)"
+        ]
+    );
+}

@@ -20,6 +20,9 @@ impl Term {
     pub const IMPORT: Term = Term(4);
     /// A branch of a chain: `case`, `else`, `30%`.
     pub const CHAIN: Term = Term(8);
+    /// The enclosing bracket is never closed: a function definition
+    /// `name = ...` then ends the body after all.
+    pub const UNCLOSED: Term = Term(16);
 
     fn has(self, other: Term) -> bool {
         self.0 & other.0 != 0
@@ -30,9 +33,19 @@ impl Term {
     }
 
     /// Inside brackets `side = X` is a comp entry, not a function
-    /// definition, so only unambiguous item starts end the body.
+    /// definition, so only unambiguous item starts end the body (unless
+    /// the bracket is never closed).
     fn soft_item_starts(self) -> bool {
-        !self.has(Term(Term::BLOCK.0 | Term::PUSH.0 | Term::IMPORT.0))
+        self.has(Term::UNCLOSED) || !self.has(Term(Term::BLOCK.0 | Term::PUSH.0 | Term::IMPORT.0))
+    }
+
+    /// `term`, marked unclosed when the bracket at `open` has no partner.
+    pub(super) fn inside(self, p: &Parser, open: usize) -> Term {
+        if p.partner_of(open).is_some() {
+            self
+        } else {
+            self.with(Term::UNCLOSED)
+        }
     }
 }
 
@@ -201,7 +214,7 @@ impl Parser<'_> {
         let open = self.pos;
         let start = self.tok_at(open).start;
         self.bump();
-        let body = self.parse_body(Term::PUSH, "`[`");
+        let body = self.parse_body(Term::PUSH.inside(self, open), "`[`");
         if !self.eat(Tok::RBracket) && !self.lex_error_since(open) {
             self.expected("`]` to close the push", "expected `]`");
             self.note_opened_at("`[`", open);
@@ -286,7 +299,7 @@ impl Parser<'_> {
     /// (`union { A | B }`) and entries with a second head (`2 : 4 : X`).
     pub(super) fn parse_block<T>(
         &mut self,
-        value: fn(&mut Parser, &str) -> T,
+        value: fn(&mut Parser, &str, Term) -> T,
         repeat_allowed: bool,
         op_block: bool,
     ) -> Block<T> {
@@ -324,7 +337,7 @@ impl Parser<'_> {
     fn parse_block_parts<T>(
         &mut self,
         open: usize,
-        value: fn(&mut Parser, &str) -> T,
+        value: fn(&mut Parser, &str, Term) -> T,
         op_block: bool,
         parts: &mut Vec<BlockPart<T>>,
     ) {
@@ -333,6 +346,7 @@ impl Parser<'_> {
         // that `{ top : A | side B }` is an error (missing `:`), not a
         // headed entry followed by a bare body.
         let mut unlabeled: Option<bool> = None;
+        let unclosed = self.partner_of(open).is_none();
         loop {
             let mark = self.diags.len();
             let part_start = self.cur_span().start;
@@ -346,7 +360,7 @@ impl Parser<'_> {
                 }
                 Tok::Eof => {}
                 _ if *unlabeled.get_or_insert_with(|| op_block && self.is_unlabeled_part()) => {
-                    let body = value(self, "`{`");
+                    let body = value(self, "`{`", Term::BLOCK.inside(self, open));
                     parts.push(BlockPart::Unlabeled {
                         body,
                         span: self.span_from(part_start),
@@ -367,7 +381,7 @@ impl Parser<'_> {
                             depth = Some(self.parse_arg());
                             self.expect(Tok::Colon, "`:` after the setback depth", "expected `:`");
                         }
-                        let body = value(self, after);
+                        let body = value(self, after, Term::BLOCK.inside(self, open));
                         parts.push(BlockPart::Entry(BlockEntry {
                             head,
                             depth,
@@ -391,7 +405,7 @@ impl Parser<'_> {
                 return;
             }
             if self.diags.len() == mark && !self.lex_error_since(open) {
-                if self.cur() == Tok::Eof || self.is_item_start(false) {
+                if self.cur() == Tok::Eof || self.is_item_start(unclosed) {
                     self.expected("`}` to close the block", "expected `}`");
                     self.note_opened_at("`{`", open);
                 } else {
@@ -407,7 +421,7 @@ impl Parser<'_> {
                     Tok::RBrace if depth == 0 => break,
                     Tok::LParen | Tok::LBracket | Tok::LBrace => depth += 1,
                     Tok::RParen | Tok::RBracket | Tok::RBrace => depth = depth.saturating_sub(1),
-                    _ if self.is_item_start(false) => return,
+                    _ if self.is_item_start(unclosed) => return,
                     _ => {}
                 }
                 self.bump();
@@ -498,6 +512,6 @@ impl Parser<'_> {
     }
 }
 
-fn parse_entry_body(p: &mut Parser, after: &str) -> Body {
-    p.parse_body(Term::BLOCK, after)
+fn parse_entry_body(p: &mut Parser, after: &str, term: Term) -> Body {
+    p.parse_body(term, after)
 }

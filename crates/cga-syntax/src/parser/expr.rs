@@ -379,7 +379,7 @@ impl Parser<'_> {
                 }
                 let args = self.parse_args();
                 if name.name == "comp" && self.cur() == Tok::LBrace {
-                    let block = self.parse_block(|p, _| p.parse_expr(), false, false);
+                    let block = self.parse_block(|p, _, _| p.parse_expr(), false, false);
                     return Expr {
                         kind: ExprKind::CompFn { args, block },
                         span: self.span_from(start),

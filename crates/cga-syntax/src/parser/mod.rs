@@ -637,7 +637,8 @@ impl<'t> Parser<'t> {
                             "`-->` after the redefined rule's name",
                             "expected `-->`",
                         ) {
-                            let body = self.parse_body(body::Term::IMPORT, "`-->`");
+                            let term = body::Term::IMPORT.inside(self, open);
+                            let body = self.parse_body(term, "`-->`");
                             list.push(ImportOverride::Rule { name, params, body });
                         }
                     }

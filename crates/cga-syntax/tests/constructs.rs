@@ -110,6 +110,18 @@ fn case_chains() {
         one("R --> case a : X else : case b : Y else : Z W"),
         "(rule R (case (a X) (else (case (b Y) (else Z W)))))"
     );
+    // A nested chain ends with its `else` branch: the next `case` belongs to
+    // the outer chain (CityEngine's manual, "Conditional rule", example 2).
+    assert_eq!(
+        one("Footprint(type) -->\n\
+             case type == \"residential\" || type == \"park\":\n\
+             case geometry.area/2 < 200 && geometry.area > 10 : extrude(10)\n\
+             else: extrude(15)\n\
+             case type == \"industrial\" : extrude(100)\n\
+             else : NIL"),
+        "(rule Footprint(type) (case ((|| (== type \"residential\") (== type \"park\")) (case ((&& (< (/ geometry.area 2) 200) \
+         (> geometry.area 10)) (extrude 10)) (else (extrude 15)))) ((== type \"industrial\") (extrude 100)) (else NIL)))"
+    );
     // Conditions may use the full operator set; chains inside a block entry.
     assert_eq!(
         one("R --> comp(f) { top : case scope.sx > 3 && !x : A else : B | side : C }"),

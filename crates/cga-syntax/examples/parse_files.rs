@@ -1,16 +1,19 @@
 //! Parses the given `.cga` files, prints their diagnostics and how long
-//! parsing took (run with `--release` for meaningful timings):
+//! parsing took (run with `--release` for meaningful timings), and with
+//! `--tree` the syntax tree as S-expressions:
 //!
-//!     cargo run --release -p cga-syntax --example parse_files -- a.cga b.cga
+//!     cargo run --release -p cga-syntax --example parse_files -- [--tree] a.cga b.cga
 
 use std::time::Instant;
 
-use cga_syntax::{parse, SourceMap};
+use cga_syntax::{parse, sexpr, SourceMap};
 
 fn main() {
     let mut sources = SourceMap::new();
     let mut failed = false;
-    for path in std::env::args().skip(1) {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let tree = args.iter().any(|a| a == "--tree");
+    for path in args.into_iter().filter(|a| a != "--tree") {
         let text = match std::fs::read(&path) {
             Ok(bytes) => String::from_utf8_lossy(&bytes).into_owned(),
             Err(e) => {
@@ -34,6 +37,9 @@ fn main() {
             diagnostics.len(),
             per_parse.as_secs_f64() * 1e6
         );
+        if tree {
+            print!("{}", sexpr::module(&module));
+        }
         for d in &diagnostics {
             print!("{}", d.render(&sources));
             failed = true;

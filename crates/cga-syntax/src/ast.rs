@@ -6,6 +6,17 @@
 //! call or an operation, whether `front` is a selector or an attribute, and
 //! whether a `'` size is legal where it stands is the resolver's job
 //! (`cga-engine`), which has the spans to report on.
+//!
+//! Spans: a declaration's span runs from its keyword or name to its last
+//! token (annotations have their own spans and are not included); a
+//! [`Call`]'s from its name to the end of its arguments or blocks; an
+//! [`Expr`]'s over the whole expression including `'`/`~` prefixes and
+//! parentheses.
+//!
+//! Operations that take the next operation (`inline Volumes`,
+//! `inline(recompose) split(x) { ... }`) are plain statements in sequence:
+//! `inline` is a [`Call`] and the operation it applies to is the next
+//! [`Stmt`].
 
 use crate::span::Span;
 
@@ -203,7 +214,9 @@ pub enum Stmt {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Call {
     pub name: Ident,
-    /// `imp(height = 20).Lot`: the dynamic import overrides (name is then `imp.Lot`).
+    /// `imp(height = 20).Lot`: the dynamic import overrides (name is then
+    /// `imp.Lot`, spanning `imp( ... ).Lot`); `imp().Lot` gives `Some(vec![])`.
+    /// Arguments may follow: `imp(h = 1).Lot(2)`.
     pub import_overrides: Option<Vec<ImportOverride>>,
     /// `None` when written without parentheses (`reverseNormals`, `Window`).
     pub args: Option<Vec<Expr>>,
@@ -278,6 +291,8 @@ pub enum ExprKind {
     Str(String),
     /// A name: attribute, const, parameter, local, zero-argument function,
     /// shape attribute (`scope.sx`), or a selector keyword (`x`, `front`, `world.up`).
+    /// An empty name stands for an expression missing after a syntax error
+    /// (such a module comes with an error diagnostic and is never evaluated).
     Name(Ident),
     /// `f(a, b)`, `geometry.area()`, `imp.f(1)`.
     Call {

@@ -71,12 +71,13 @@ impl Diagnostic {
             let _ = writeln!(out, "{pad}--> {}:{line}:{col}", file.path.display());
             let _ = writeln!(out, "{pad} |");
             let _ = writeln!(out, "{line} | {text}");
-            // The caret covers the span on its first line, at least one column.
+            // The carets cover the span on its first line (to the end of
+            // that line for a span over several lines), at least one column.
             let (end_line, end_col) = file.line_col(span.end);
-            let width = if end_line == line && end_col > col {
-                end_col - col
+            let width = if end_line == line {
+                end_col.saturating_sub(col).max(1)
             } else {
-                1
+                (text.chars().count() + 1).saturating_sub(col).max(1)
             };
             let lead: String = text
                 .chars()
@@ -89,9 +90,85 @@ impl Diagnostic {
             }
             out.push('\n');
         }
+        // Notes line up with the gutter (`  = ` for one-digit line numbers).
+        let pad = match self.span {
+            Some(span) => " ".repeat(
+                sources
+                    .get(span.file)
+                    .line_col(span.start)
+                    .0
+                    .to_string()
+                    .len(),
+            ),
+            None => " ".to_string(),
+        };
         for note in &self.notes {
-            let _ = writeln!(out, "  = {note}");
+            let _ = writeln!(out, "{pad} = {note}");
         }
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::span::Span;
+
+    fn sources(text: &str) -> SourceMap {
+        let mut sources = SourceMap::new();
+        sources.add("r.cga", text.to_string());
+        sources
+    }
+
+    fn span(start: u32, end: u32) -> Span {
+        Span::new(crate::FileId(0), start, end)
+    }
+
+    #[test]
+    fn renders_location_line_carets_label_and_notes() {
+        let s = sources("Lot -->\n\textrude(x;)\n");
+        let d = Diagnostic::error("bad", span(18, 19))
+            .with_label("here")
+            .with_note("a note");
+        assert_eq!(
+            d.render(&s),
+            "error: bad\n --> r.cga:2:11\n  |\n2 | \textrude(x;)\n  | \t         ^ here\n  = a note\n"
+        );
+    }
+
+    #[test]
+    fn spans_over_several_lines_underline_the_rest_of_the_first_line() {
+        let s = sources("a = (1 +\n 2");
+        let d = Diagnostic::warning("multi", span(4, 11));
+        assert_eq!(
+            d.render(&s),
+            "warning: multi\n --> r.cga:1:5\n  |\n1 | a = (1 +\n  |     ^^^^\n"
+        );
+    }
+
+    #[test]
+    fn notes_line_up_with_wide_gutters_and_end_of_file_spans_render() {
+        let text = "x\n".repeat(11) + "y";
+        let s = sources(&text);
+        let end = text.len() as u32;
+        let d = Diagnostic::error("eof", span(end, end)).with_note("n");
+        assert_eq!(
+            d.render(&s),
+            "error: eof\n  --> r.cga:12:2\n   |\n12 | y\n   |  ^\n   = n\n"
+        );
+    }
+
+    #[test]
+    fn diagnostics_without_span_and_offsets_inside_characters() {
+        let d = Diagnostic {
+            span: None,
+            ..Diagnostic::error("no place", span(0, 0)).with_note("n")
+        };
+        assert_eq!(d.render(&sources("")), "error: no place\n  = n\n");
+        // An offset inside `ö` counts as the `ö`.
+        let s = sources("aö b");
+        assert_eq!(s.get(crate::FileId(0)).line_col(2), (1, 2));
+        let d = Diagnostic::error("mid", span(2, 3));
+        assert!(d.render(&s).contains(" --> r.cga:1:2\n"));
     }
 }

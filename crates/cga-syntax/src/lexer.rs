@@ -270,22 +270,30 @@ pub(crate) fn lex(file: FileId, text: &str) -> Lexed {
         let start = i;
         let kind = match b {
             b' ' | b'\t' | b'\n' | b'\r' | 0x0b | 0x0c => {
-                flush_stray(&mut stray, i, &mut diagnostics);
+                if stray.is_some() {
+                    flush_stray(&mut stray, i, &mut diagnostics);
+                }
                 i += 1;
                 continue;
             }
             b'#' => {
-                flush_stray(&mut stray, i, &mut diagnostics);
+                if stray.is_some() {
+                    flush_stray(&mut stray, i, &mut diagnostics);
+                }
                 i = skip_line(bytes, i);
                 continue;
             }
             b'/' if bytes.get(i + 1) == Some(&b'/') => {
-                flush_stray(&mut stray, i, &mut diagnostics);
+                if stray.is_some() {
+                    flush_stray(&mut stray, i, &mut diagnostics);
+                }
                 i = skip_line(bytes, i);
                 continue;
             }
             b'/' if bytes.get(i + 1) == Some(&b'*') => {
-                flush_stray(&mut stray, i, &mut diagnostics);
+                if stray.is_some() {
+                    flush_stray(&mut stray, i, &mut diagnostics);
+                }
                 match find(bytes, i + 2, b"*/") {
                     Some(end) => i = end + 2,
                     None => {
@@ -299,7 +307,9 @@ pub(crate) fn lex(file: FileId, text: &str) -> Lexed {
                 continue;
             }
             b'"' => {
-                flush_stray(&mut stray, i, &mut diagnostics);
+                if stray.is_some() {
+                    flush_stray(&mut stray, i, &mut diagnostics);
+                }
                 i += 1;
                 loop {
                     match bytes.get(i) {
@@ -330,17 +340,23 @@ pub(crate) fn lex(file: FileId, text: &str) -> Lexed {
                 Tok::Str
             }
             b'0'..=b'9' => {
-                flush_stray(&mut stray, i, &mut diagnostics);
+                if stray.is_some() {
+                    flush_stray(&mut stray, i, &mut diagnostics);
+                }
                 i = lex_number(bytes, i);
                 Tok::Number
             }
             b'.' if bytes.get(i + 1).is_some_and(u8::is_ascii_digit) => {
-                flush_stray(&mut stray, i, &mut diagnostics);
+                if stray.is_some() {
+                    flush_stray(&mut stray, i, &mut diagnostics);
+                }
                 i = lex_number(bytes, i);
                 Tok::Number
             }
             b'.' => {
-                flush_stray(&mut stray, i, &mut diagnostics);
+                if stray.is_some() {
+                    flush_stray(&mut stray, i, &mut diagnostics);
+                }
                 match elementwise_op(bytes, i) {
                     Some((tok, len)) => {
                         i += len;
@@ -352,21 +368,56 @@ pub(crate) fn lex(file: FileId, text: &str) -> Lexed {
                     }
                 }
             }
-            b if is_ident_start(b) => {
-                flush_stray(&mut stray, i, &mut diagnostics);
-                i += 1;
+            b if is_ident_start(b) || (b >= 0x80 && char_at(text, i).is_alphabetic()) => {
+                if stray.is_some() {
+                    flush_stray(&mut stray, i, &mut diagnostics);
+                }
+                // Letters outside ASCII are not allowed in names, but a word
+                // such as `höhe` is still lexed as one identifier so that it
+                // gets one diagnostic and the parser goes on undisturbed.
+                let mut non_ascii = false;
+                // Letters outside ASCII (rare) take the slow path.
+                let other_letter = |i: usize| -> usize {
+                    match bytes.get(i) {
+                        Some(&c) if c >= 0x80 => {
+                            let c = char_at(text, i);
+                            if c.is_alphanumeric() {
+                                c.len_utf8()
+                            } else {
+                                0
+                            }
+                        }
+                        _ => 0,
+                    }
+                };
                 loop {
                     while i < bytes.len() && is_ident_char(bytes[i]) {
                         i += 1;
                     }
+                    let len = other_letter(i);
+                    if len > 0 {
+                        non_ascii = true;
+                        i += len;
+                        continue;
+                    }
                     // A dot followed by an identifier start continues the name.
+                    let after_dot = bytes.get(i + 1).copied().unwrap_or(0);
                     if bytes.get(i) == Some(&b'.')
-                        && bytes.get(i + 1).is_some_and(|&c| is_ident_start(c))
+                        && (is_ident_start(after_dot) || other_letter(i + 1) > 0)
                     {
-                        i += 2;
+                        i += 1;
                     } else {
                         break;
                     }
+                }
+                if non_ascii {
+                    diagnostics.push(
+                        Diagnostic::error(
+                            format!("identifier `{}` contains characters other than ASCII letters, digits and `_`", &text[start..i]),
+                            span(start, i),
+                        )
+                        .with_label("not a valid name"),
+                    );
                 }
                 keyword(&bytes[start..i]).unwrap_or(Tok::Ident)
             }
@@ -407,9 +458,11 @@ pub(crate) fn lex(file: FileId, text: &str) -> Lexed {
                         // Not ASCII punctuation: Unicode whitespace (a
                         // non-breaking space pasted from a web page) is
                         // whitespace, anything else is a stray character.
-                        let c = text[i..].chars().next().unwrap_or('\u{fffd}');
+                        let c = char_at(text, i);
                         if c.is_whitespace() || c == '\u{feff}' {
-                            flush_stray(&mut stray, i, &mut diagnostics);
+                            if stray.is_some() {
+                                flush_stray(&mut stray, i, &mut diagnostics);
+                            }
                         } else if stray.is_none() {
                             stray = Some(i);
                         }
@@ -417,7 +470,9 @@ pub(crate) fn lex(file: FileId, text: &str) -> Lexed {
                         continue;
                     }
                 };
-                flush_stray(&mut stray, i, &mut diagnostics);
+                if stray.is_some() {
+                    flush_stray(&mut stray, i, &mut diagnostics);
+                }
                 i += len;
                 tok
             }
@@ -438,6 +493,13 @@ pub(crate) fn lex(file: FileId, text: &str) -> Lexed {
         tokens,
         diagnostics,
     }
+}
+
+/// The character starting at byte `i` (which must be a character boundary).
+fn char_at(text: &str, i: usize) -> char {
+    text.get(i..)
+        .and_then(|t| t.chars().next())
+        .unwrap_or('\u{fffd}')
 }
 
 fn skip_line(bytes: &[u8], mut i: usize) -> usize {
@@ -626,5 +688,18 @@ mod tests {
             ]
         );
         assert_eq!(lexed.diagnostics[0].span.unwrap().range(), 2..4);
+    }
+
+    #[test]
+    fn non_ascii_names_are_one_token_with_one_error() {
+        let lexed = lex(FileId(0), "höhe.wert + x");
+        let kinds: Vec<Tok> = lexed.tokens.iter().map(|t| t.kind).collect();
+        assert_eq!(kinds, [Tok::Ident, Tok::Plus, Tok::Ident, Tok::Eof]);
+        assert_eq!(lexed.tokens[0].end, 10);
+        assert_eq!(lexed.diagnostics.len(), 1);
+        assert_eq!(
+            lexed.diagnostics[0].message,
+            "identifier `höhe.wert` contains characters other than ASCII letters, digits and `_`"
+        );
     }
 }

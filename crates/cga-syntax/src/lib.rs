@@ -1,8 +1,35 @@
 //! The CGA front end: source files, lexer, parser, syntax tree and diagnostics.
 //!
-//! `parse` turns the text of one `.cga` file into a [`ast::Module`] and the
+//! [`parse`] turns the text of one `.cga` file into an [`ast::Module`] and the
 //! diagnostics found on the way. The parser recovers from errors so that one
-//! run reports every error of a file.
+//! run reports every error of a file; it never panics and takes time linear
+//! in the length of the text.
+//!
+//! ```
+//! use cga_syntax::{parse, sexpr, SourceMap};
+//!
+//! let mut sources = SourceMap::new();
+//! let text = "Lot --> extrude(10) comp(f) { top : Roof. | side = Wall }";
+//! let file = sources.add("lot.cga", text.to_string());
+//! let (module, diagnostics) = parse(file, &sources.get(file).text);
+//! assert!(diagnostics.is_empty());
+//! assert_eq!(
+//!     sexpr::module(&module),
+//!     "(rule Lot (extrude 10) (comp f {top : Roof. | side = Wall}))\n"
+//! );
+//!
+//! let (_, diagnostics) = parse(file, "Lot --> extrude(10;)");
+//! assert_eq!(diagnostics[0].message, "expected `)` to close the argument list, found `;`");
+//! ```
+//!
+//! - `lexer` (private): hand-written; dotted names (`scope.sx`) are one
+//!   token, `Leaf.` is a name and a dot, `.+` ... are element-wise operators.
+//! - `parser` (private): recursive descent with bracket-pair lookahead;
+//!   see the module docs for the recovery strategy.
+//! - [`ast`]: the syntax tree, names as written, every node with a [`Span`].
+//! - [`sexpr`]: a compact text form of the tree for tests and debugging.
+//! - [`Diagnostic`], [`SourceMap`]: errors with `path:line:col`, the source
+//!   line and carets.
 
 pub mod ast;
 pub mod diagnostic;

@@ -216,7 +216,7 @@ pub fn stmt(s: &Stmt) -> String {
             for a in call.args.iter().flatten() {
                 let _ = write!(out, " {}", expr(a));
             }
-            if let Some(b) = &call.block {
+            for b in call.block.iter().chain(&call.remainder_block) {
                 let _ = write!(out, " {}", block(b, body));
             }
             out.push(')');
@@ -239,7 +239,15 @@ pub fn block<T>(b: &Block<T>, value: fn(&T) -> String) -> String {
                     BlockOp::Equals => "=",
                     BlockOp::EqualsColon => "=:",
                 };
-                format!("{} {op} {}", expr(&e.head), value(&e.body))
+                match &e.depth {
+                    Some(depth) => format!(
+                        "{} {op} {} : {}",
+                        expr(&e.head),
+                        expr(depth),
+                        value(&e.body)
+                    ),
+                    None => format!("{} {op} {}", expr(&e.head), value(&e.body)),
+                }
             }
             BlockPart::Group(g) => block(g, value),
             BlockPart::Unlabeled { body, .. } => value(body),

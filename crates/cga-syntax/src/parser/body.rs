@@ -20,6 +20,9 @@ impl Term {
     pub const IMPORT: Term = Term(4);
     /// A branch of a chain: `case`, `else`, `30%`.
     pub const CHAIN: Term = Term(8);
+    /// The enclosing bracket is never closed: a function definition
+    /// `name = ...` then ends the body after all.
+    pub const UNCLOSED: Term = Term(16);
 
     fn has(self, other: Term) -> bool {
         self.0 & other.0 != 0
@@ -30,9 +33,19 @@ impl Term {
     }
 
     /// Inside brackets `side = X` is a comp entry, not a function
-    /// definition, so only unambiguous item starts end the body.
+    /// definition, so only unambiguous item starts end the body (unless
+    /// the bracket is never closed).
     fn soft_item_starts(self) -> bool {
-        !self.has(Term(Term::BLOCK.0 | Term::PUSH.0 | Term::IMPORT.0))
+        self.has(Term::UNCLOSED) || !self.has(Term(Term::BLOCK.0 | Term::PUSH.0 | Term::IMPORT.0))
+    }
+
+    /// `term`, marked unclosed when the bracket at `open` has no partner.
+    pub(super) fn inside(self, p: &Parser, open: usize) -> Term {
+        if p.partner_of(open).is_some() {
+            self
+        } else {
+            self.with(Term::UNCLOSED)
+        }
     }
 }
 
@@ -65,8 +78,25 @@ impl Parser<'_> {
             Tok::Comma | Tok::RParen if term.has(Term::IMPORT) => true,
             Tok::Case | Tok::Else if term.has(Term::CHAIN) => true,
             Tok::Number if term.has(Term::CHAIN) && self.is_percent_at(self.pos) => true,
+            // In a block, what cannot start an operation but starts an
+            // entry (`2 : B`, `'0.5 : B`, `side = B`, `isTagged("x") : B`)
+            // means a `|` is missing: end the body so that the block says so.
+            Tok::Number | Tok::Quote | Tok::Tilde if term.has(Term::BLOCK) => true,
+            Tok::Ident if term.has(Term::BLOCK) && self.is_entry_head() => true,
             _ => self.is_item_start(term.soft_item_starts()),
         }
+    }
+
+    /// `name :`, `name =`, `name =:`, `f(...) :` at the current token.
+    fn is_entry_head(&self) -> bool {
+        let after = match self.nth(1) {
+            Tok::LParen => match self.partner_of(self.pos + 1) {
+                Some(close) => self.kind_at(close + 1),
+                None => return false,
+            },
+            k => k,
+        };
+        matches!(after, Tok::Colon | Tok::Eq | Tok::EqColon)
     }
 
     /// Skips a bad stretch of a body: up to where the body ends, without
@@ -91,11 +121,15 @@ impl Parser<'_> {
     fn parse_ops(&mut self, term: Term, after: &str) -> Vec<Stmt> {
         let mut stmts = Vec::new();
         let mark = self.diags.len();
+        // Whether the previous statement reported an error: a stray token
+        // right after it is a consequence, not worth a second report.
+        let mut prev_errored = false;
         loop {
             if self.at_body_end(term) {
                 break;
             }
             let before = self.pos;
+            let stmt_mark = self.diags.len();
             match self.cur() {
                 Tok::Ident | Tok::Start => stmts.push(self.parse_name_stmt()),
                 Tok::Nil => {
@@ -136,19 +170,38 @@ impl Parser<'_> {
                     self.bump();
                 }
                 _ => {
-                    self.expected(
-                        "an operation, a rule, `NIL`, a leaf `Name.` or `[`",
-                        "expected an operation",
-                    );
+                    if !prev_errored {
+                        self.expected(
+                            "an operation, a rule, `NIL`, a leaf `Name.` or `[`",
+                            "expected an operation",
+                        );
+                    }
                     self.skip_to_body_end(term);
                 }
             }
             if self.pos == before {
                 self.bump();
             }
+            prev_errored = self.diags.len() > stmt_mark;
         }
         if stmts.is_empty() && self.diags.len() == mark {
-            self.expected(&format!("operations after {after}"), "expected operations");
+            if self.pos > 0 && (self.cur() == Tok::Eof || self.is_item_start(true)) {
+                // `R -->` at the end of its line: point at the arrow, not
+                // at the next declaration.
+                let next = if self.cur() == Tok::Eof {
+                    "end of file"
+                } else {
+                    "the next declaration"
+                };
+                let span = self.span_at(self.pos - 1);
+                self.error(
+                    format!("expected operations after {after}, found {next}"),
+                    span,
+                    "empty body",
+                );
+            } else {
+                self.expected(&format!("operations after {after}"), "expected operations");
+            }
             self.note(
                 "write `NIL` to delete the shape or `Name.` to keep it as a leaf".to_string(),
             );
@@ -161,8 +214,8 @@ impl Parser<'_> {
         let open = self.pos;
         let start = self.tok_at(open).start;
         self.bump();
-        let body = self.parse_body(Term::PUSH, "`[`");
-        if !self.eat(Tok::RBracket) {
+        let body = self.parse_body(Term::PUSH.inside(self, open), "`[`");
+        if !self.eat(Tok::RBracket) && !self.lex_error_since(open) {
             self.expected("`]` to close the push", "expected `]`");
             self.note_opened_at("`[`", open);
         }
@@ -242,12 +295,13 @@ impl Parser<'_> {
 
     /// `{ part | part | ... }` with an optional `*` (when `repeat` is allowed).
     /// Parts are nested groups `{ ... }*`, entries `head op value`, and, for
-    /// operation blocks (`unlabeled`), bodies without a head (`union { A | B }`).
+    /// blocks after operations (`op_block`), bodies without a head
+    /// (`union { A | B }`) and entries with a second head (`2 : 4 : X`).
     pub(super) fn parse_block<T>(
         &mut self,
-        value: fn(&mut Parser, &str) -> T,
+        value: fn(&mut Parser, &str, Term) -> T,
         repeat_allowed: bool,
-        unlabeled: bool,
+        op_block: bool,
     ) -> Block<T> {
         let open = self.pos;
         let start = self.tok_at(open).start;
@@ -269,7 +323,7 @@ impl Parser<'_> {
             );
             self.bump();
         } else {
-            self.parse_block_parts(open, value, unlabeled, &mut parts);
+            self.parse_block_parts(open, value, op_block, &mut parts);
         }
         self.leave();
         let repeat = repeat_allowed && self.eat(Tok::Star);
@@ -283,29 +337,35 @@ impl Parser<'_> {
     fn parse_block_parts<T>(
         &mut self,
         open: usize,
-        value: fn(&mut Parser, &str) -> T,
-        unlabeled: bool,
+        value: fn(&mut Parser, &str, Term) -> T,
+        op_block: bool,
         parts: &mut Vec<BlockPart<T>>,
     ) {
+        // Whether the parts of this block have heads, decided by the first
+        // part that is not a group: a block does not mix the two kinds, so
+        // that `{ top : A | side B }` is an error (missing `:`), not a
+        // headed entry followed by a bare body.
+        let mut unlabeled: Option<bool> = None;
+        let unclosed = self.partner_of(open).is_none();
         loop {
             let mark = self.diags.len();
             let part_start = self.cur_span().start;
             match self.cur() {
                 Tok::LBrace => {
-                    let group = self.parse_block(value, true, unlabeled);
+                    let group = self.parse_block(value, true, op_block);
                     parts.push(BlockPart::Group(group));
                 }
                 Tok::Pipe | Tok::RBrace => {
                     self.expected("a block entry such as `1 : X`", "expected an entry");
                 }
-                _ if unlabeled && self.is_unlabeled_part() => {
-                    let body = value(self, "`{`");
+                Tok::Eof => {}
+                _ if *unlabeled.get_or_insert_with(|| op_block && self.is_unlabeled_part()) => {
+                    let body = value(self, "`{`", Term::BLOCK.inside(self, open));
                     parts.push(BlockPart::Unlabeled {
                         body,
                         span: self.span_from(part_start),
                     });
                 }
-                Tok::Eof => {}
                 _ => {
                     let head = self.parse_arg();
                     let op = match self.cur() {
@@ -317,11 +377,11 @@ impl Parser<'_> {
                     if let Some((op, after)) = op {
                         self.bump();
                         let mut depth = None;
-                        if unlabeled && op == BlockOp::Colon && self.has_second_head() {
+                        if op_block && op == BlockOp::Colon && self.has_second_head() {
                             depth = Some(self.parse_arg());
                             self.expect(Tok::Colon, "`:` after the setback depth", "expected `:`");
                         }
-                        let body = value(self, after);
+                        let body = value(self, after, Term::BLOCK.inside(self, open));
                         parts.push(BlockPart::Entry(BlockEntry {
                             head,
                             depth,
@@ -344,8 +404,8 @@ impl Parser<'_> {
             if self.eat(Tok::RBrace) {
                 return;
             }
-            if self.diags.len() == mark {
-                if self.cur() == Tok::Eof || self.is_item_start(false) {
+            if self.diags.len() == mark && !self.lex_error_since(open) {
+                if self.cur() == Tok::Eof || self.is_item_start(unclosed) {
                     self.expected("`}` to close the block", "expected `}`");
                     self.note_opened_at("`{`", open);
                 } else {
@@ -361,7 +421,7 @@ impl Parser<'_> {
                     Tok::RBrace if depth == 0 => break,
                     Tok::LParen | Tok::LBracket | Tok::LBrace => depth += 1,
                     Tok::RParen | Tok::RBracket | Tok::RBrace => depth = depth.saturating_sub(1),
-                    _ if self.is_item_start(false) => return,
+                    _ if self.is_item_start(unclosed) => return,
                     _ => {}
                 }
                 self.bump();
@@ -373,31 +433,57 @@ impl Parser<'_> {
         }
     }
 
-    /// Whether a second `:` follows in this entry (`length : depth : ops` of
-    /// splitAndSetbackPerimeter). Bodies contain no `:` outside brackets
-    /// unless they start with a chain.
+    /// Whether the current token starts `depth :`, the second head of a
+    /// splitAndSetbackPerimeter entry (`length : depth : ops`): one
+    /// operand-operator-operand expression followed by `:`. A body never
+    /// looks like that: two operands in a row (`X 2 : Y`) are two things.
     fn has_second_head(&self) -> bool {
-        if self.cur() == Tok::Case || self.is_percent_at(self.pos) {
-            return false;
-        }
+        use super::expr::{binary_op, unary_op};
         let mut i = self.pos;
+        while matches!(self.kind_at(i), Tok::Quote | Tok::Tilde) {
+            i += 1;
+        }
+        let skip_group = |i: usize| self.partner_of(i).map(|close| close + 1);
+        let mut want_operand = true;
         loop {
-            match self.kind_at(i) {
-                Tok::Colon => return i > self.pos,
-                Tok::LParen | Tok::LBracket | Tok::LBrace => match self.partner_of(i) {
-                    Some(close) => i = close + 1,
-                    None => return false,
-                },
-                Tok::Ident
-                | Tok::Number
-                | Tok::Str
-                | Tok::Start
-                | Tok::True
-                | Tok::False
-                | Tok::Quote
-                | Tok::Tilde => i += 1,
-                k if super::expr::is_operator(k) => i += 1,
-                _ => return false,
+            let kind = self.kind_at(i);
+            if want_operand {
+                match kind {
+                    k if unary_op(k).is_some() => i += 1,
+                    Tok::Ident | Tok::Start | Tok::Number | Tok::Str | Tok::True | Tok::False => {
+                        i += 1;
+                        if self.kind_at(i) == Tok::LParen {
+                            let Some(next) = skip_group(i) else {
+                                return false;
+                            };
+                            i = next;
+                        }
+                        want_operand = false;
+                    }
+                    Tok::LParen | Tok::LBracket => {
+                        let Some(next) = skip_group(i) else {
+                            return false;
+                        };
+                        i = next;
+                        want_operand = false;
+                    }
+                    _ => return false,
+                }
+            } else {
+                match kind {
+                    Tok::Colon => return true,
+                    Tok::LBracket => {
+                        let Some(next) = skip_group(i) else {
+                            return false;
+                        };
+                        i = next;
+                    }
+                    k if binary_op(k).is_some() => {
+                        i += 1;
+                        want_operand = true;
+                    }
+                    _ => return false,
+                }
             }
         }
     }
@@ -426,6 +512,6 @@ impl Parser<'_> {
     }
 }
 
-fn parse_entry_body(p: &mut Parser, after: &str) -> Body {
-    p.parse_body(Term::BLOCK, after)
+fn parse_entry_body(p: &mut Parser, after: &str, term: Term) -> Body {
+    p.parse_body(term, after)
 }

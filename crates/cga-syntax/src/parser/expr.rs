@@ -8,7 +8,7 @@ use crate::span::Span;
 
 /// Binary operators by token: (operator, element-wise, precedence).
 /// Higher precedence binds tighter.
-fn binary_op(kind: Tok) -> Option<(BinaryOp, bool, u8)> {
+pub(super) fn binary_op(kind: Tok) -> Option<(BinaryOp, bool, u8)> {
     use BinaryOp::*;
     Some(match kind {
         Tok::OrOr => (Or, false, 1),
@@ -41,12 +41,7 @@ fn binary_op(kind: Tok) -> Option<(BinaryOp, bool, u8)> {
     })
 }
 
-/// Whether the token is a unary or binary operator.
-pub(super) fn is_operator(kind: Tok) -> bool {
-    binary_op(kind).is_some() || unary_op(kind).is_some()
-}
-
-fn unary_op(kind: Tok) -> Option<(UnaryOp, bool)> {
+pub(super) fn unary_op(kind: Tok) -> Option<(UnaryOp, bool)> {
     Some(match kind {
         Tok::Minus => (UnaryOp::Neg, false),
         Tok::Plus => (UnaryOp::Plus, false),
@@ -63,6 +58,15 @@ impl Parser<'_> {
     /// expression. Used wherever a value stands on its own (definitions,
     /// arguments, array elements, branch values, parentheses).
     pub(super) fn parse_expr(&mut self) -> Expr {
+        if !self.enter() {
+            return self.missing_expr();
+        }
+        let expr = self.parse_expr_inner();
+        self.leave();
+        expr
+    }
+
+    fn parse_expr_inner(&mut self) -> Expr {
         match self.cur() {
             Tok::Case => {
                 let chain = self.parse_case_chain(&mut |p: &mut Parser| p.parse_expr());
@@ -89,11 +93,16 @@ impl Parser<'_> {
     /// to the whole expression (`'1.85*8` is relative 14.8).
     pub(super) fn parse_arg(&mut self) -> Expr {
         let mut prefixes = Vec::new();
-        while matches!(self.cur(), Tok::Quote | Tok::Tilde) {
+        // Each prefix nests the tree one level deeper: count it against the
+        // depth limit (dropping a tree recurses too).
+        while matches!(self.cur(), Tok::Quote | Tok::Tilde) && self.enter() {
             prefixes.push((self.cur(), self.tok_at(self.pos).start));
             self.bump();
         }
         let mut expr = self.parse_expr();
+        for _ in &prefixes {
+            self.leave();
+        }
         for (kind, start) in prefixes.into_iter().rev() {
             let span = Span::new(self.file, start, expr.span.end);
             let inner = Box::new(expr);
@@ -181,6 +190,9 @@ impl Parser<'_> {
     /// Operator expressions by precedence climbing (left associative).
     fn parse_binary(&mut self, min_prec: u8) -> Expr {
         let mut lhs = self.parse_unary();
+        // Every operator of a chain `a + b + c ...` nests the left operand
+        // one level deeper: count the levels against the depth limit.
+        let mut levels = 0;
         while let Some((op, elementwise, prec)) = binary_op(self.cur()) {
             if prec < min_prec {
                 break;
@@ -189,6 +201,10 @@ impl Parser<'_> {
             if op == BinaryOp::Rem && !elementwise && self.nth(1) == Tok::Colon {
                 break;
             }
+            if !self.enter() {
+                break;
+            }
+            levels += 1;
             self.bump();
             let rhs = self.parse_binary(prec + 1);
             let span = lhs.span.to(rhs.span);
@@ -201,6 +217,9 @@ impl Parser<'_> {
                 },
                 span,
             };
+        }
+        for _ in 0..levels {
+            self.leave();
         }
         lhs
     }
@@ -239,7 +258,9 @@ impl Parser<'_> {
 
     fn parse_postfix(&mut self) -> Expr {
         let mut expr = self.parse_primary();
-        while self.cur() == Tok::LBracket {
+        let mut levels = 0;
+        while self.cur() == Tok::LBracket && self.enter() {
+            levels += 1;
             let open = self.pos;
             self.bump();
             let mut indices = Vec::new();
@@ -269,6 +290,9 @@ impl Parser<'_> {
                 },
                 span,
             };
+        }
+        for _ in 0..levels {
+            self.leave();
         }
         expr
     }
@@ -355,7 +379,7 @@ impl Parser<'_> {
                 }
                 let args = self.parse_args();
                 if name.name == "comp" && self.cur() == Tok::LBrace {
-                    let block = self.parse_block(|p, _| p.parse_expr(), false, false);
+                    let block = self.parse_block(|p, _, _| p.parse_expr(), false, false);
                     return Expr {
                         kind: ExprKind::CompFn { args, block },
                         span: self.span_from(start),

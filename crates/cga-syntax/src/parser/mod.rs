@@ -25,17 +25,16 @@ use crate::diagnostic::Diagnostic;
 use crate::lexer::{self, Tok, Token};
 use crate::span::{FileId, Span};
 
-/// Deepest nesting of expressions, bodies and blocks the parser accepts.
-/// Real rule files stay far below; the limit keeps the recursion (and the
-/// stack) bounded on hostile input.
+/// Deepest nesting of expressions, bodies and blocks the parser accepts,
+/// counted in parser levels (a parenthesis costs two, as does a nested
+/// block; every operator of a chain `a + b + ...` one, since it nests the
+/// tree). Real rule files stay far below. The limit bounds the recursion:
+/// parsing needs about 700 KiB of stack in a debug build and 200 KiB in a
+/// release build, well inside a thread's default 2 MiB; and it bounds the
+/// depth of the tree, which is dropped (and evaluated) recursively.
 pub(crate) const MAX_DEPTH: u32 = 200;
 
 const NO_PARTNER: u32 = u32::MAX;
-
-/// How far below the top of the bracket stack a closing bracket looks for
-/// its opener (`( [ )` closes the `(`). Bounded so that unbalanced input
-/// cannot make bracket matching quadratic.
-const PARTNER_SEARCH: usize = 16;
 
 pub(crate) struct Parser<'t> {
     file: FileId,
@@ -49,11 +48,19 @@ pub(crate) struct Parser<'t> {
     /// Set when nesting exceeded [`MAX_DEPTH`]: the parser then sees end of
     /// file (and reports nothing) until the top level skips to the next item.
     bail: bool,
+    /// Start offsets of the lexer's errors, ascending. An unclosed bracket
+    /// after an unterminated string is the string's fault and not reported.
+    lex_errors: Vec<u32>,
 }
 
 pub(crate) fn parse(file: FileId, text: &str) -> (Module, Vec<Diagnostic>) {
     let lexed = lexer::lex(file, text);
     let mut parser = Parser::new(file, text, lexed.tokens);
+    parser.lex_errors = lexed
+        .diagnostics
+        .iter()
+        .filter_map(|d| d.span.map(|s| s.start))
+        .collect();
     let module = parser.parse_module();
     let mut diags = lexed.diagnostics;
     diags.extend(parser.diags);
@@ -74,6 +81,7 @@ impl<'t> Parser<'t> {
             diags: Vec::new(),
             depth: 0,
             bail: false,
+            lex_errors: Vec::new(),
         }
     }
 
@@ -210,6 +218,16 @@ impl<'t> Parser<'t> {
         self.error(message, span, label);
     }
 
+    /// Whether the lexer reported an error between token `from` and the
+    /// current token: errors about brackets in that stretch are then
+    /// consequences (an unterminated string swallowed the closing bracket).
+    fn lex_error_since(&self, from: usize) -> bool {
+        let start = self.tok_at(from).start;
+        let end = self.tok_at(self.pos).start;
+        let i = self.lex_errors.partition_point(|&e| e < start);
+        self.lex_errors.get(i).is_some_and(|&e| e <= end)
+    }
+
     /// Appends a note to the last diagnostic.
     fn note(&mut self, note: String) {
         if let Some(d) = self.diags.last_mut() {
@@ -242,11 +260,15 @@ impl<'t> Parser<'t> {
         if self.depth > MAX_DEPTH {
             let span = self.cur_span();
             self.error(
-                format!("nesting is too deep (more than {MAX_DEPTH} levels)"),
+                "expressions or blocks are nested too deeply",
                 span,
                 "too deeply nested",
             );
-            self.note("the rest of this declaration is skipped".to_string());
+            self.note(
+                "the parser accepts about 100 levels of parentheses or nested blocks; \
+                 the rest of this declaration is skipped"
+                    .to_string(),
+            );
             self.bail = true;
             self.depth -= 1;
             return false;
@@ -275,7 +297,11 @@ impl<'t> Parser<'t> {
             | Tok::Style
             | Tok::Version
             | Tok::Extension => true,
-            Tok::Start => Self::is_name(self.kind_at(i + 1)) && self.is_head_tail(i + 2, false),
+            // `start Name -->`, or a rule or function named `start`.
+            Tok::Start => {
+                (Self::is_name(self.kind_at(i + 1)) && self.is_head_tail(i + 2, false))
+                    || self.is_head_tail(i + 1, soft)
+            }
             Tok::Ident => self.is_head_tail(i + 1, soft),
             _ => false,
         }
@@ -327,6 +353,11 @@ impl<'t> Parser<'t> {
                 items.push(item);
             }
             self.bail = false;
+            if self.diags.len() == errors && Self::is_name(self.cur()) && self.pos != start {
+                // `attr h = 10  Lot extrude(10)`: let the next round read
+                // `Lot` as a definition and report its missing `-->`.
+                continue;
+            }
             if self.cur() != Tok::Eof && !self.is_item_start(true) {
                 if self.diags.len() == errors {
                     self.expected("an operator or the next declaration", "unexpected here");
@@ -482,7 +513,7 @@ impl<'t> Parser<'t> {
     /// closing bracket: report (unless the element already did) and continue
     /// after the matching closing bracket if there is one.
     fn close_list_after_error(&mut self, open: usize, mark: usize, what: &str, label: &str) {
-        if self.diags.len() == mark {
+        if self.diags.len() == mark && !self.lex_error_since(open) {
             self.expected(what, &format!("expected {label}"));
             if self.partner_of(open).is_none() {
                 let kind = self.kind_at(open).describe();
@@ -606,7 +637,8 @@ impl<'t> Parser<'t> {
                             "`-->` after the redefined rule's name",
                             "expected `-->`",
                         ) {
-                            let body = self.parse_body(body::Term::IMPORT, "`-->`");
+                            let term = body::Term::IMPORT.inside(self, open);
+                            let body = self.parse_body(term, "`-->`");
                             list.push(ImportOverride::Rule { name, params, body });
                         }
                     }
@@ -753,12 +785,12 @@ impl<'t> Parser<'t> {
             );
             self.parse_params();
         }
+        let mark = self.diags.len();
         let locals = self.parse_with();
-        if !self.expect(
-            Tok::Eq,
-            &format!("`=` after `attr {}`", name.name),
-            "expected `=`",
-        ) {
+        if !self.eat(Tok::Eq) {
+            if self.diags.len() == mark {
+                self.expected(&format!("`=` after `attr {}`", name.name), "expected `=`");
+            }
             return None;
         }
         let value = self.parse_expr();
@@ -796,6 +828,7 @@ impl<'t> Parser<'t> {
         } else {
             Vec::new()
         };
+        let mark = self.diags.len();
         let locals = self.parse_with();
         match self.cur() {
             Tok::Arrow if !is_const => {
@@ -824,6 +857,7 @@ impl<'t> Parser<'t> {
                     span: self.span_from(start),
                 }))
             }
+            _ if self.diags.len() > mark => None,
             _ => {
                 let (what, label) = if is_const {
                     (format!("`=` after `const {}`", name.name), "expected `=`")
@@ -858,7 +892,8 @@ fn match_brackets(toks: &[Token]) -> Vec<u32> {
             Tok::RBracket => Tok::LBracket,
             Tok::RBrace => Tok::LBrace,
             // These never stand inside brackets: whatever is still open
-            // before them is unclosed.
+            // before them is unclosed. Nor does a rule head `Name -->`,
+            // unless it redefines a rule in an import list `( ..., R --> X )`.
             Tok::At
             | Tok::Attr
             | Tok::Const
@@ -869,15 +904,20 @@ fn match_brackets(toks: &[Token]) -> Vec<u32> {
                 stack.clear();
                 continue;
             }
+            Tok::Ident | Tok::Start
+                if toks.get(i + 1).is_some_and(|n| n.kind == Tok::Arrow)
+                    && !(i > 0 && matches!(toks[i - 1].kind, Tok::Comma | Tok::LParen)) =>
+            {
+                stack.clear();
+                continue;
+            }
             _ => continue,
         };
-        let lowest = stack.len().saturating_sub(PARTNER_SEARCH);
-        if let Some(k) = (lowest..stack.len())
-            .rev()
-            .find(|&k| toks[stack[k]].kind == opener)
-        {
-            let open = stack[k];
-            stack.truncate(k);
+        // Only the innermost open bracket can be closed; a closer of
+        // another kind is stray and closes nothing (so that `{ 1 : A ) }`
+        // keeps its braces paired).
+        if stack.last().is_some_and(|&open| toks[open].kind == opener) {
+            let open = stack.pop().unwrap_or_default();
             partner[open] = i as u32;
             partner[i] = open as u32;
         }

@@ -84,11 +84,25 @@ enum Failure {
     Usage(String),
 }
 
+/// Stack for the thread that derives: deep but legal grammars (recursion up
+/// to `--max-depth` rule invocations) must stop at the limit with a message,
+/// not overflow the stack. Only the pages actually used are committed.
+const DERIVATION_STACK: usize = 1 << 30;
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result = match cli.command {
-        Command::Generate(args) => generate(args),
-        Command::Check { rules } => check(&rules),
+    let worker = std::thread::Builder::new()
+        .stack_size(DERIVATION_STACK)
+        .spawn(move || match cli.command {
+            Command::Generate(args) => generate(args),
+            Command::Check { rules } => check(&rules),
+        });
+    let result = match worker.map(|w| w.join()) {
+        Ok(Ok(r)) => r,
+        _ => {
+            eprintln!("error: internal error while generating; please report this rule file");
+            return ExitCode::from(1);
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

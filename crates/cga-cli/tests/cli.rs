@@ -1,0 +1,320 @@
+//! The `cga` command's contract (README, DESIGN): what goes to standard
+//! output and error, exit statuses, lots, attributes, reports, limits.
+
+mod common;
+
+use common::*;
+
+const BOX: &str = "version \"2023.0\"\n@StartRule\nLot --> extrude(10) Box.\n";
+
+#[test]
+fn prints_go_to_stdout_in_derivation_order_and_nothing_else() {
+    let dir = temp_dir("prints");
+    let rules = rule_file(
+        &dir,
+        "p.cga",
+        "Lot --> print(\"first\") extrude(4) print(scope.sy) A(2) print(\"last\")\n\
+         A(n) --> print(\"in A \" + n) X.\n",
+    );
+    let out = run(&["generate", rules.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(stdout(&out), "first\n4\nin A 2\nlast\n");
+}
+
+#[test]
+fn default_lot_is_a_20_by_30_rectangle() {
+    let dir = temp_dir("default-lot");
+    let rules = rule_file(
+        &dir,
+        "d.cga",
+        "Lot --> print(scope.sx) print(scope.sz) print(geometry.area)\n",
+    );
+    let out = run(&["generate", rules.to_str().unwrap()]);
+    assert_eq!(stdout(&out), "20\n30\n600\n");
+}
+
+#[test]
+fn start_rule_comes_from_the_annotation_then_lot_then_the_option() {
+    let dir = temp_dir("start");
+    let annotated = rule_file(
+        &dir,
+        "a.cga",
+        "@StartRule\nInit --> print(\"init\")\nLot --> print(\"lot\")\n",
+    );
+    assert_eq!(
+        stdout(&run(&["generate", annotated.to_str().unwrap()])),
+        "init\n"
+    );
+    let plain = rule_file(
+        &dir,
+        "b.cga",
+        "Init --> print(\"init\")\nLot --> print(\"lot\")\n",
+    );
+    assert_eq!(
+        stdout(&run(&["generate", plain.to_str().unwrap()])),
+        "lot\n"
+    );
+    let chosen = run(&["generate", plain.to_str().unwrap(), "--start-rule", "Init"]);
+    assert_eq!(stdout(&chosen), "init\n");
+    let missing = run(&["generate", plain.to_str().unwrap(), "--start-rule", "Nope"]);
+    assert_eq!(missing.status.code(), Some(2));
+    assert!(stderr(&missing).contains("Nope"));
+}
+
+#[test]
+fn attributes_are_overridden_with_the_type_of_their_default() {
+    let dir = temp_dir("attrs");
+    let rules = rule_file(
+        &dir,
+        "a.cga",
+        "attr h = 10\nattr name = \"x\"\nattr on = false\n\
+         Lot --> print(h * 2) print(name + \"!\") print(on)\n",
+    );
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--attr",
+        "h=2.5",
+        "--attr",
+        "name=12",
+        "--attr",
+        "on=true",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(stdout(&out), "5\n12!\ntrue\n");
+    let unknown = run(&["generate", rules.to_str().unwrap(), "--attr", "height=3"]);
+    assert_eq!(unknown.status.code(), Some(2));
+    assert!(stderr(&unknown).contains("no attribute `height`"));
+}
+
+#[test]
+fn syntax_errors_give_file_line_column_source_line_and_exit_1() {
+    let dir = temp_dir("syntax");
+    let rules = rule_file(&dir, "bad.cga", "Lot -->\n    extrude(10\n    X.\n");
+    for cmd in ["check", "generate"] {
+        let out = run(&[cmd, rules.to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(1), "{cmd}");
+        let err = stderr(&out);
+        assert!(err.contains("bad.cga:3:5"), "{err}");
+        assert!(err.contains("expected"), "{err}");
+        assert!(err.contains("    X."), "the source line is shown: {err}");
+        assert!(stdout(&out).is_empty());
+    }
+}
+
+#[test]
+fn unknown_operation_names_the_closest_one() {
+    let dir = temp_dir("typo");
+    let rules = rule_file(&dir, "typo.cga", "Lot --> exturde(10) X.\n");
+    let out = run(&["check", rules.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert!(err.contains("typo.cga:1:9"), "{err}");
+    assert!(err.contains("did you mean `extrude`?"), "{err}");
+}
+
+#[test]
+fn check_accepts_a_valid_file() {
+    let dir = temp_dir("check-ok");
+    let rules = rule_file(&dir, "ok.cga", BOX);
+    let out = run(&["check", rules.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stdout(&out).is_empty());
+}
+
+#[test]
+fn runtime_errors_point_at_the_rule_and_keep_the_model() {
+    let dir = temp_dir("runtime");
+    let rules = rule_file(
+        &dir,
+        "rt.cga",
+        "Lot --> extrude(10) A\nA --> print(\"before\") s(\"wide\", '1, '1) X.\n",
+    );
+    let obj = dir.join("m.obj");
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "-o",
+        obj.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert!(err.contains("rt.cga:2:25"), "{err}");
+    assert!(err.contains("expected a float"), "{err}");
+    assert_eq!(stdout(&out), "before\n");
+    assert!(obj.exists(), "the model is written even when a lot fails");
+}
+
+#[test]
+fn usage_errors_exit_2() {
+    let dir = temp_dir("usage");
+    let rules = rule_file(&dir, "u.cga", BOX);
+    let r = rules.to_str().unwrap();
+    for args in [
+        vec!["generate", r, "--lot", "rect:20"],
+        vec!["generate", r, "--lot", "rect:-1,3"],
+        vec!["generate", r, "--lot", "nothing.shp"],
+        vec!["generate", r, "--lot", "missing.obj"],
+        vec!["generate", r, "-o", "model.xyz"],
+        vec!["generate", "no-such-file.cga"],
+        vec!["frobnicate"],
+    ] {
+        let out = run(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+    }
+}
+
+#[test]
+fn missing_asset_is_a_warning_and_the_model_is_still_written() {
+    let dir = temp_dir("asset");
+    let rules = rule_file(
+        &dir,
+        "a.cga",
+        "Lot --> extrude(10) [ i(\"nowhere/window.obj\") W. ] Mass.\n",
+    );
+    let obj = dir.join("m.obj");
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "-o",
+        obj.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("warning"));
+    assert!(stderr(&out).contains("nowhere/window.obj"));
+    let s = summarize(&obj);
+    // Both the mass and the shape that kept its geometry: 2 boxes of 2200 m².
+    assert_eq!(s.faces, 12);
+    assert!((s.area - 4400.0).abs() < 1e-6, "{}", s.area);
+}
+
+#[test]
+fn runaway_recursion_stops_at_the_depth_limit() {
+    let dir = temp_dir("depth");
+    let rules = rule_file(&dir, "r.cga", "Lot --> A\nA --> t(1, 0, 0) A\n");
+    let out = run(&["generate", rules.to_str().unwrap(), "--max-depth", "50"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert!(err.contains("depth limit (50)"), "{err}");
+    assert!(err.contains("r.cga:2:18"), "{err}");
+}
+
+#[test]
+fn shape_explosions_stop_at_the_shape_limit() {
+    let dir = temp_dir("shapes");
+    let rules = rule_file(&dir, "x.cga", "Lot --> A\nA --> A A\n");
+    let out = run(&["generate", rules.to_str().unwrap(), "--max-shapes", "1000"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("shape limit (1000)"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+#[test]
+fn reports_are_aggregated_per_key() {
+    let dir = temp_dir("report");
+    let rules = rule_file(
+        &dir,
+        "r.cga",
+        "Lot --> report(\"area\", geometry.area) A(3) A(5) report(\"kind\", \"lot\")\n\
+         A(x) --> report(\"x\", x) report(\"ok\", true)\n",
+    );
+    let json = dir.join("r.json");
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--report",
+        json.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["area_sum"], 600.0);
+    assert_eq!(v["x_n"], 2.0);
+    assert_eq!(v["x_sum"], 8.0);
+    assert_eq!(v["x_avg"], 4.0);
+    assert_eq!(v["x_min"], 3.0);
+    assert_eq!(v["x_max"], 5.0);
+    assert_eq!(v["ok_n"], 2.0);
+    assert_eq!(v["ok_sum"], true);
+    assert_eq!(v["kind_avg"], "lot");
+}
+
+#[test]
+fn obj_and_geojson_lots_give_one_initial_shape_per_polygon() {
+    let dir = temp_dir("lots");
+    let rules = rule_file(
+        &dir,
+        "l.cga",
+        "attr height = 3\nLot --> print(initialShape.name + \" \" + geometry.area + \" \" + height)\n",
+    );
+    let obj = dir.join("lots.obj");
+    std::fs::write(
+        &obj,
+        "v 0 0 0\nv 4 0 0\nv 4 0 -2\nv 0 0 -2\nv 10 0 0\nv 13 0 0\nv 13 0 -3\nf 1 2 3 4\nf 5 6 7\n",
+    )
+    .unwrap();
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--lot",
+        obj.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let lines: Vec<String> = stdout(&out)
+        .lines()
+        .map(|l| l.rsplit_once(' ').unwrap().0.to_string())
+        .collect();
+    assert_eq!(lines.len(), 2);
+    assert!(lines[0].ends_with(" 8"), "{lines:?}");
+    assert!(lines[1].ends_with(" 4.5"), "{lines:?}");
+
+    let gj = dir.join("lots.geojson");
+    std::fs::write(
+        &gj,
+        r#"{"type":"FeatureCollection","features":[
+          {"type":"Feature","id":"a","properties":{"height":12},"geometry":{"type":"Polygon",
+           "coordinates":[[[0,0],[10,0],[10,10],[0,10],[0,0]],[[2,2],[2,4],[4,4],[4,2],[2,2]]]}},
+          {"type":"Feature","id":"b","properties":{},"geometry":{"type":"MultiPolygon",
+           "coordinates":[[[[20,0],[22,0],[22,2],[20,2],[20,0]]],[[[30,0],[31,0],[31,1],[30,0]]]]}}]}"#,
+    )
+    .unwrap();
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--lot",
+        gj.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(stdout(&out), "a 96 12\nb 4 3\nb.1 0.5 3\n");
+}
+
+#[test]
+fn glb_gltf_and_obj_outputs_are_written() {
+    let dir = temp_dir("formats");
+    let rules = rule_file(
+        &dir,
+        "f.cga",
+        "Lot --> extrude(10) color(\"#ff0000\") Box.\n",
+    );
+    for ext in ["glb", "gltf", "obj"] {
+        let path = dir.join(format!("m.{ext}"));
+        let out = run(&[
+            "generate",
+            rules.to_str().unwrap(),
+            "-o",
+            path.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{ext}: {}", stderr(&out));
+        assert!(std::fs::metadata(&path).unwrap().len() > 100, "{ext}");
+    }
+    let s = summarize(&dir.join("m.obj"));
+    assert_eq!(
+        s.by_appearance.get("1.000,0.000,0.000|-").copied(),
+        Some(2200.0)
+    );
+    assert_eq!(s.min, [0.0, 0.0, -30.0]);
+    assert_eq!(s.max, [20.0, 10.0, 0.0]);
+}

@@ -68,6 +68,9 @@ struct GenerateArgs {
     /// Write the values of report() as JSON.
     #[arg(long, value_name = "FILE")]
     report: Option<PathBuf>,
+    /// Worker threads (default: all cores). The output does not depend on it.
+    #[arg(long, value_name = "N")]
+    jobs: Option<usize>,
     /// Maximum nesting of rule invocations.
     #[arg(long, default_value_t = Limits::default().max_depth)]
     max_depth: usize,
@@ -237,33 +240,76 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
         _ => None,
     };
 
-    let mut failed = false;
+    let jobs = args.jobs.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs.max(1))
+        .stack_size(DERIVATION_STACK)
+        .build()
+        .map_err(|e| Failure::Usage(format!("cannot start worker threads: {e}")))?;
+    let progress = progress_bar(lots.len());
+
+    let mut failed_lots = 0usize;
     let mut reports = report::Reports::default();
     let mut shapes = 0usize;
     let mut leaves = 0usize;
-    for (i, lot) in lots.iter().enumerate() {
-        let (out, error) = generate_lot(&program, &assets, rule, lot, i, &options);
-        {
-            use std::io::Write;
-            let mut stdout = std::io::stdout().lock();
-            for line in &out.prints {
-                let _ = writeln!(stdout, "{line}");
+    let mut seen_warnings = std::collections::HashSet::new();
+    // Lots are derived in parallel a batch at a time; their results are
+    // written in lot order, so the output does not depend on the thread count
+    // and memory holds one batch of results, not the whole city.
+    let batch = (jobs * 8).max(1);
+    for (b, chunk) in lots.chunks(batch).enumerate() {
+        let results: Vec<_> = pool.install(|| {
+            use rayon::prelude::*;
+            chunk
+                .par_iter()
+                .enumerate()
+                .map(|(j, lot)| generate_lot(&program, &assets, rule, lot, b * batch + j, &options))
+                .collect()
+        });
+        for (lot, (out, error)) in chunk.iter().zip(results) {
+            {
+                use std::io::Write;
+                let mut stdout = std::io::stdout().lock();
+                for line in &out.prints {
+                    let _ = writeln!(stdout, "{line}");
+                }
             }
-        }
-        report_diagnostics(&out.warnings, &sources);
-        if let Some(e) = error {
-            report_diagnostics(&[e.to_diagnostic()], &sources);
-            failed = true;
-        }
-        reports.add(&out.reports);
-        shapes += out.shapes;
-        leaves += out.meshes.len();
-        if let Some(w) = writer.as_mut() {
-            for m in &out.meshes {
-                w.add_mesh(m)
-                    .map_err(|e| Failure::Usage(format!("export failed: {e}")))?;
+            for w in &out.warnings {
+                if seen_warnings.insert((w.message.clone(), w.span)) {
+                    progress.suspend(|| report_diagnostics(std::slice::from_ref(w), &sources));
+                }
             }
+            if let Some(e) = error {
+                let mut d = e.to_diagnostic();
+                if lots.len() > 1 {
+                    d = d.with_note(format!("in lot `{}`", lot.name));
+                }
+                progress.suspend(|| report_diagnostics(&[d], &sources));
+                failed_lots += 1;
+            }
+            reports.add(&out.reports);
+            shapes += out.shapes;
+            leaves += out.meshes.len();
+            if let Some(w) = writer.as_mut() {
+                for m in &out.meshes {
+                    w.add_mesh(m)
+                        .map_err(|e| Failure::Usage(format!("export failed: {e}")))?;
+                }
+            }
+            progress.inc(1);
         }
+    }
+    progress.finish_and_clear();
+    let failed = failed_lots > 0;
+    if failed && lots.len() > 1 {
+        eprintln!(
+            "error: {failed_lots} of {} lots stopped on an error; the others were generated",
+            lots.len()
+        );
     }
     if let Some(w) = writer {
         let stats = w
@@ -293,6 +339,22 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
     } else {
         Ok(())
     }
+}
+
+/// A progress bar on standard error for long runs; hidden when standard
+/// error is not a terminal or there is a single lot.
+fn progress_bar(lots: usize) -> indicatif::ProgressBar {
+    use std::io::IsTerminal;
+    if lots < 2 || !std::io::stderr().is_terminal() {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(lots as u64);
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "{elapsed_precise} [{bar:40}] {pos}/{len} lots ({per_sec}, {eta} left)",
+    ) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar
 }
 
 /// Where textures named in the rules may be: the rule file's folder and its

@@ -42,6 +42,9 @@ enum Command {
     Check {
         /// The rule file.
         rules: PathBuf,
+        /// `text` for people, `json` (one object with all diagnostics) for tools.
+        #[arg(long, value_enum, default_value_t = CheckFormat::Text)]
+        format: CheckFormat,
     },
 }
 
@@ -79,6 +82,12 @@ struct GenerateArgs {
     max_shapes: usize,
 }
 
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum CheckFormat {
+    Text,
+    Json,
+}
+
 /// How a run ended.
 enum Failure {
     /// Errors in the rules (already reported): exit 1.
@@ -98,7 +107,7 @@ fn main() -> ExitCode {
         .stack_size(DERIVATION_STACK)
         .spawn(move || match cli.command {
             Command::Generate(args) => generate(args),
-            Command::Check { rules } => check(&rules),
+            Command::Check { rules, format } => check(&rules, format),
         });
     let result = match worker.map(|w| w.join()) {
         Ok(Ok(r)) => r,
@@ -136,17 +145,63 @@ fn load(path: &Path, sources: &mut SourceMap) -> Result<cga_engine::Program, Fai
     loaded.program.ok_or(Failure::Rules)
 }
 
-fn check(path: &Path) -> Result<(), Failure> {
+fn check(path: &Path, format: CheckFormat) -> Result<(), Failure> {
+    if format == CheckFormat::Text {
+        let mut sources = SourceMap::new();
+        let program = load(path, &mut sources)?;
+        eprintln!(
+            "{}: ok ({} rules, {} attributes, {} functions)",
+            path.display(),
+            program.rules.len(),
+            program.attrs.len(),
+            program.functions.len()
+        );
+        return Ok(());
+    }
+    if !path.is_file() {
+        return Err(Failure::Usage(format!(
+            "rule file {} not found",
+            path.display()
+        )));
+    }
     let mut sources = SourceMap::new();
-    let program = load(path, &mut sources)?;
-    eprintln!(
-        "{}: ok ({} rules, {} attributes, {} functions)",
-        path.display(),
-        program.rules.len(),
-        program.attrs.len(),
-        program.functions.len()
-    );
-    Ok(())
+    let loaded = cga_engine::load(path, &mut sources);
+    let diagnostics: Vec<serde_json::Value> = loaded
+        .diagnostics
+        .iter()
+        .map(|d| diagnostic_json(d, &sources))
+        .collect();
+    let ok = loaded.program.is_some();
+    let doc = serde_json::json!({ "file": path.display().to_string(), "ok": ok, "diagnostics": diagnostics });
+    println!("{}", serde_json::to_string_pretty(&doc).unwrap_or_default());
+    if ok {
+        Ok(())
+    } else {
+        Err(Failure::Rules)
+    }
+}
+
+/// A diagnostic as JSON for tools: severity, message, file, 1-based line and
+/// column of the start and end, label and notes.
+fn diagnostic_json(d: &Diagnostic, sources: &SourceMap) -> serde_json::Value {
+    let severity = if d.is_error() { "error" } else { "warning" };
+    let mut v = serde_json::json!({
+        "severity": severity,
+        "message": d.message,
+        "label": d.label,
+        "notes": d.notes,
+    });
+    if let Some(span) = d.span {
+        let file = sources.get(span.file);
+        let (line, column) = file.line_col(span.start);
+        let (end_line, end_column) = file.line_col(span.end);
+        v["file"] = file.path.display().to_string().into();
+        v["line"] = line.into();
+        v["column"] = column.into();
+        v["end_line"] = end_line.into();
+        v["end_column"] = end_column.into();
+    }
+    v
 }
 
 fn read_lots(specs: &[String]) -> Result<Vec<Lot>, Failure> {

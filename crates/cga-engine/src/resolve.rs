@@ -660,12 +660,23 @@ impl Resolver<'_> {
         candidates
             .into_iter()
             .map(|c| (strsim::damerau_levenshtein(name, c), c))
-            .filter(|&(d, c)| d <= 2.max(name.len() / 4) && d < c.len())
+            .filter(|&(d, c)| {
+                let allowed = match name.chars().count() {
+                    0..=3 => 1,
+                    4..=6 => 2,
+                    _ => 3,
+                };
+                d <= allowed && d < c.len()
+            })
             .min()
             .map(|(_, c)| c.to_string())
     }
 
     fn unknown(&mut self, what: &str, ident: &ast::Ident, rs: RuleSetId, kind: NameKind) {
+        if ident.name.is_empty() {
+            // The parser's stand-in for a missing expression: already reported.
+            return;
+        }
         let mut d = Diagnostic::error(format!("unknown {what} `{}`", ident.name), ident.span)
             .with_label(format!("not a known {what}"));
         if let Some(s) = self.suggest(rs, &ident.name, kind) {

@@ -206,7 +206,10 @@ pub fn assert_valid_gltf(file: &Path) {
             std::env::var("CGA_REQUIRE_GLTF_VALIDATOR").as_deref() != Ok("1"),
             "the glTF validator is not installed: run `npm ci --prefix tools/gltf-validator`"
         );
-        eprintln!("note: glTF validator not installed; not validating {}", file.display());
+        eprintln!(
+            "note: glTF validator not installed; not validating {}",
+            file.display()
+        );
         return;
     }
     let out = Command::new("node")
@@ -215,5 +218,8 @@ pub fn assert_valid_gltf(file: &Path) {
         .output()
         .expect("node runs the glTF validator");
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("a JSON report");
-    assert_eq!(report["issues"]["numErrors"], 0, "validator errors: {report:#}");
+    assert_eq!(
+        report["issues"]["numErrors"], 0,
+        "validator errors: {report:#}"
+    );
 }

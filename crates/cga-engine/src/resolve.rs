@@ -73,6 +73,9 @@ pub fn load(path: &Path, sources: &mut SourceMap) -> Loaded {
         rules.sort_by_key(|&(_, id)| id);
         r.program.main_rules = rules;
     }
+    // Report in file order, whatever stage found them.
+    r.diags
+        .sort_by_key(|d| d.span.map(|s| (s.file.0, s.start)).unwrap_or((0, 0)));
     let has_errors = r.diags.iter().any(|d| d.is_error());
     let mut program = r.program;
     program.symbols = {

@@ -261,6 +261,13 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
         let (name, value) = a
             .split_once('=')
             .ok_or_else(|| Failure::Usage(format!("expected --attr NAME=VALUE, found `{a}`")))?;
+        if name == "seed" && program.main_attr("seed").is_none() {
+            // As in CityEngine, `seed` is the initial shapes' random seed.
+            options.seed = value.trim().parse().map_err(|_| {
+                Failure::Usage(format!("the seed must be a whole number, found `{value}`"))
+            })?;
+            continue;
+        }
         let id = program.main_attr(name).ok_or_else(|| {
             let known: Vec<&str> = program.main_attrs.iter().map(|(n, _)| n.as_str()).collect();
             Failure::Usage(format!(

@@ -157,9 +157,15 @@ pub fn initial_shape(lot: &Lot, seed: u64, name: u32) -> Shape {
         comp: None,
         trim: TrimFlags::default(),
         projections: None,
-        rng: std::cell::Cell::new(seed ^ 0x5EED_0F_C6A_u64),
+        rng: std::cell::Cell::new(seed_stream(seed as f64)),
+        seedian: seed as f64,
         name,
     }
+}
+
+/// The random stream state that a seed value starts.
+pub fn seed_stream(seed: f64) -> u64 {
+    seed.to_bits() ^ 0x5EED_0F_C6A_u64
 }
 
 /// The normal of the first face and the direction of its first edge.

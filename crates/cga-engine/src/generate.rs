@@ -33,6 +33,17 @@ pub fn generate_lot(
     // Each lot has its own seed: the run's seed for the first lot, then the
     // following numbers (`--seed 666` on one lot gives `seedian` 666).
     let seed = options.seed.wrapping_add(lot_index as u64);
+    if let Some(why) = crate::lot::degenerate(lot) {
+        let mut out = LotOutput::default();
+        out.warnings.push(cga_syntax::Diagnostic {
+            severity: cga_syntax::Severity::Warning,
+            message: format!("lot `{}` is skipped: {why}", lot.name),
+            span: None,
+            label: None,
+            notes: Vec::new(),
+        });
+        return (out, None);
+    }
     let shape = initial_shape(lot, seed, program.rule_symbol(rule));
     let info = InitialInfo {
         name: lot.name.clone(),

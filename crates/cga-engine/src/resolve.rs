@@ -300,9 +300,23 @@ impl Resolver<'_> {
                 continue;
             };
             if self.stack.contains(&target) || target == path {
-                self.error(
-                    format!("import cycle: \"{}\" imports itself", decl.path),
-                    decl.path_span,
+                let name = |p: &Path| {
+                    p.file_name()
+                        .map(|n| n.to_string_lossy().into_owned())
+                        .unwrap_or_default()
+                };
+                let start = self.stack.iter().position(|p| *p == target);
+                let mut chain: Vec<String> = start
+                    .map(|i| self.stack[i..].iter().map(|p| name(p)).collect())
+                    .unwrap_or_default();
+                chain.push(name(&path));
+                chain.push(name(&target));
+                self.diags.push(
+                    Diagnostic::error(
+                        format!("import cycle: {}", chain.join(" imports ")),
+                        decl.path_span,
+                    )
+                    .with_label("this import closes the cycle"),
                 );
                 continue;
             }
@@ -1017,7 +1031,7 @@ impl Resolver<'_> {
         if !arities.is_empty() {
             self.error(
                 format!(
-                    "rule `{name}` takes {} parameters, called with {arity}",
+                    "rule `{name}` takes {} parameter(s), called with {arity}",
                     arities
                         .iter()
                         .map(|a| a.to_string())

@@ -13,6 +13,7 @@
 //! | [`primitive`] | `primitive*` and `builtin:cube` |
 //! | [`obj`] | OBJ + MTL assets |
 //! | [`transform`] | affine transforms, reversing, merging |
+//! | [`skeleton`] | weighted straight skeletons and wavefront offsets |
 
 pub mod cut;
 pub mod extrude;
@@ -21,6 +22,7 @@ pub mod measure;
 pub mod mesh;
 pub mod obj;
 pub mod primitive;
+pub mod skeleton;
 pub mod topology;
 pub mod transform;
 pub mod triangulate;

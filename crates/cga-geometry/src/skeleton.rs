@@ -342,6 +342,14 @@ struct Sim {
     /// For each edge, the vertices ever created with it as outgoing edge.
     verts_of_edge: Vec<Vec<u32>>,
     n_input_edges: usize,
+    /// Number of alive vertices.
+    alive: usize,
+    /// Split candidates `(time, edge)`, sorted per vertex; `cand_next[v]..
+    /// cand_end[v]` are those of vertex `v` not yet tried. Only the earliest
+    /// of each vertex is in the heap, which keeps the heap small.
+    cands: Vec<(f64, u32)>,
+    cand_next: Vec<u32>,
+    cand_end: Vec<u32>,
 }
 
 enum Motion {
@@ -382,6 +390,9 @@ impl Sim {
         });
         self.edges[eout as usize].active += 1;
         self.verts_of_edge[eout as usize].push(id);
+        self.alive += 1;
+        self.cand_next.push(0);
+        self.cand_end.push(0);
         id
     }
 
@@ -398,6 +409,7 @@ impl Sim {
         });
         self.verts[v as usize].alive = false;
         self.edges[vv.eout as usize].active -= 1;
+        self.alive -= 1;
     }
 
     fn link(&mut self, a: u32, b: u32) {
@@ -537,6 +549,7 @@ impl Sim {
         let vv = self.verts[v as usize];
         let t = self.tc;
         let p = vv.at(t);
+        self.cand_next[v as usize] = self.cands.len() as u32;
         for e in 0..self.edges.len() as u32 {
             if e == vv.ein || e == vv.eout {
                 continue;
@@ -553,9 +566,44 @@ impl Sim {
             if dist < -EPS {
                 continue;
             }
+            if dist <= EPS && self.edge_has_vertex_at(e, p, v) {
+                // The edge passes through v's point through one of its own
+                // vertices there: that meeting has just been resolved.
+                continue;
+            }
             let te = t + dist.max(0.0) / -rate;
+            self.cands.push((te, e));
+        }
+        let start = self.cand_next[v as usize] as usize;
+        self.cands[start..].sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+        self.cand_end[v as usize] = self.cands.len() as u32;
+        if start < self.cands.len() {
+            let (te, e) = self.cands[start];
+            self.cand_next[v as usize] += 1;
             self.push(te, Kind::Split { v, e });
         }
+    }
+
+    /// The next untried split candidate of `v`.
+    fn next_candidate(&mut self, v: u32) -> Option<(f64, u32)> {
+        let i = self.cand_next[v as usize];
+        if i >= self.cand_end[v as usize] {
+            return None;
+        }
+        self.cand_next[v as usize] += 1;
+        Some(self.cands[i as usize])
+    }
+
+    fn edge_has_vertex_at(&self, e: u32, p: DVec2, not: u32) -> bool {
+        let t = self.tc;
+        self.verts_of_edge[e as usize].iter().any(|&x| {
+            let vx = &self.verts[x as usize];
+            let vy = &self.verts[vx.next as usize];
+            x != not
+                && vx.alive
+                && vx.eout == e
+                && (vx.at(t).distance(p) <= EPS * 4.0 || vy.at(t).distance(p) <= EPS * 4.0)
+        })
     }
 
     fn collapse(&mut self, a: u32, b: u32, point: DVec2) {
@@ -588,6 +636,172 @@ impl Sim {
         self.link(v2, nv);
         self.settle(v1);
         self.settle(v2);
+    }
+
+    /// Resolves all wavefront vertices meeting at `p` now (a generalised
+    /// vertex event in the sense of Eppstein & Erickson): runs of consecutive
+    /// vertices there collapse to one, and the remaining runs are re-linked
+    /// by pairing, counter-clockwise around `p`, each outgoing edge with the
+    /// next incoming edge. Returns false (doing nothing) if the rays around
+    /// `p` do not alternate, which only inconsistent input produces.
+    fn vertex_event(&mut self, p: DVec2) -> bool {
+        let t = self.tc;
+        let tol = EPS * 4.0;
+        let members: Vec<u32> = (0..self.verts.len() as u32)
+            .filter(|&v| {
+                let x = &self.verts[v as usize];
+                x.alive && x.at(t).distance(p) <= tol
+            })
+            .collect();
+        if members.len() < 2 {
+            return false;
+        }
+        let is_member = |s: &Sim, v: u32| members.contains(&v) && s.verts[v as usize].alive;
+        // Runs of consecutive members: (first, last).
+        // Loops entirely at p have no run start: they are simply removed.
+        let mut chains: Vec<(u32, u32)> = Vec::new();
+        for &m in &members {
+            let prev = self.verts[m as usize].prev;
+            if is_member(self, prev) {
+                continue;
+            }
+            let mut last = m;
+            let mut guard = 0;
+            while is_member(self, self.verts[last as usize].next) && guard < members.len() {
+                last = self.verts[last as usize].next;
+                guard += 1;
+            }
+            chains.push((m, last));
+        }
+        let mut rays: Vec<(f64, u8, usize)> = Vec::with_capacity(chains.len() * 2);
+        for (k, &(a, b)) in chains.iter().enumerate() {
+            let ein = self.edges[self.verts[a as usize].ein as usize].dir;
+            let eout = self.edges[self.verts[b as usize].eout as usize].dir;
+            rays.push((eout.y.atan2(eout.x), 0, k));
+            rays.push(((-ein.y).atan2(-ein.x), 1, k));
+        }
+        rays.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+        let m = rays.len();
+        let mut pairs: Vec<(usize, usize)> = Vec::with_capacity(chains.len());
+        let mut used = vec![false; chains.len()];
+        if chains.len() == 1 {
+            pairs.push((0, 0));
+        } else if chains.len() > 1 {
+            for i in 0..m {
+                if rays[i].1 != 0 {
+                    continue;
+                }
+                let mut j = (i + 1) % m;
+                while rays[j].1 != 1 {
+                    j = (j + 1) % m;
+                }
+                let k = rays[j].2;
+                if used[k] {
+                    return false;
+                }
+                used[k] = true;
+                pairs.push((k, rays[i].2)); // (in-chain, out-chain)
+            }
+        }
+        let node = self.node(p, t);
+        let ends: Vec<(u32, u32, u32, u32)> = chains
+            .iter()
+            .map(|&(a, b)| {
+                let va = self.verts[a as usize];
+                let vb = self.verts[b as usize];
+                (va.prev, va.ein, vb.eout, vb.next)
+            })
+            .collect();
+        for &mm in &members {
+            self.kill(mm, node);
+        }
+        // Each chain's outside neighbours are not members, and each is used
+        // by exactly one pair, so the links are consistent.
+        let mut created = Vec::with_capacity(pairs.len());
+        for &(ki, ko) in &pairs {
+            let (prev, ein, _, _) = ends[ki];
+            let (_, _, eout, next) = ends[ko];
+            let c = self.new_vert(p, ein, eout, node);
+            created.push((c, prev, next));
+        }
+        for &(c, prev, next) in &created {
+            self.link(prev, c);
+            self.link(c, next);
+        }
+        for &(c, _, _) in &created {
+            self.settle(c);
+        }
+        true
+    }
+
+    /// Performs the split of `v` against `e` now if it is valid; returns
+    /// whether it was.
+    fn try_split(&mut self, v: u32, e: u32) -> bool {
+        let vv = self.verts[v as usize];
+        if !vv.alive || !vv.ready || self.edges[e as usize].active == 0 {
+            return false;
+        }
+        let t = self.tc;
+        let p = vv.at(t);
+        let ed = self.edges[e as usize];
+        let tol = EPS * (1.0 + vv.vel.length());
+        let mut found = None;
+        for &x in &self.verts_of_edge[e as usize] {
+            let vx = self.verts[x as usize];
+            if !vx.alive || vx.eout != e || !vx.ready {
+                continue;
+            }
+            let y = vx.next;
+            let vy = self.verts[y as usize];
+            if !vy.ready {
+                continue;
+            }
+            let xt = vx.at(t);
+            let yt = vy.at(t);
+            let s = (p - xt).dot(ed.dir);
+            let len = (yt - xt).dot(ed.dir);
+            if s >= -tol && s <= len + tol && (p - xt).dot(ed.n).abs() <= tol * 10.0 {
+                found = Some((x, y));
+                break;
+            }
+        }
+        if let Some((x, y)) = found {
+            // Insert a flat vertex on the edge at the hit point unless
+            // an end of the segment is there already, then resolve
+            // everything that meets at the point at once.
+            let tol_p = EPS * 4.0;
+            let xt = self.verts[x as usize].at(t);
+            let yt = self.verts[y as usize].at(t);
+            let near_end = p.distance(xt) <= tol_p || p.distance(yt) <= tol_p;
+            let flat = if near_end {
+                NONE
+            } else {
+                let node = self.node(p, t);
+                let f = self.new_vert(p, e, e, node);
+                self.verts[f as usize].ready = true;
+                self.verts[f as usize].vel = DVec2::ZERO;
+                self.link(x, f);
+                self.link(f, y);
+                f
+            };
+            if !self.vertex_event(p) {
+                // Unresolvable configuration: fall back to the plain
+                // split of the segment (the result is checked later).
+                if flat != NONE && self.verts[flat as usize].alive {
+                    self.verts[flat as usize].alive = false;
+                    self.edges[e as usize].active -= 1;
+                    self.alive -= 1;
+                    self.link(x, y);
+                }
+                if self.verts[v as usize].alive
+                    && self.verts[x as usize].alive
+                    && self.verts[x as usize].next == y
+                {
+                    self.split(v, e, x, y, p);
+                }
+            }
+        }
+        found.is_some()
     }
 
     fn replace(&mut self, v: u32) {
@@ -634,48 +848,17 @@ impl Sim {
                 self.collapse(a, b, point);
             }
             Kind::Split { v, e } => {
-                let vv = self.verts[v as usize];
-                if !vv.alive || !vv.ready || self.edges[e as usize].active == 0 {
-                    return;
-                }
-                let t = self.tc;
-                let p = vv.at(t);
-                let ed = self.edges[e as usize];
-                let tol = EPS * (1.0 + vv.vel.length());
-                let mut found = None;
-                for &x in &self.verts_of_edge[e as usize] {
-                    let vx = self.verts[x as usize];
-                    if !vx.alive || vx.eout != e || !vx.ready {
-                        continue;
-                    }
-                    let y = vx.next;
-                    let vy = self.verts[y as usize];
-                    if !vy.ready {
-                        continue;
-                    }
-                    let xt = vx.at(t);
-                    let yt = vy.at(t);
-                    let s = (p - xt).dot(ed.dir);
-                    let len = (yt - xt).dot(ed.dir);
-                    if s >= -tol && s <= len + tol && (p - xt).dot(ed.n).abs() <= tol * 10.0 {
-                        found = Some((x, y));
-                        break;
-                    }
-                }
-                if let Some((x, y)) = found {
-                    self.split(v, e, x, y, p);
-                }
+                self.try_split(v, e);
             }
             Kind::Weight { e, w } => {
                 let t = self.tc;
                 let ed = &mut self.edges[e as usize];
                 ed.c += (ed.w - w) * t;
                 ed.w = w;
+                // All vertices are renewed: split candidates against this
+                // edge are stale, and they are recomputed with the vertices.
                 let affected: Vec<u32> = (0..self.verts.len() as u32)
-                    .filter(|&v| {
-                        let x = self.verts[v as usize];
-                        x.alive && (x.ein == e || x.eout == e)
-                    })
+                    .filter(|&v| self.verts[v as usize].alive)
                     .collect();
                 for v in affected {
                     self.replace(v);
@@ -783,6 +966,10 @@ fn run(
         tc: 0.0,
         verts_of_edge: Vec::with_capacity(n_edges),
         n_input_edges: n_edges,
+        alive: 0,
+        cands: Vec::with_capacity(n_edges * 8),
+        cand_next: Vec::with_capacity(n_edges * 3),
+        cand_end: Vec::with_capacity(n_edges * 3),
     };
     for p in loops_in.iter().flatten() {
         let q = norm(*p, &mut k);
@@ -903,6 +1090,7 @@ fn run(
     let mut processed = 0usize;
     let pop_budget = budget * (all.len() + 8) * 4;
     let mut pops = 0usize;
+    let (mut instant_t, mut instant_n, mut instant_limit) = (f64::NEG_INFINITY, 0usize, 0usize);
     while let Some(ev) = sim.heap.peek().copied() {
         pops += 1;
         if pops > pop_budget {
@@ -925,10 +1113,46 @@ fn run(
         sim.heap.pop();
         sim.tc = t;
         let before = sim.pieces.len();
-        sim.process(ev);
+        if let Kind::Split { v, e } = ev.kind {
+            // Try the candidates of v in time order; those before the next
+            // queued event are checked right here (nothing moves differently
+            // until then), the first later one goes back into the queue.
+            let mut e = e;
+            while sim.verts[v as usize].alive && !sim.try_split(v, e) {
+                let Some((t2, e2)) = sim.next_candidate(v) else {
+                    break;
+                };
+                let limit = sim.heap.peek().map_or(f64::INFINITY, |x| x.t);
+                let inline = target_area.is_none() && t2 <= limit && stop_t.is_none_or(|s| t2 <= s);
+                if inline {
+                    sim.tc = t2.max(sim.tc);
+                    e = e2;
+                } else {
+                    sim.push(t2, Kind::Split { v, e: e2 });
+                    break;
+                }
+            }
+        } else {
+            sim.process(ev);
+        }
         if sim.pieces.len() != before {
             processed += 1;
             if processed > budget {
+                return Err(SkeletonError::EventLimit);
+            }
+            // Events at one instant are bounded by the wavefront's size; more
+            // means a cycle among coincident events (a split re-created by
+            // the collapse it causes): give up early, the caller retries on
+            // a perturbed copy.
+            if t - instant_t > EPS {
+                instant_t = t;
+                instant_n = 0;
+            }
+            instant_n += 1;
+            if instant_n == 1 {
+                instant_limit = 4 * sim.alive + 64;
+            }
+            if instant_n > instant_limit {
                 return Err(SkeletonError::EventLimit);
             }
         }

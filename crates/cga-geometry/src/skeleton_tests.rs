@@ -146,7 +146,12 @@ proptest! {
         if w.iter().all(|&x| x == 0.0) { w[0] = 1.0; }
         let w = vec![w];
         let loops = vec![p];
-        let s = skeleton(&loops, &w, StopAt::Collapse, &[]).map_err(|e| TestCaseError::fail(format!("{e:?} {loops:?} {w:?}")))?;
+        let s = skeleton(&loops, &w, StopAt::Collapse, &[]);
+        // With zero weights the moving edges may all vanish, leaving a static rest.
+        if s == Err(SkeletonError::NoCollapse) && w[0].contains(&0.0) {
+            return Ok(());
+        }
+        let s = s.map_err(|e| TestCaseError::fail(format!("{e:?} {loops:?} {w:?}")))?;
         check(&loops, &w, &s).map_err(|e| TestCaseError::fail(format!("{e} {loops:?} {w:?}")))?;
     }
 
@@ -176,4 +181,153 @@ proptest! {
         let s = skeleton(&loops, &w, StopAt::Collapse, &[]).map_err(|e| TestCaseError::fail(format!("{e:?} {loops:?}")))?;
         check(&loops, &w, &s).map_err(|e| TestCaseError::fail(format!("{e} {loops:?}")))?;
     }
+}
+
+#[test]
+fn random_polygons_succeed_on_first_attempt() {
+    use proptest::strategy::ValueTree;
+    use proptest::test_runner::TestRunner;
+    let mut runner = TestRunner::deterministic();
+    let strat = (
+        prop::collection::vec(0.0..std::f64::consts::TAU, 3..60),
+        prop::collection::vec(0.3f64..1.0, 60),
+        prop::collection::vec(1u8..6, 1..30),
+    );
+    let (mut fails, mut total, mut hfails) = (0, 0, 0);
+    for _ in 0..2000 {
+        let (angles, radii, h) = strat.new_tree(&mut runner).unwrap().current();
+        if max_gap(&angles) < 3.0 {
+            let p = star(&angles, &radii, DVec2::ZERO, 10.0, true);
+            if p.len() >= 3 {
+                let w = vec![vec![1.0; p.len()]];
+                total += 1;
+                if run(&[p], &w, StopAt::Collapse, &[], 0.0).is_err() {
+                    fails += 1;
+                }
+            }
+        }
+        let p = histogram(&h);
+        let w = vec![vec![1.0; p.len()]];
+        if run(&[p.clone()], &w, StopAt::Collapse, &[], 0.0).is_err() {
+            hfails += 1;
+        }
+    }
+    // The perturbed retry is a safety net, not the rule.
+    assert!(total > 1000);
+    assert_eq!((fails, hfails), (0, 0));
+}
+
+/// Timing of a 200-vertex concave footprint: run with
+/// `cargo test --release -p cga-geometry skeleton_timing -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn skeleton_timing() {
+    let n = 200;
+    let p: Vec<DVec2> = (0..n)
+        .map(|i| {
+            let a = i as f64 * std::f64::consts::TAU / n as f64;
+            let r = if i % 2 == 0 {
+                10.0
+            } else {
+                7.0 + (i % 7) as f64 * 0.3
+            };
+            DVec2::new(a.cos(), a.sin()) * r
+        })
+        .collect();
+    let w = vec![vec![1.0; n]];
+    let loops = vec![p];
+    let iters = 200;
+    let t0 = std::time::Instant::now();
+    for _ in 0..iters {
+        let s = skeleton(&loops, &w, StopAt::Collapse, &[]).unwrap();
+        assert_eq!(s.faces.len(), n);
+    }
+    let dt = t0.elapsed().as_secs_f64() / iters as f64;
+    eprintln!("200-vertex skeleton: {:.1} us", dt * 1e6);
+    let h = histogram(&[
+        3, 1, 4, 1, 5, 2, 6, 2, 5, 3, 5, 1, 4, 2, 3, 1, 4, 1, 5, 2, 6, 2, 5, 3, 5, 1, 4, 2, 3, 1,
+        4, 1, 5, 2, 6, 2, 5, 3, 5, 1, 4, 2, 3, 1, 4, 1, 5, 2, 6, 2,
+    ]);
+    let w = vec![vec![1.0; h.len()]];
+    let m = h.len();
+    let loops = vec![h];
+    let t0 = std::time::Instant::now();
+    for _ in 0..iters {
+        skeleton(&loops, &w, StopAt::Collapse, &[]).unwrap();
+    }
+    let dt = t0.elapsed().as_secs_f64() / iters as f64;
+    eprintln!("{m}-vertex rectilinear skeleton: {:.1} us", dt * 1e6);
+}
+
+/// Symmetric stars: several reflex vertices meet at the centre at once
+/// (vertex events), on the first attempt, without the perturbed retry.
+#[test]
+fn symmetric_stars_vertex_events() {
+    for n in (8usize..90).step_by(2) {
+        let p: Vec<DVec2> = (0..n)
+            .map(|i| {
+                let a = i as f64 * std::f64::consts::TAU / n as f64;
+                let r = if i % 2 == 0 {
+                    10.0
+                } else {
+                    7.0 + (i % 7) as f64 * 0.3
+                };
+                DVec2::new(a.cos(), a.sin()) * r
+            })
+            .collect();
+        let w = vec![vec![1.0; n]];
+        let loops = vec![p];
+        let s =
+            run(&loops, &w, StopAt::Collapse, &[], 0.0).unwrap_or_else(|e| panic!("n={n}: {e:?}"));
+        check(&loops, &w, &s).unwrap_or_else(|e| panic!("n={n}: {e}"));
+    }
+    // A regular star: all reflex vertices meet at the centre together.
+    for n in [3usize, 4, 5, 8] {
+        let p: Vec<DVec2> = (0..2 * n)
+            .map(|i| {
+                let a = i as f64 * std::f64::consts::PI / n as f64;
+                DVec2::new(a.cos(), a.sin()) * if i % 2 == 0 { 10.0 } else { 4.0 }
+            })
+            .collect();
+        let w = vec![vec![1.0; 2 * n]];
+        let loops = vec![p];
+        let s = skeleton(&loops, &w, StopAt::Collapse, &[]).unwrap();
+        check(&loops, &w, &s).unwrap();
+    }
+}
+
+#[test]
+fn one_moving_edge_sweeps_the_square() {
+    let sq = vec![v(0.0, 0.0), v(4.0, 0.0), v(4.0, 4.0), v(0.0, 4.0)];
+    let w = vec![vec![2.0, 0.0, 0.0, 0.0]];
+    let loops = vec![sq];
+    let s = skeleton(&loops, &w, StopAt::Collapse, &[]).unwrap();
+    check(&loops, &w, &s).unwrap();
+    assert!((face_area(&s, &s.faces[0]) - 16.0).abs() < 1e-9);
+    assert!((s.stop_time - 2.0).abs() < 1e-12);
+    // Stopped half way it is a setback of depth 2 along the front.
+    let s = skeleton(&loops, &w, StopAt::Time(0.5), &[]).unwrap();
+    assert!((face_area(&s, &s.faces[0]) - 4.0).abs() < 1e-9);
+    assert_eq!(s.wavefront.len(), 1);
+    assert_eq!(s.wavefront[0].len(), 4);
+}
+
+#[test]
+fn static_remainder_does_not_collapse() {
+    // A spike that is the only moving part vanishes; the rest never moves.
+    let p = vec![
+        v(0.0, 0.0),
+        v(4.0, 0.0),
+        v(4.0, 4.0),
+        v(2.0, 4.0),
+        v(2.0, 8.0),
+        v(1.0, 8.0),
+        v(1.0, 4.0),
+        v(0.0, 4.0),
+    ];
+    let w = vec![vec![0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0]];
+    assert_eq!(
+        skeleton(&[p], &w, StopAt::Collapse, &[]),
+        Err(SkeletonError::NoCollapse)
+    );
 }

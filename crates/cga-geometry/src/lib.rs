@@ -13,6 +13,7 @@
 //! | [`primitive`] | `primitive*` and `builtin:cube` |
 //! | [`obj`] | OBJ + MTL assets |
 //! | [`transform`] | affine transforms, reversing, merging |
+//! | [`roof`] | `roofHip`, `roofGable`, `roofPyramid`, `roofShed`, `roofRidge` |
 //! | [`skeleton`] | weighted straight skeletons and wavefront offsets |
 
 pub mod cut;
@@ -22,6 +23,7 @@ pub mod measure;
 pub mod mesh;
 pub mod obj;
 pub mod primitive;
+pub mod roof;
 pub mod skeleton;
 pub mod topology;
 pub mod transform;
@@ -33,5 +35,7 @@ pub use glam::{DAffine3, DMat3, DQuat, DVec2, DVec3};
 pub use material::{Material, TextureChannel, TEXTURE_CHANNELS};
 pub use mesh::{Face, Loop, Mesh, UV_SETS};
 pub use obj::{load_obj, parse_obj, ObjAsset, ObjError};
+pub use roof::{roof, Roof, RoofEdgeKind, RoofFaceRole, RoofKind, RoofSlope, SourceEdge};
+pub use skeleton::{skeleton, straight_skeleton, Skeleton, SkeletonError, StopAt, WeightChange};
 pub use topology::Topology;
 pub use triangulate::triangulate_face;

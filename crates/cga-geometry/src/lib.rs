@@ -14,6 +14,7 @@
 //! | [`obj`] | OBJ + MTL assets |
 //! | [`transform`] | affine transforms, reversing, merging |
 //! | [`roof`] | `roofHip`, `roofGable`, `roofPyramid`, `roofShed`, `roofRidge` |
+//! | [`setback`] | `offset`, `setback`, `setbackToArea`, `shapeL/U/O` |
 //! | [`skeleton`] | weighted straight skeletons and wavefront offsets |
 
 pub mod cut;
@@ -24,6 +25,7 @@ pub mod mesh;
 pub mod obj;
 pub mod primitive;
 pub mod roof;
+pub mod setback;
 pub mod skeleton;
 pub mod topology;
 pub mod transform;
@@ -36,6 +38,9 @@ pub use material::{Material, TextureChannel, TEXTURE_CHANNELS};
 pub use mesh::{Face, Loop, Mesh, UV_SETS};
 pub use obj::{load_obj, parse_obj, ObjAsset, ObjError};
 pub use roof::{roof, Roof, RoofEdgeKind, RoofFaceRole, RoofKind, RoofSlope, SourceEdge};
+pub use setback::{
+    merge_strips, offset, setback, setback_to_area, Offset, OffsetFace, SetbackEdgeTag,
+};
 pub use skeleton::{skeleton, straight_skeleton, Skeleton, SkeletonError, StopAt, WeightChange};
 pub use topology::Topology;
 pub use triangulate::triangulate_face;

@@ -544,15 +544,15 @@ impl Builder {
             pos_of[i]
         };
         let mut g = 0;
-        for (l, pts) in loops2.iter().enumerate() {
-            for i in 0..pts.len() {
+        for (l, wl) in w.iter().enumerate() {
+            for (i, &wi) in wl.iter().enumerate() {
                 let face = &sk.faces[g];
                 g += 1;
                 if face.len() < 3 {
                     continue;
                 }
                 let ids: Vec<u32> = face.iter().map(|&nd| idx(nd, &mut self.out)).collect();
-                let role = if w[l][i] > 0.0 {
+                let role = if wi > 0.0 {
                     RoofFaceRole::Top
                 } else {
                     RoofFaceRole::Side

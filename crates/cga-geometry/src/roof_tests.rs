@@ -354,3 +354,52 @@ proptest! {
         prop_assert!(Topology::new(&r.mesh).is_closed(&r.mesh));
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    /// Degenerate input never panics and ends quickly: random points on a
+    /// coarse grid (collinear runs, repeated points, zero-length edges,
+    /// spikes, self-intersections), through every roof, offset and setback.
+    #[test]
+    fn degenerate_footprints_do_not_panic(pts in prop::collection::vec((0i32..4, 0i32..4), 0..14),
+                                          hole in prop::collection::vec((0i32..4, 0i32..4), 0..5),
+                                          d in -2.0f64..2.0) {
+        let p: Vec<(f64, f64)> = pts.iter().map(|&(x, z)| (x as f64 * 2.5, -z as f64 * 2.5)).collect();
+        let h: Vec<(f64, f64)> = hole.iter().map(|&(x, z)| (x as f64 * 2.5, -z as f64 * 2.5)).collect();
+        let m = if h.len() >= 3 { footprint(&[&p, &h]) } else { footprint(&[&p]) };
+        let started = std::time::Instant::now();
+        for kind in [
+            RoofKind::Hip { overhang: 0.5, even: true },
+            RoofKind::Gable { overhang_x: 0.0, overhang_y: 0.0, even: false, index: None },
+            RoofKind::Gable { overhang_x: 1.0, overhang_y: 1.0, even: false, index: Some(2) },
+            RoofKind::Pyramid,
+            RoofKind::Shed { index: 1 },
+            RoofKind::Ridge { ridge: DVec3::X },
+        ] {
+            let _ = roof(&m, RoofSlope::Angle(30.0), kind);
+            let _ = roof(&m, RoofSlope::Height(2.0), kind);
+        }
+        let _ = crate::setback::offset(&m, d);
+        let _ = crate::setback::setback(&m, &[d.abs(), 0.0, 1.0, d]);
+        let _ = crate::setback::setback_to_area(&m, 3.0, &[true; 20], None, None);
+        prop_assert!(started.elapsed().as_secs_f64() < 2.0);
+    }
+
+    /// Nearly parallel and nearly collinear edges.
+    #[test]
+    fn nearly_collinear(eps in prop::collection::vec(-1e-7f64..1e-7, 8), k in 3usize..8) {
+        let mut p: Vec<(f64, f64)> = Vec::new();
+        for i in 0..=k {
+            p.push((i as f64 * 10.0 / k as f64, eps[i % 8]));
+        }
+        p.push((10.0, -5.0 + eps[1]));
+        p.push((0.0, -5.0 + eps[2]));
+        let m = footprint(&[&p]);
+        let r = roof(&m, RoofSlope::Angle(45.0), RoofKind::Hip { overhang: 0.0, even: false });
+        if r.failed.is_empty() {
+            let sum: f64 = (1..r.mesh.faces.len()).map(|f| projected_area(&r.mesh, f, DVec3::Y)).sum();
+            prop_assert!((sum - crate::measure::face_area(&m, 0)).abs() < 1e-6);
+        }
+    }
+}

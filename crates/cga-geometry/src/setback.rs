@@ -246,7 +246,7 @@ pub fn setback_to_area(
     };
     let at_min = setback(mesh, &lo);
     let a0 = remainder_area(&at_min);
-    if !(area > 0.0) || a0 <= area {
+    if area.is_nan() || area <= 0.0 || a0 <= area {
         return (at_min, lo, a0 == area);
     }
     let s = if mesh.faces.len() == 1 {
@@ -506,11 +506,11 @@ fn strips_and_remainder(
     let stop = sk.stop_time;
     let tol = 1e-9 * (1.0 + stop);
     let mut g = 0;
-    for (l, pts) in flat.loops.iter().enumerate() {
-        for i in 0..pts.len() {
+    for (l, wl) in w.iter().enumerate() {
+        for (i, &wi) in wl.iter().enumerate() {
             let face = &sk.faces[g];
             g += 1;
-            if w[l][i] <= 0.0 || face.len() < 3 {
+            if wi <= 0.0 || face.len() < 3 {
                 continue;
             }
             let p3: Vec<DVec3> = face

@@ -980,16 +980,15 @@ fn run(
     let mut base = 0usize;
     let mut loop_verts: Vec<Vec<u32>> = Vec::new();
     let mut any = false;
-    for (l, pts) in loops_in.iter().enumerate() {
+    for (pts, wl) in loops_in.iter().zip(weights) {
         let n = pts.len();
-        for i in 0..n {
+        for (i, &w) in wl.iter().enumerate() {
             let a = sim.nodes[base + i];
             let b = sim.nodes[base + (i + 1) % n];
             let d = b - a;
             let len = d.length();
             let dir = if len > EPS { d / len } else { DVec2::X };
             let nn = dir.perp();
-            let w = weights[l][i];
             sim.edges.push(Edge {
                 dir,
                 n: nn,

@@ -208,7 +208,7 @@ fn random_polygons_succeed_on_first_attempt() {
         }
         let p = histogram(&h);
         let w = vec![vec![1.0; p.len()]];
-        if run(&[p.clone()], &w, StopAt::Collapse, &[], 0.0).is_err() {
+        if run(std::slice::from_ref(&p), &w, StopAt::Collapse, &[], 0.0).is_err() {
             hfails += 1;
         }
     }

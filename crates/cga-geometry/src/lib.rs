@@ -10,6 +10,7 @@
 //! | [`triangulate`] | faces to triangles for export |
 //! | [`cut`] | plane cuts with caps: `split`, trim planes |
 //! | [`extrude`] | `extrude` |
+//! | [`inner_rect`] | `innerRectangle` |
 //! | [`primitive`] | `primitive*` and `builtin:cube` |
 //! | [`obj`] | OBJ + MTL assets |
 //! | [`transform`] | affine transforms, reversing, merging |
@@ -19,6 +20,7 @@
 
 pub mod cut;
 pub mod extrude;
+pub mod inner_rect;
 pub mod material;
 pub mod measure;
 pub mod mesh;
@@ -34,6 +36,7 @@ pub mod triangulate;
 pub use cut::{cut_by_plane, split_along_axis, split_by_parallel_planes};
 pub use extrude::{extrude, extrude_with_roles, ExtrudeRole, Extrusion};
 pub use glam::{DAffine3, DMat3, DQuat, DVec2, DVec3};
+pub use inner_rect::{inner_rectangle, largest_inner_rectangle};
 pub use material::{Material, TextureChannel, TEXTURE_CHANNELS};
 pub use mesh::{Face, Loop, Mesh, UV_SETS};
 pub use obj::{load_obj, parse_obj, ObjAsset, ObjError};

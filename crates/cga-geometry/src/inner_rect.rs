@@ -324,7 +324,7 @@ mod tests {
         assert!((rect_area(&r) - 4.0).abs() < 0.05, "{}", rect_area(&r));
         // A square rotated by 45 degrees, aligned with its edge: the whole square.
         let s = vec![v(0.0, -1.0), v(1.0, 0.0), v(0.0, 1.0), v(-1.0, 0.0)];
-        let r = largest_inner_rectangle(&[s.clone()], v(1.0, 1.0)).unwrap();
+        let r = largest_inner_rectangle(std::slice::from_ref(&s), v(1.0, 1.0)).unwrap();
         assert!((rect_area(&r) - 2.0).abs() < 1e-9);
         // Axis-aligned in the diamond: the inscribed square of area 1.
         let r = largest_inner_rectangle(&[s], DVec2::X).unwrap();

@@ -9,11 +9,13 @@
 //! | [`topology`] | welding, unique edges with their faces (`comp(e)` order), closedness |
 //! | [`triangulate`] | faces to triangles for export |
 //! | [`cut`] | plane cuts with caps: `split`, trim planes |
+//! | [`area_split`] | the area left of a moving plane and its inverse: `splitArea` |
 //! | [`extrude`] | `extrude` |
 //! | [`primitive`] | `primitive*` and `builtin:cube` |
 //! | [`obj`] | OBJ + MTL assets |
 //! | [`transform`] | affine transforms, reversing, merging |
 
+pub mod area_split;
 pub mod cut;
 pub mod extrude;
 pub mod material;
@@ -25,6 +27,7 @@ pub mod topology;
 pub mod transform;
 pub mod triangulate;
 
+pub use area_split::{split_by_areas, AreaProfile, Flatness};
 pub use cut::{cut_by_plane, split_along_axis, split_by_parallel_planes};
 pub use extrude::{extrude, extrude_with_roles, ExtrudeRole, Extrusion};
 pub use glam::{DAffine3, DMat3, DQuat, DVec2, DVec3};

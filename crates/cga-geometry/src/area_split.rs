@@ -46,7 +46,7 @@
 use glam::DVec3;
 
 use crate::cut::split_by_parallel_planes;
-use crate::measure::loop_newell;
+use crate::measure::{loop_newell, mesh_area};
 use crate::mesh::Mesh;
 
 /// Faces with `|n × d|^2` at or below this (within about 1e-6 rad of being
@@ -121,6 +121,8 @@ pub struct AreaProfile {
     f_start: Vec<f64>,
     f_end: Vec<f64>,
     total: f64,
+    /// The unit direction the profile was built for.
+    dir: DVec3,
     weighted_normal: DVec3,
     face_area: f64,
     out_of_plane: f64,
@@ -156,6 +158,7 @@ impl AreaProfile {
         self.jumps.clear();
         self.active.clear();
         self.total = 0.0;
+        self.dir = DVec3::ZERO;
         self.weighted_normal = DVec3::ZERO;
         self.face_area = 0.0;
         self.out_of_plane = 0.0;
@@ -165,6 +168,7 @@ impl AreaProfile {
             return;
         }
         let dir = dir / len;
+        self.dir = dir;
         for face in 0..mesh.faces.len() {
             self.add_face(mesh, face, dir);
         }
@@ -419,6 +423,80 @@ impl AreaProfile {
         out.clear();
         out.extend(areas.iter().map(|&a| self.position_of(a)));
     }
+
+    /// Where to cut `mesh` (the mesh this profile was built from) so that
+    /// the slab between the cuts for `bounds[i - 1]` and `bounds[i]` has
+    /// area `bounds[i] - bounds[i - 1]` as [`mesh_area`] measures it, and
+    /// the part below the first cut `bounds[0]`. `bounds` are cumulative
+    /// areas, ascending; the positions go to `out` (cleared first),
+    /// non-decreasing.
+    ///
+    /// For planar faces these are [`position_of`](Self::position_of)
+    /// exactly. A face bent out of its plane is measured by the profile in
+    /// its best-fit plane, but each cut piece of it is measured in the
+    /// piece's own best-fit plane, which differs by the square of the bend
+    /// (for a narrow piece of a bent face, 1e-5 of its area is common). So
+    /// when some face is not planar, each cut is polished by a few Newton
+    /// steps on the measured area of the actual slab, with the profile's
+    /// cross-section as the derivative (a cut of the whole mesh per step).
+    /// Closed meshes are not polished: their parts get caps the profile does
+    /// not count, so no cut can match.
+    pub fn cut_positions(&self, mesh: &Mesh, bounds: &[f64], out: &mut Vec<f64>) {
+        self.positions_of(bounds, out);
+        let flat = self.flatness();
+        if flat.out_of_plane <= 1e-10 || flat.normal_agreement < 0.5 || self.xs.is_empty() {
+            return;
+        }
+        let end = self.xs[self.xs.len() - 1];
+        let tol = 1e-13 * self.total;
+        let mut prev_t = f64::NEG_INFINITY;
+        let mut prev_area = 0.0;
+        for (i, &bound) in bounds.iter().enumerate() {
+            if bound >= self.total || bound <= 0.0 {
+                prev_t = prev_t.max(out[i]);
+                prev_area = bound;
+                continue;
+            }
+            let want = bound - prev_area;
+            let measure = |t: f64| -> f64 {
+                let offsets = [prev_t, t];
+                let planes = if prev_t.is_finite() {
+                    &offsets[..]
+                } else {
+                    &offsets[1..]
+                };
+                let slabs = split_by_parallel_planes(mesh, self.dir, planes);
+                mesh_area(&slabs[planes.len() - 1])
+            };
+            // Start from the profile's answer for this slab (relative to
+            // where the previous cut actually is).
+            let start_area = if prev_t.is_finite() {
+                self.area_below(prev_t)
+            } else {
+                0.0
+            };
+            let mut t = self.position_of(start_area + want).max(prev_t);
+            let mut r = measure(t) - want;
+            for _ in 0..6 {
+                if r.abs() <= tol {
+                    break;
+                }
+                let slope = self.cross_section(t);
+                if !(slope > 0.0) {
+                    break;
+                }
+                let next = (t - r / slope).clamp(prev_t.max(self.xs[0]), end);
+                let next_r = measure(next) - want;
+                if next_r.abs() >= r.abs() {
+                    break;
+                }
+                (t, r) = (next, next_r);
+            }
+            out[i] = t;
+            prev_t = t;
+            prev_area = bound;
+        }
+    }
 }
 
 /// The `u` in `[0, h]` with `f0 u + (f1 - f0) u^2 / (2h) = d`, for a
@@ -464,13 +542,15 @@ pub fn split_by_areas(mesh: &Mesh, dir: DVec3, areas: &[f64]) -> Vec<Mesh> {
     let dir = dir / len;
     let profile = AreaProfile::of_mesh(mesh, dir);
     let mut sum = 0.0;
-    let positions: Vec<f64> = areas
+    let bounds: Vec<f64> = areas
         .iter()
         .map(|&a| {
             sum += a.max(0.0);
-            profile.position_of(sum)
+            sum
         })
         .collect();
+    let mut positions = Vec::with_capacity(bounds.len());
+    profile.cut_positions(mesh, &bounds, &mut positions);
     split_by_parallel_planes(mesh, dir, &positions)
 }
 

@@ -482,7 +482,7 @@ impl AreaProfile {
                     break;
                 }
                 let slope = self.cross_section(t);
-                if !(slope > 0.0) {
+                if slope.is_nan() || slope <= 0.0 {
                     break;
                 }
                 let next = (t - r / slope).clamp(prev_t.max(self.xs[0]), end);
@@ -503,7 +503,7 @@ impl AreaProfile {
 /// cross-section going linearly from `f0 >= 0` to `f1 >= 0` over `h`, and
 /// `0 < d <= h (f0 + f1) / 2`.
 fn solve_quadratic(f0: f64, f1: f64, h: f64, d: f64) -> f64 {
-    if !(h > 0.0) {
+    if h.is_nan() || h <= 0.0 {
         return 0.0;
     }
     let c = 0.5 * (f1 - f0) / h;

@@ -46,11 +46,14 @@ fn star(radii: &[f64], jitter: &[f64], center: (f64, f64), clockwise: bool) -> V
     pts
 }
 
+/// A hole: radii, angle jitter, centre.
+type HoleSpec = (Vec<f64>, Vec<f64>, (f64, f64));
+
 #[derive(Clone, Debug)]
 struct LotSpec {
     radii: Vec<f64>,
     jitter: Vec<f64>,
-    hole: Option<(Vec<f64>, Vec<f64>, (f64, f64))>,
+    hole: Option<HoleSpec>,
     heading: f64,
 }
 

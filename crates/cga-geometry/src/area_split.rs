@@ -92,15 +92,18 @@ pub struct Flatness {
 }
 
 impl Flatness {
-    /// Whether the geometry is planar enough for exact area splits: its
-    /// faces face the same way (within about 1 degree), bend out of their
-    /// planes by at most 1% of their size, and none is perpendicular to the
-    /// direction.
-    pub fn is_nearly_planar(&self) -> bool {
+    /// Whether the faces do not lie in one plane: they face different ways
+    /// (by more than about 1 degree on average; a closed surface faces all
+    /// ways) or bend out of their planes by more than 1% of their size.
+    pub fn is_bent(&self) -> bool {
         const COS_1_DEGREE: f64 = 0.999_847_695_156_391_3;
-        self.normal_agreement >= COS_1_DEGREE
-            && self.out_of_plane <= 1e-2
-            && self.perpendicular_area <= 1e-9 * self.area
+        self.normal_agreement < COS_1_DEGREE || self.out_of_plane > 1e-2
+    }
+
+    /// Whether the geometry is planar enough for exact area splits: not
+    /// [bent](Self::is_bent), and no face is perpendicular to the direction.
+    pub fn is_nearly_planar(&self) -> bool {
+        !self.is_bent() && self.perpendicular_area <= 1e-9 * self.area
     }
 }
 

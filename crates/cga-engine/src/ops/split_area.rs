@@ -6,8 +6,9 @@
 //! lengths: the pattern is laid out on `L` = the geometry's area, so every
 //! part gets an interval `[A0, A1]` of cumulative area (`'r` is `r` times
 //! the area, `~w` shares what the fixed areas leave, repeats and nested
-//! groups as in `split`; sums below the whole leave the rest unused, parts
-//! beyond it are dropped). `cga_geometry::AreaProfile` then gives, in closed
+//! groups as in `split`; sums below the whole leave the rest unused, a part
+//! reaching beyond it is cut at the whole and later ones are not created).
+//! `cga_geometry::AreaProfile` then gives, in closed
 //! form, the position along the axis where the area on the low side reaches
 //! each `A`, and the geometry is cut there once. Part `k`'s geometry is the
 //! slab between its two cuts (on lots with holes or concave lots it may
@@ -16,8 +17,16 @@
 //! default), as in `split`.
 //!
 //! Parts follow the axis from the scope's origin: along +axis, or along
-//! -axis when the scope's size on it is negative (a mirrored scope), as
-//! `split` does.
+//! -axis when the scope's size on it is negative, as `split` does.
+//! `split.index` / `split.total` count the created parts (parts below
+//! [`MIN_PART_AREA`] are not created and not counted).
+//!
+//! The areas are exact on planar geometry, also with several faces not in
+//! one plane (each face is measured in its own plane). Faces bent out of
+//! their plane are handled by `AreaProfile::cut_positions` (every part but
+//! the last measures exactly; areas of bent faces are not additive). Bent
+//! or closed geometry, and geometry perpendicular to the axis, get a
+//! warning and a best effort, never an error.
 
 use std::cell::RefCell;
 
@@ -155,10 +164,9 @@ fn plan(
     profile.build(mesh, dir);
     let area = profile.total();
     let flat = profile.flatness();
-    const COS_1_DEGREE: f64 = 0.999_847_695_156_391_3;
     let warning = if !mesh.faces.is_empty() && area <= 0.0 {
         Some("splitArea: the geometry has no area; no part is created".to_string())
-    } else if flat.normal_agreement < COS_1_DEGREE || flat.out_of_plane > 1e-2 {
+    } else if flat.is_bent() {
         Some(
             "splitArea works on planar geometry; this geometry is not planar (or is a volume), \
              so the parts' areas are approximate"

@@ -39,9 +39,18 @@
 //! by these planes: their area is a step of `A` at their position (see
 //! [`Flatness::perpendicular_area`]). Each face is measured in its own plane,
 //! so meshes of several non-coplanar faces (roofs, multi-face lots) are exact
-//! too; only non-planar faces are approximate (the deviation is of second
-//! order in their bend). Closed meshes are best effort: the cut parts get
-//! caps, which the profile does not count.
+//! too. A face bent out of its plane is measured in its best-fit plane,
+//! while each piece cut from it is measured in the piece's own: areas of
+//! bent faces are not additive, and the two differ by the square of the
+//! bend. [`AreaProfile::cut_positions`] therefore polishes the cuts on such
+//! meshes with the measured areas of the actual slabs (all parts but the
+//! last then measure exactly; the last takes what is left). Closed meshes
+//! are best effort: the cut parts get caps, which the profile does not
+//! count.
+//!
+//! Cost: `O(n log n)` to build for `n` edges plus the sum over the intervals
+//! of the edges crossing them (a few per interval for lots), `O(log n)` per
+//! position.
 
 use glam::DVec3;
 

@@ -9,6 +9,7 @@
 //! | [`topology`] | welding, unique edges with their faces (`comp(e)` order), closedness |
 //! | [`triangulate`] | faces to triangles for export |
 //! | [`cut`] | plane cuts with caps: `split`, trim planes |
+//! | [`area_split`] | the area left of a moving plane and its inverse: `splitArea` |
 //! | [`extrude`] | `extrude` |
 //! | [`inner_rect`] | `innerRectangle` |
 //! | [`primitive`] | `primitive*` and `builtin:cube` |
@@ -18,6 +19,7 @@
 //! | [`setback`] | `offset`, `setback`, `setbackToArea`, `shapeL/U/O` |
 //! | [`skeleton`] | weighted straight skeletons and wavefront offsets |
 
+pub mod area_split;
 pub mod cut;
 pub mod extrude;
 pub mod inner_rect;
@@ -33,6 +35,7 @@ pub mod topology;
 pub mod transform;
 pub mod triangulate;
 
+pub use area_split::{split_by_areas, AreaProfile, Flatness};
 pub use cut::{cut_by_plane, split_along_axis, split_by_parallel_planes};
 pub use extrude::{extrude, extrude_with_roles, ExtrudeRole, Extrusion};
 pub use glam::{DAffine3, DMat3, DQuat, DVec2, DVec3};

@@ -6,6 +6,7 @@ mod attrs;
 mod create;
 mod scope_ops;
 pub mod split;
+pub mod split_area;
 mod transform;
 
 use cga_value::Value;
@@ -53,6 +54,7 @@ pub enum Op {
     ResetGeometry,
     ReverseNormals,
     Split,
+    SplitArea,
 }
 
 /// How an operation's arguments are read by the resolver.
@@ -140,6 +142,12 @@ pub fn lookup(name: &str) -> Option<OpInfo> {
             op: Op::Split,
             min_args: 1,
             max_args: 3,
+            block: true,
+        }),
+        "splitArea" => Some(OpInfo {
+            op: Op::SplitArea,
+            min_args: 1,
+            max_args: 2,
             block: true,
         }),
         _ => None,
@@ -241,6 +249,7 @@ pub fn exec(
 ) -> Result<(), RtError> {
     match call.op {
         Op::Split => split::exec(cx, st, call, args, frame),
+        Op::SplitArea => split_area::exec(cx, st, call, args, frame),
         Op::T | Op::Translate | Op::S | Op::R | Op::Rotate | Op::Center => {
             transform::exec(cx, st, call, args)
         }

@@ -234,12 +234,14 @@ impl Interp<'_> {
             "pivot" => shape.pivot,
             "object" => self.initial.pivot,
             "world" => Frame::IDENTITY,
-            other => return Err(RtError::new(
-                format!(
+            other => {
+                return Err(RtError::new(
+                    format!(
                     "unknown coordinate system `{other}`: expected scope, pivot, object or world"
                 ),
-                at.span,
-            )),
+                    at.span,
+                ))
+            }
         })
     }
 }

@@ -157,7 +157,7 @@ pub fn initial_shape(lot: &Lot, seed: u64, name: u32) -> Shape {
         comp: None,
         trim: TrimFlags::default(),
         projections: None,
-        rng: std::cell::Cell::new(seed ^ 0x5EED_0F_C6A_u64),
+        rng: std::cell::Cell::new(seed ^ 0x0005_EED0_FC6A_u64),
         name,
     }
 }
@@ -179,34 +179,6 @@ fn first_edge_frame(mesh: &Mesh) -> (DVec3, DVec3) {
         .find(|e| e.length() > 1e-12)
         .unwrap_or(DVec3::X);
     (n, x)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn rect_lot_scope_is_w_0_d() {
-        let s = initial_shape(&rect(20.0, 30.0), 0, 0);
-        assert!((s.scope.size - DVec3::new(20.0, 0.0, 30.0)).length() < 1e-12);
-        // x along the first edge, y up, z towards the street (+z).
-        assert!((s.scope.frame.axes.x_axis - DVec3::X).length() < 1e-12);
-        assert!((s.scope.frame.axes.y_axis - DVec3::Y).length() < 1e-12);
-        assert!((s.scope.frame.origin - DVec3::new(0.0, 0.0, -30.0)).length() < 1e-12);
-        let m = s.object_mesh();
-        assert!(m
-            .positions
-            .iter()
-            .any(|p| (*p - DVec3::new(20.0, 0.0, -30.0)).length() < 1e-12));
-    }
-
-    #[test]
-    fn clockwise_lot_is_turned_up() {
-        let mut lot = rect(4.0, 2.0);
-        lot.mesh.corners.reverse();
-        let s = initial_shape(&lot, 0, 0);
-        assert!((s.scope.frame.axes.y_axis - DVec3::Y).length() < 1e-12);
-    }
 }
 
 /// Each polygon of a GeoJSON file is one lot (MultiPolygons give one lot
@@ -311,5 +283,33 @@ fn orient_rings(positions: &[DVec3], loops: &mut [Vec<u32>]) {
         if (i == 0) != ccw {
             l[1..].reverse();
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rect_lot_scope_is_w_0_d() {
+        let s = initial_shape(&rect(20.0, 30.0), 0, 0);
+        assert!((s.scope.size - DVec3::new(20.0, 0.0, 30.0)).length() < 1e-12);
+        // x along the first edge, y up, z towards the street (+z).
+        assert!((s.scope.frame.axes.x_axis - DVec3::X).length() < 1e-12);
+        assert!((s.scope.frame.axes.y_axis - DVec3::Y).length() < 1e-12);
+        assert!((s.scope.frame.origin - DVec3::new(0.0, 0.0, -30.0)).length() < 1e-12);
+        let m = s.object_mesh();
+        assert!(m
+            .positions
+            .iter()
+            .any(|p| (*p - DVec3::new(20.0, 0.0, -30.0)).length() < 1e-12));
+    }
+
+    #[test]
+    fn clockwise_lot_is_turned_up() {
+        let mut lot = rect(4.0, 2.0);
+        lot.mesh.corners.reverse();
+        let s = initial_shape(&lot, 0, 0);
+        assert!((s.scope.frame.axes.y_axis - DVec3::Y).length() < 1e-12);
     }
 }

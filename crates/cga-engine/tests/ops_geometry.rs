@@ -77,7 +77,9 @@ fn lot_with_hole() -> Opts {
 fn measures_of_a_lot() {
     check(
         &measures("", &Opts::default()),
-        ["600", "0", "4", "1", "0", "false", "true", "true", "false", "100", "0"],
+        [
+            "600", "0", "4", "1", "0", "false", "true", "true", "false", "100", "0",
+        ],
     );
 }
 
@@ -99,7 +101,9 @@ fn measures_of_an_extrusion() {
 fn measures_with_holes() {
     check(
         &measures("", &lot_with_hole()),
-        ["96", "0", "8", "1", "1", "false", "true", "false", "true", "48", "0"],
+        [
+            "96", "0", "8", "1", "1", "false", "true", "false", "true", "48", "0",
+        ],
     );
     check(
         &measures("extrude(10)", &lot_with_hole()),
@@ -122,7 +126,9 @@ fn measures_of_an_l() {
     ]);
     check(
         &measures("", &l),
-        ["64", "0", "6", "1", "0", "false", "true", "false", "true", "40", "0"],
+        [
+            "64", "0", "6", "1", "0", "false", "true", "false", "true", "40", "0",
+        ],
     );
 }
 

@@ -145,7 +145,10 @@ fn primitive_solids_fit_the_scope() {
         ("primitiveCone()", Some(octa16 * 25.0 / 3.0), 17.0, 17.0),
     ];
     for (op, volume, nv, nf) in cases {
-        let (s, geo, g) = run(&format!("{op} texture(\"builtin:uvtest.png\")"), &Opts::default());
+        let (s, geo, g) = run(
+            &format!("{op} texture(\"builtin:uvtest.png\")"),
+            &Opts::default(),
+        );
         assert_vec_near(s.t, [0.0, 0.0, -30.0], EPS);
         assert_vec_near(s.s, [20.0, 25.0, 30.0], EPS);
         if let Some(v) = volume {
@@ -167,9 +170,16 @@ fn primitive_solids_fit_the_scope() {
 #[test]
 fn primitive_solids_with_dimensions() {
     let octa = ngon_area(8.0, 10.0);
-    let cases: [(&str, [f64; 3], Option<f64>, f64, f64); 4] = [
+    type Case<'a> = (&'a str, [f64; 3], Option<f64>, f64, f64);
+    let cases: [Case; 4] = [
         // op, size, volume (when exact), vertices, faces
-        ("primitiveCube(10,15,20)", [10.0, 15.0, 20.0], Some(3000.0), 8.0, 6.0),
+        (
+            "primitiveCube(10,15,20)",
+            [10.0, 15.0, 20.0],
+            Some(3000.0),
+            8.0,
+            6.0,
+        ),
         (
             "primitiveSphere(8,4,10)",
             [20.0, 20.0, 20.0],
@@ -193,7 +203,10 @@ fn primitive_solids_with_dimensions() {
         ),
     ];
     for (op, size, volume, nv, nf) in cases {
-        let (s, geo, g) = run(&format!("{op} texture(\"builtin:uvtest.png\")"), &Opts::default());
+        let (s, geo, g) = run(
+            &format!("{op} texture(\"builtin:uvtest.png\")"),
+            &Opts::default(),
+        );
         let t = [(20.0 - size[0]) / 2.0, 0.0, -30.0 + (30.0 - size[2]) / 2.0];
         assert_vec_near(s.t, t, EPS);
         assert_vec_near(s.s, size, EPS);
@@ -258,10 +271,7 @@ fn insert_into_a_point_scope_keeps_the_asset() {
     assert_vec_near(lo, [12.3, 4.3, -22.8], 1e-9);
     assert_vec_near(hi, [14.3, 7.3, -21.8], 1e-9);
     // keepSizeAndPosition is "the same as setting zero scope dimensions".
-    let (s2, _, g2) = run(
-        "i(\"box.obj\", yUp, keepSizeAndPosition)",
-        &Opts::default(),
-    );
+    let (s2, _, g2) = run("i(\"box.obj\", yUp, keepSizeAndPosition)", &Opts::default());
     assert_all_near(&s2.t.to_array(), &s.t.to_array(), 1e-9);
     assert_all_near(&s2.s.to_array(), &s.s.to_array(), 1e-9);
     assert_all_near(&g2.bounds().0.to_array(), &lo.to_array(), 1e-9);

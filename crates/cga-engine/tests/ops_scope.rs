@@ -248,7 +248,10 @@ fn set_pivot_corners() {
             let bits: Vec<bool> = (0..3)
                 .map(|i| {
                     let v = rel[i] / size[i];
-                    assert!(v.abs() < EPS || (v - 1.0).abs() < EPS, "{map} {corner}: {rel:?}");
+                    assert!(
+                        v.abs() < EPS || (v - 1.0).abs() < EPS,
+                        "{map} {corner}: {rel:?}"
+                    );
                     v > 0.5
                 })
                 .collect();
@@ -265,7 +268,10 @@ fn set_pivot_corners() {
                     .find(|&i| a.dot(old_axes[i]).abs() > 1.0 - 1e-9)
                     .expect("a scope axis");
                 let inward = if bits[i] { -old_axes[i] } else { old_axes[i] };
-                assert!(a.dot(inward) > 0.0, "{map} {corner}: axis {k} points inside");
+                assert!(
+                    a.dot(inward) > 0.0,
+                    "{map} {corner}: axis {k} points inside"
+                );
                 extent[k] = size[i];
             }
             assert!(axes[0].cross(axes[1]).dot(axes[2]) > 0.0);
@@ -441,7 +447,11 @@ fn scope_elevation() {
         DVec3::new(10.0, 5.0, -10.0),
         DVec3::new(0.0, 5.0, -10.0),
     ]);
-    let g = gen_with("Lot --> print(scope.elevation) t(0,3,0) print(scope.elevation) print(scope.ty)\n", &lot).ok();
+    let g = gen_with(
+        "Lot --> print(scope.elevation) t(0,3,0) print(scope.elevation) print(scope.ty)\n",
+        &lot,
+    )
+    .ok();
     assert_eq!(g.prints(), ["5", "8", "3"]);
 }
 
@@ -537,7 +547,11 @@ fn convert_page_example() {
     assert_eq!(p.len(), 5);
     // CityEngine computes in single precision: its 0.3999996185302735 is 0.4.
     let tol = 1e-6;
-    assert_all_near(&array(&p[0]), &[1.0452611297369, 0.0, 2.183733612298965], tol);
+    assert_all_near(
+        &array(&p[0]),
+        &[1.0452611297369, 0.0, 2.183733612298965],
+        tol,
+    );
     assert_near(numbers(&p[1])[0], 1.0452611297369, tol);
     assert_all_near(
         &array(&p[2]),

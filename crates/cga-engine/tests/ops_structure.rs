@@ -10,8 +10,6 @@ use cga_geometry::DVec3;
 use cga_value::Value;
 use ops_common::*;
 
-const EPS: f64 = 1e-9;
-
 /// `n` lots `rect:10,10` (each has its own random stream).
 fn many_lots(n: usize) -> Opts {
     Opts {
@@ -114,14 +112,20 @@ fn report_window_state_page_rule() {
                Window -->\n    40%:\n      report(\"windowarea\", geometry.area())\n      report(\"windows.open\", 1)\n      NIL\n\
                else:\n      report(\"windowarea\", geometry.area())\n      report(\"windows.closed\", 1)\n      color(\"#aaffaa\")\n";
     let g = gen(src).ok();
-    let facades = g.out().reports.iter().filter(|(k, _)| k == "facades").count();
+    let facades = g
+        .out()
+        .reports
+        .iter()
+        .filter(|(k, _)| k == "facades")
+        .count();
     assert_eq!(facades, 4);
 }
 
 /// op_report: value types float, bool and string; other types are errors.
 #[test]
 fn report_value_types() {
-    let g = gen("Lot --> report(\"a.b\", 2.5) report(\"flag\", true) report(\"name\", \"x\") X\n").ok();
+    let g =
+        gen("Lot --> report(\"a.b\", 2.5) report(\"flag\", true) report(\"name\", \"x\") X\n").ok();
     assert_eq!(
         g.out().reports,
         [
@@ -169,7 +173,9 @@ fn push_pop_rotation() {
 #[test]
 #[ignore = "comp and roofHip are not implemented yet"]
 fn push_pop_house() {
-    let a = gen("House -->\n    extrude(10)\n    comp(f) { top : roofHip(45) Roof. | all = House.}\n").ok();
+    let a =
+        gen("House -->\n    extrude(10)\n    comp(f) { top : roofHip(45) Roof. | all = House.}\n")
+            .ok();
     let b = gen("House -->\n    [ t(0,10,0) roofHip(45) Roof. ]\n    extrude(10)\n    comp(f) { top : NIL | all = House. }\n").ok();
     assert_near(a.area(), b.area(), 1e-9);
     assert_eq!(a.bounds(), b.bounds());
@@ -280,10 +286,7 @@ fn split_index_and_total() {
         assert_near(mesh_bounds(m).0.y, 2.0 * i as f64, 1e-9);
     }
     let g = gen("Lot --> print([split.index, split.total]) extrude(9) split(y) { 3 : print([split.index, split.total]) X }*\n").ok();
-    assert_eq!(
-        g.prints(),
-        ["(2)[0,0]", "(2)[0,3]", "(2)[1,3]", "(2)[2,3]"]
-    );
+    assert_eq!(g.prints(), ["(2)[0,0]", "(2)[0,3]", "(2)[1,3]", "(2)[2,3]"]);
 }
 
 // ---------------------------------------------------------------------------
@@ -339,7 +342,8 @@ fn case_chain_needs_else() {
 /// proportion are at most 0.045.
 #[test]
 fn stochastic_rule_proportions() {
-    let src = "Lot --> 30% : print(\"A\")\n        20% : print(\"B\")\n        else : print(\"C\")\n";
+    let src =
+        "Lot --> 30% : print(\"A\")\n        20% : print(\"B\")\n        else : print(\"C\")\n";
     let check = |prints: Vec<String>| {
         let n = prints.len() as f64;
         assert_eq!(n, 2000.0);
@@ -350,7 +354,11 @@ fn stochastic_rule_proportions() {
     };
     check(gen_with(src, &many_lots(2000)).ok().prints());
     let by_seed: Vec<String> = (0..2000u64)
-        .flat_map(|seed| gen_with(src, &Opts::rect(10.0, 10.0).seed(seed)).ok().prints())
+        .flat_map(|seed| {
+            gen_with(src, &Opts::rect(10.0, 10.0).seed(seed))
+                .ok()
+                .prints()
+        })
         .collect();
     check(by_seed);
 }
@@ -428,7 +436,13 @@ fn p_examples() {
     let rows: Vec<String> = g.prints();
     let share = |k: usize| {
         rows.iter()
-            .filter(|r| r.trim_start_matches("(2)[").split(',').nth(k).unwrap().starts_with("true"))
+            .filter(|r| {
+                r.trim_start_matches("(2)[")
+                    .split(',')
+                    .nth(k)
+                    .unwrap()
+                    .starts_with("true")
+            })
             .count() as f64
             / rows.len() as f64
     };

@@ -284,7 +284,7 @@ fn translate_rel_world_and_object() {
         let g = gen_with(&src, &turned_square(30.0, 10.0).start("Init")).ok();
         let meshes = g.meshes();
         assert!(
-            meshes.len() >= 2 && meshes.len() % 2 == 0,
+            meshes.len() >= 2 && meshes.len().is_multiple_of(2),
             "pairs of cubes, got {}",
             meshes.len()
         );

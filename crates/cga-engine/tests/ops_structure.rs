@@ -353,12 +353,10 @@ fn stochastic_rule_proportions() {
         assert_near(share("C"), 0.5, 0.045);
     };
     check(gen_with(src, &many_lots(2000)).ok().prints());
-    let by_seed: Vec<String> = (0..2000u64)
-        .flat_map(|seed| {
-            gen_with(src, &Opts::rect(10.0, 10.0).seed(seed))
-                .ok()
-                .prints()
-        })
+    let seeds: Vec<u64> = (0..2000).collect();
+    let by_seed: Vec<String> = gen_seeds(src, &Opts::rect(10.0, 10.0), &seeds)
+        .into_iter()
+        .flat_map(|g| g.ok().prints())
         .collect();
     check(by_seed);
 }

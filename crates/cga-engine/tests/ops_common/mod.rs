@@ -119,6 +119,20 @@ pub fn gen_with(src: &str, opts: &Opts) -> Gen {
 /// Loads and derives a rule file; a rule file that does not load fails the test.
 #[track_caller]
 pub fn gen_file(path: &Path, opts: &Opts) -> Gen {
+    gen_file_seeds(path, opts, &[opts.seed]).pop().unwrap()
+}
+
+/// Derives `src` once per seed, loading it once.
+#[track_caller]
+pub fn gen_seeds(src: &str, opts: &Opts, seeds: &[u64]) -> Vec<Gen> {
+    let dir = scratch_dir();
+    let path = dir.join("rules.cga");
+    std::fs::write(&path, src).unwrap();
+    gen_file_seeds(&path, opts, seeds)
+}
+
+#[track_caller]
+fn gen_file_seeds(path: &Path, opts: &Opts, seeds: &[u64]) -> Vec<Gen> {
     let mut sources = SourceMap::new();
     let loaded = cga_engine::load(path, &mut sources);
     let Some(program) = loaded.program else {
@@ -132,29 +146,36 @@ pub fn gen_file(path: &Path, opts: &Opts) -> Gen {
     let rule = program
         .start_rule(opts.start.as_deref())
         .unwrap_or_else(|e| panic!("{e}"));
-    let mut options = GenerateOptions {
-        seed: opts.seed,
-        ..GenerateOptions::default()
-    };
+    let mut attrs = Vec::new();
     for (name, v) in &opts.attrs {
         let id = program
             .main_attr(name)
             .unwrap_or_else(|| panic!("no attribute {name}"));
-        options.attrs.push((id, v.clone()));
+        attrs.push((id, v.clone()));
     }
     let assets = Assets::new(&sources);
-    let mut g = Gen {
-        lots: Vec::new(),
-        errors: Vec::new(),
-    };
-    for (i, l) in opts.lots.iter().enumerate() {
-        let (out, err) = generate_lot(&program, &assets, rule, l, i, &options);
-        g.lots.push(out);
-        if let Some(e) = err {
-            g.errors.push(e);
-        }
-    }
-    g
+    seeds
+        .iter()
+        .map(|&seed| {
+            let options = GenerateOptions {
+                seed,
+                attrs: attrs.clone(),
+                ..GenerateOptions::default()
+            };
+            let mut g = Gen {
+                lots: Vec::new(),
+                errors: Vec::new(),
+            };
+            for (i, l) in opts.lots.iter().enumerate() {
+                let (out, err) = generate_lot(&program, &assets, rule, l, i, &options);
+                g.lots.push(out);
+                if let Some(e) = err {
+                    g.errors.push(e);
+                }
+            }
+            g
+        })
+        .collect()
 }
 
 impl Gen {

@@ -1,10 +1,13 @@
 //! Initial shapes: lots from a `W,D` rectangle, OBJ faces or GeoJSON polygons.
 //!
 //! Conventions: y is up, lots lie in the x-z plane, counter-clockwise seen
-//! from above (a lot given clockwise is reversed), and the first edge is the
-//! street front. The initial pivot sits on the first vertex with its x axis
-//! along the first edge and its y axis along the lot's normal; the scope is
-//! the lot's bounding box in that frame.
+//! from above, and the first edge is the street front. The initial pivot
+//! sits on the first vertex with its x axis along the first edge and its y
+//! axis along the lot's normal; the scope is the lot's bounding box in that
+//! frame. A polygon given clockwise keeps its orientation: its normal points
+//! down and so do its extrusions, as in CityEngine's runtime (a clockwise
+//! 10 x 10 OBJ lot extruded by 7 spans y -7..0 there). GeoJSON rings are
+//! oriented by their own convention when read.
 
 use std::sync::Arc;
 
@@ -109,11 +112,7 @@ pub fn from_obj(path: &std::path::Path) -> Result<Vec<Lot>, String> {
 /// The initial shape of a lot, ready for derivation.
 pub fn initial_shape(lot: &Lot, seed: u64, name: u32) -> Shape {
     let mut mesh = lot.mesh.clone();
-    let (mut normal, mut x) = first_edge_frame(&mesh);
-    if normal.y < -1e-9 {
-        cga_geometry::transform::reverse_faces(&mut mesh);
-        (normal, x) = first_edge_frame(&mesh);
-    }
+    let (normal, x) = first_edge_frame(&mesh);
     let y = normal;
     let x = (x - y * x.dot(y)).normalize_or(DVec3::X);
     let z = x.cross(y);
@@ -306,10 +305,13 @@ mod tests {
     }
 
     #[test]
-    fn clockwise_lot_is_turned_up() {
+    fn clockwise_lot_faces_down() {
         let mut lot = rect(4.0, 2.0);
         lot.mesh.corners.reverse();
         let s = initial_shape(&lot, 0, 0);
-        assert!((s.scope.frame.axes.y_axis - DVec3::Y).length() < 1e-12);
+        assert!((s.scope.frame.axes.y_axis + DVec3::Y).length() < 1e-12);
+        // x along the first edge, (0,0,-2) -> (4,0,-2); a right-handed frame
+        assert!((s.scope.frame.axes.x_axis - DVec3::X).length() < 1e-12);
+        assert!((s.scope.frame.axes.z_axis + DVec3::Z).length() < 1e-12);
     }
 }

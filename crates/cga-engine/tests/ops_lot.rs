@@ -116,3 +116,17 @@ fn clockwise_lot_extrudes_down() {
     assert_near(lo.y, -10.0, 1e-9);
     assert_near(hi.y, 0.0, 1e-9);
 }
+
+/// A lot with a vertex in the middle of an edge keeps it (the oracle counts
+/// 10 vertices and 7 faces after extrude(10)); a repeated vertex is dropped
+/// (8 vertices, 6 faces).
+#[test]
+fn collinear_and_repeated_vertices() {
+    let rule = package_rule("FacesHolesVerticesrule", "FacesHolesVerticesrule.cga");
+    let g = gen_file(&rule, &obj_lot("col.obj")).ok();
+    assert_eq!(g.prints(), ["10", "7", "0"]);
+    assert_near(g.area(), 600.0, 1e-9);
+    let g = gen_file(&rule, &obj_lot("dup.obj")).ok();
+    assert_eq!(g.prints(), ["8", "6", "0"]);
+    assert_near(g.area(), 600.0, 1e-9);
+}

@@ -582,3 +582,12 @@ fn convert_round_trips() {
     // rect lots: object = world
     assert_eq!(p[3], "2");
 }
+
+/// op_alignScopeToGeometry: "xUp not supported yet": an error, not a
+/// silent yUp.
+#[test]
+fn align_scope_to_geometry_x_up_is_an_error() {
+    let g = gen("Lot --> extrude(2) alignScopeToGeometry(xUp, 0, 0) X\n");
+    assert_eq!(g.errors.len(), 1);
+    assert!(g.errors[0].message.contains("xUp"));
+}

@@ -73,7 +73,8 @@ pub fn exec(
             align_pivot_and_scope(shape, axes);
         }
         Op::AlignScopeToGeometry => {
-            let up = selector(&args[0], &["yUp", "zUp", "xUp"])?;
+            // xUp is a selector of the reference that CityEngine does not support yet.
+            let up = selector(&args[0], &["yUp", "zUp"])?;
             let mesh = shape.object_mesh();
             if mesh.faces.is_empty() {
                 return Ok(());

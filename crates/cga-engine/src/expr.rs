@@ -124,7 +124,10 @@ pub struct OpCall {
 pub struct RuleCall {
     pub rule: RuleId,
     pub args: Vec<RExpr>,
-    /// Attribute values set for this call only (dynamic import `imp(h = 2).Lot`).
+    /// A dynamic import call (`imp(h = 2).Lot`, also `imp().Lot`): the
+    /// imported rule set's attributes are initialised anew for this call.
+    pub dynamic: bool,
+    /// Attribute values set for this call only.
     pub attr_overrides: Vec<(AttrId, RExpr)>,
     pub span: Span,
 }

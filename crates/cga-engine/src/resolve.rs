@@ -157,17 +157,72 @@ struct Resolver<'s> {
     symbols: HashMap<Arc<str>, u32>,
 }
 
-/// Which items of a module are in the default style (those before the first
-/// `style` statement, and those after `style Default`).
-fn default_style_items(module: &ast::Module) -> impl Iterator<Item = &Item> {
-    let mut in_default = true;
-    module.items.iter().filter(move |item| {
-        if let Item::Style { name, .. } = item {
-            in_default = name.name == "Default";
-            return false;
+/// The items of a module as one style sees them: the items of the Default
+/// style (before the first `style` statement, or after `style Default`),
+/// with the attributes, functions and rules that `style` (and the styles it
+/// extends) redefines replaced by its versions, and its new ones added.
+fn style_items<'m>(module: &'m ast::Module, style: Option<&str>) -> Vec<&'m Item> {
+    // Sections: (style name, extends, items).
+    let mut sections: Vec<(&str, Option<&str>, Vec<&Item>)> = vec![("Default", None, Vec::new())];
+    for item in &module.items {
+        match item {
+            Item::Style { name, extends, .. } => sections.push((
+                name.name.as_str(),
+                Some(extends.as_ref().map_or("Default", |e| e.name.as_str())),
+                Vec::new(),
+            )),
+            Item::Import(_) | Item::Version { .. } => sections[0].2.push(item),
+            _ => sections
+                .last_mut()
+                .expect("the Default section")
+                .2
+                .push(item),
         }
-        in_default || matches!(item, Item::Import(_) | Item::Version { .. })
-    })
+    }
+    let mut items: Vec<&Item> = sections
+        .iter()
+        .filter(|s| s.0 == "Default")
+        .flat_map(|s| s.2.iter().copied())
+        .collect();
+    // The chain of styles from the most basic to the chosen one.
+    let mut chain = Vec::new();
+    let mut current = style.filter(|s| *s != "Default");
+    while let Some(name) = current {
+        if chain.contains(&name) || chain.len() > 32 {
+            break;
+        }
+        let Some(section) = sections.iter().find(|s| s.0 == name) else {
+            break;
+        };
+        chain.push(name);
+        current = section.1.filter(|s| *s != "Default");
+    }
+    for name in chain.into_iter().rev() {
+        for section in sections.iter().filter(|s| s.0 == name) {
+            for &item in &section.2 {
+                match items.iter().position(|&i| same_definition(i, item)) {
+                    Some(k) => items[k] = item,
+                    None => items.push(item),
+                }
+            }
+        }
+    }
+    items
+}
+
+/// Whether two items define the same attribute, function or rule (name and
+/// number of parameters).
+fn same_definition(a: &Item, b: &Item) -> bool {
+    match (a, b) {
+        (Item::Attr(x), Item::Attr(y)) => x.name.name == y.name.name,
+        (Item::Function(x), Item::Function(y)) => {
+            x.name.name == y.name.name && x.params.len() == y.params.len()
+        }
+        (Item::Rule(x), Item::Rule(y)) => {
+            x.name.name == y.name.name && x.params.len() == y.params.len()
+        }
+        _ => false,
+    }
 }
 
 /// Names in scope inside one definition: parameters, then `with` locals.
@@ -239,7 +294,14 @@ impl Resolver<'_> {
         let overrides: Option<Vec<ast::ImportOverride>> =
             importer.as_ref().and_then(|(_, d)| d.overrides.clone());
 
-        for item in default_style_items(&module) {
+        // An import that lists styles (`import imp (mystyle) : "f.cga"`)
+        // generates with the first of them; everything else with Default.
+        let style: Option<String> = importer
+            .as_ref()
+            .and_then(|(_, d)| d.styles.as_ref())
+            .and_then(|list| list.first())
+            .map(|s| s.name.clone());
+        for item in style_items(&module, style.as_deref()) {
             match item {
                 Item::Attr(decl) => {
                     self.declare_attr(rs, decl, importer.as_ref().map(|i| i.0), &overrides)
@@ -968,6 +1030,7 @@ impl Resolver<'_> {
             return RStmt::Rule(RuleCall {
                 rule,
                 args,
+                dynamic: call.import_overrides.is_some(),
                 attr_overrides,
                 span,
             });

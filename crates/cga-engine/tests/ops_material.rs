@@ -198,7 +198,6 @@ fn reset_material_lets_the_asset_material_through() {
 /// materials to the CGA default, `shape` (the default) only the shape's,
 /// `all` both.
 #[test]
-#[ignore = "ops/mod.rs registers resetMaterial with no arguments: resetMaterial(shape|geometry|all) does not load"]
 fn reset_material_targets() {
     let src = "Lot --> color(1,0,0) i(\"plant.obj\") [ resetMaterial(shape) A. ] [ resetMaterial(geometry) B. ] [ resetMaterial(all) C. ]\n";
     let g = gen(src).ok();

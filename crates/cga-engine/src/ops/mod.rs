@@ -79,7 +79,11 @@ pub enum ArgMode {
 pub fn arg_mode(name: &str, arity: usize, pos: usize) -> ArgMode {
     use ArgMode::*;
     match (name, arity, pos) {
-        ("split" | "splitArea" | "comp" | "center" | "alignScopeToAxes", _, _) => Selector,
+        (
+            "split" | "splitArea" | "comp" | "center" | "alignScopeToAxes" | "resetMaterial",
+            _,
+            _,
+        ) => Selector,
         ("extrude", 2, 0) => Selector,
         ("r", 4, 0) => Selector,
         ("translate" | "rotate", _, 0 | 1) => Selector,
@@ -127,7 +131,7 @@ pub fn lookup(name: &str) -> Option<OpInfo> {
         "i" | "insert" => info(Op::Insert, 1, 4),
         "color" => info(Op::Color, 1, 4),
         "setMaterial" => info(Op::SetMaterial, 1, 1),
-        "resetMaterial" => info(Op::ResetMaterial, 0, 0),
+        "resetMaterial" => info(Op::ResetMaterial, 0, 1),
         "texture" => info(Op::Texture, 1, 1),
         "print" => info(Op::Print, 1, 1),
         "report" => info(Op::Report, 2, 2),

@@ -1303,9 +1303,9 @@ fn select(
     };
     match &expr.kind {
         RExprKind::CompSelector(sel, _) if *sel != Selector::IsTagged => {
-            for k in 0..n {
-                if !taken[k] && comps.matches(*sel, k) {
-                    taken[k] = true;
+            for (k, t) in taken.iter_mut().enumerate() {
+                if !*t && comps.matches(*sel, k) {
+                    *t = true;
                     out.push(k as u32);
                 }
             }
@@ -1332,8 +1332,8 @@ fn select(
         }
     }
     let with_shape = needs_component_shape(expr);
-    for k in 0..n {
-        if taken[k] {
+    for (k, t) in taken.iter_mut().enumerate() {
+        if *t {
             continue;
         }
         let shape;
@@ -1344,7 +1344,7 @@ fn select(
             parent
         };
         if eval_condition(cx, frame, on, comps, k, expr)? {
-            taken[k] = true;
+            *t = true;
             out.push(k as u32);
         }
     }

@@ -658,7 +658,9 @@ impl Components {
         if trim {
             if let Item::Faces { start, len: 1 } = first {
                 let f = self.face_list[start as usize] as usize;
-                let planes = self.trim_planes(f, axes.y_axis);
+                // Planes are classified against the new pivot's xz-plane.
+                let pivot_y = p.scope.frame.axes.transpose() * pivot.axes.y_axis;
+                let planes = self.trim_planes(f, pivot_y);
                 if !planes.is_empty() {
                     let frame = p.scope.frame;
                     let planes: Vec<TrimPlane> = planes

@@ -6,7 +6,10 @@
 //! two faces, so that geometry inserted on two neighbouring faces (ledges,
 //! cornices, a beam wider than its facade) is mitred where they meet instead
 //! of intersecting. The part of the geometry on the face's side of the plane
-//! is kept.
+//! is kept, and the cut is left open: no cap faces close a trimmed solid.
+//! That is what CityEngine does: the Candler building's ledges and cornices
+//! (closed assets, mitred at every corner) have CityEngine's areas only
+//! without caps (see `tests/comp_candler.rs`).
 //!
 //! Planes are fixed in space: they are stored in object coordinates and do
 //! not move with the scope, so a shape translated after the split is still
@@ -147,9 +150,9 @@ pub fn apply(shape: &mut Shape, bounds: Option<(DVec3, DVec3)>) {
 }
 
 /// `mesh` without the faces lying in the plane `n · p = offset` and facing
-/// away from `n`: the caps a plane cut adds to close a solid. Trimming
-/// leaves the cut open, as CityEngine does (the Candler building's ledges
-/// and cornices, compared with CityEngine's output, have no caps).
+/// away from `n`: the caps `cut_by_plane` adds to close a cut solid (a face
+/// of the input lying exactly in the plane and facing out of the kept part
+/// goes too; it would lie on the cut anyway).
 fn without_caps(mut mesh: Mesh, n: DVec3, offset: f64) -> Mesh {
     let scale = mesh
         .positions

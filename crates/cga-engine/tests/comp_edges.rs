@@ -222,3 +222,41 @@ fn connected_edges() {
     // Edge normals of the top ring are aslant (45 degrees up), of the bottom ring nutant.
     assert_eq!(r.prints, vec!["aslant 0 1 4", "nutant 0 1 4"]);
 }
+
+#[test]
+fn seed_edge_and_vertex_examples() {
+    // The seed's "Edge Split Details": a cube in every edge, scaled to
+    // (length, 0.8, 0.8). The 12 edges of the 20 x 30 x 3 mass are 212 long.
+    let text = "Lot --> extrude(3) comp(e) { all : primitiveCube() s('1, 0.8, 0.8) X }\n";
+    let r = run("seed_edges", text).ok();
+    assert_eq!(r.meshes.len(), 12);
+    assert!((r.volume() - 212.0 * 0.64).abs() < 1e-9, "{}", r.volume());
+    // op_comp.md's version: s('1, 0.25, 1).
+    let text = "Lot --> extrude(3) comp(e) { all : primitiveCube() s('1, 0.25, 1) X. }\n";
+    let r = run("ref_edges", text).ok();
+    assert!((r.volume() - 212.0 * 0.25).abs() < 1e-9, "{}", r.volume());
+    // The seed's "Border Selector Vertex Split": small cubes on the 12
+    // border and the 4 inside vertices of the grid.
+    let text = r##"Init --> comp(v) { border : VBorder | inside : VInside }
+VBorder --> s(0.05, 0.05, 0.05) t(-0.025, -0.025, -0.025) color("#ff0000") primitiveCube()
+VInside --> s(0.05, 0.05, 0.05) t(-0.025, -0.025, -0.025) color("#00ff00") primitiveCube()
+"##;
+    let r = run_on("seed_vertices", text, &grid_lot(), "Init").ok();
+    assert_eq!(r.meshes.len(), 16);
+    let red = r
+        .meshes
+        .iter()
+        .filter(|m| m.materials[0].color == [1.0, 0.0, 0.0])
+        .count();
+    assert_eq!(red, 12);
+    // Each cube is centred on its vertex.
+    for m in &r.meshes {
+        let (lo, hi) = bbox(m);
+        let c = 0.5 * (lo + hi);
+        assert!(
+            (c.x - c.x.round()).abs() < 1e-9 && (c.z - c.z.round()).abs() < 1e-9,
+            "{c:?}"
+        );
+        assert!(c.y.abs() < 1e-9, "{c:?}");
+    }
+}

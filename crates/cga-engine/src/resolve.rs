@@ -847,6 +847,7 @@ impl Resolver<'_> {
         RExpr { kind, span }
     }
 
+    /// The block of the comp function (the only expression with a block).
     fn expr_block(&mut self, cx: &Cx, b: &ast::Block<Expr>) -> RBlock<RExpr> {
         RBlock {
             parts: b
@@ -854,7 +855,7 @@ impl Resolver<'_> {
                 .iter()
                 .map(|p| match p {
                     BlockPart::Entry(e) => RPart::Entry {
-                        head: self.head(cx, &e.head),
+                        head: self.comp_head(cx, &e.head),
                         depth: e.depth.as_ref().map(|d| self.expr(cx, d)),
                         op: e.op,
                         body: self.expr(cx, &e.body),
@@ -938,6 +939,82 @@ impl Resolver<'_> {
         }
     }
 
+    /// A comp head: the selection expression with the selector text as
+    /// written (`comp.sel`).
+    fn comp_head(&mut self, cx: &Cx, e: &Expr) -> RExpr {
+        let text = self
+            .sources
+            .get(e.span.file)
+            .text
+            .get(e.span.range())
+            .unwrap_or("")
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
+        RExpr {
+            kind: RExprKind::CompHead {
+                text: Arc::from(text.as_str()),
+                expr: Box::new(self.comp_selection(cx, e)),
+            },
+            span: e.span,
+        }
+    }
+
+    /// A comp selection expression: selector keywords (and `isTagged(...)`)
+    /// are selectors, alone or under `!`, `&&`, `||` and comparisons; in
+    /// a comp head a keyword wins over an attribute or function of the same
+    /// name (`inside` is the selector there, not the occlusion query).
+    /// Anything else is an ordinary expression (an index, a condition on
+    /// the component shape such as `geometry.area() > 1`).
+    fn comp_selection(&mut self, cx: &Cx, e: &Expr) -> RExpr {
+        let span = e.span;
+        let kind = match &e.kind {
+            ExprKind::Name(ident) => match crate::selectors::Selector::parse(&ident.name) {
+                Some(sel) => RExprKind::CompSelector(sel, Vec::new()),
+                None => return self.name(cx, ident, false),
+            },
+            ExprKind::Call { name, args } if name.name == "isTagged" => {
+                if args.is_empty() || args.len() > 2 {
+                    self.error(
+                        format!(
+                            "`isTagged` takes 1 or 2 arguments (tag query, e|v), found {}",
+                            args.len()
+                        ),
+                        span,
+                    );
+                    return placeholder(span);
+                }
+                let mut list = vec![self.expr(cx, &args[0])];
+                if let Some(sub) = args.get(1) {
+                    list.push(self.selector_arg(cx, sub));
+                }
+                RExprKind::CompSelector(crate::selectors::Selector::IsTagged, list)
+            }
+            ExprKind::Unary {
+                op,
+                elementwise,
+                operand,
+            } => RExprKind::Unary {
+                op: *op,
+                elementwise: *elementwise,
+                operand: Box::new(self.comp_selection(cx, operand)),
+            },
+            ExprKind::Binary {
+                op,
+                elementwise,
+                lhs,
+                rhs,
+            } => RExprKind::Binary {
+                op: *op,
+                elementwise: *elementwise,
+                lhs: Box::new(self.comp_selection(cx, lhs)),
+                rhs: Box::new(self.comp_selection(cx, rhs)),
+            },
+            _ => return self.expr(cx, e),
+        };
+        RExpr { kind, span }
+    }
+
     fn selector_arg(&mut self, _cx: &Cx, e: &Expr) -> RExpr {
         match &e.kind {
             ExprKind::Name(ident) => {
@@ -971,20 +1048,25 @@ impl Resolver<'_> {
         }
     }
 
-    fn op_block(&mut self, cx: &Cx, b: &ast::Block<Body>) -> RBlock<RBody> {
+    /// The block of an operation; `comp`: the heads are comp selectors.
+    fn op_block(&mut self, cx: &Cx, b: &ast::Block<Body>, comp: bool) -> RBlock<RBody> {
         RBlock {
             parts: b
                 .parts
                 .iter()
                 .map(|p| match p {
                     BlockPart::Entry(e) => RPart::Entry {
-                        head: self.head(cx, &e.head),
+                        head: if comp {
+                            self.comp_head(cx, &e.head)
+                        } else {
+                            self.head(cx, &e.head)
+                        },
                         depth: e.depth.as_ref().map(|d| self.expr(cx, d)),
                         op: e.op,
                         body: self.body(cx, &e.body),
                         span: e.span,
                     },
-                    BlockPart::Group(g) => RPart::Group(self.op_block(cx, g)),
+                    BlockPart::Group(g) => RPart::Group(self.op_block(cx, g, comp)),
                     BlockPart::Unlabeled { body, span } => RPart::Unlabeled {
                         body: self.body(cx, body),
                         span: *span,
@@ -1047,7 +1129,10 @@ impl Resolver<'_> {
                 return RStmt::Nil;
             }
             let args = self.op_args(cx, name, call.args.as_deref().unwrap_or(&[]));
-            let block = call.block.as_ref().map(|b| self.op_block(cx, b));
+            let block = call
+                .block
+                .as_ref()
+                .map(|b| self.op_block(cx, b, name == "comp"));
             if block.is_some() && !info.block {
                 self.error(format!("`{name}` takes no `{{ ... }}` block"), span);
             }
@@ -1062,7 +1147,7 @@ impl Resolver<'_> {
             // Resolve what is inside anyway, so that its errors are reported.
             let _ = self.op_args(cx, name, call.args.as_deref().unwrap_or(&[]));
             if let Some(b) = &call.block {
-                let _ = self.op_block(cx, b);
+                let _ = self.op_block(cx, b, false);
             }
             return RStmt::Unsupported {
                 name: name.to_string(),

@@ -128,11 +128,14 @@ pub fn transformed(mesh: &Mesh, t: &DAffine3) -> Mesh {
     m
 }
 
-/// Trim state of a shape (`trim.horizontal`, `trim.vertical`).
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Trim state of a shape: the switches `trim.horizontal` and
+/// `trim.vertical`, and the trim planes the last face component split gave
+/// the shape or an ancestor (see `crate::trim`; shared, so copies are cheap).
+#[derive(Clone, Debug, PartialEq)]
 pub struct TrimFlags {
     pub horizontal: bool,
     pub vertical: bool,
+    pub planes: Option<crate::trim::TrimPlanes>,
 }
 
 impl Default for TrimFlags {
@@ -140,6 +143,7 @@ impl Default for TrimFlags {
         TrimFlags {
             horizontal: false,
             vertical: true,
+            planes: None,
         }
     }
 }

@@ -275,6 +275,11 @@ pub fn insert_fitted(shape: &mut Shape, asset: Arc<Mesh>, mode: InsertMode) {
     let mut g = crate::shape::Geometry::new(asset);
     g.transform(to_local);
     shape.geometry = g;
+    if shape.trim.planes.is_some() {
+        // Inserted geometry is cut by the trim planes of a component split
+        // (op_i.md); it fills the box [0, size] of the new scope.
+        crate::trim::apply(shape, Some((DVec3::ZERO.min(s), DVec3::ZERO.max(s))));
+    }
 }
 
 fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {

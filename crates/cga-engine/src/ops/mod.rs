@@ -3,6 +3,7 @@
 //! Each family of operations lives in its own module.
 
 mod attrs;
+pub mod comp;
 mod create;
 mod scope_ops;
 pub mod split;
@@ -55,6 +56,8 @@ pub enum Op {
     ReverseNormals,
     Split,
     SplitArea,
+    Comp,
+    Trim,
 }
 
 /// How an operation's arguments are read by the resolver.
@@ -154,6 +157,13 @@ pub fn lookup(name: &str) -> Option<OpInfo> {
             max_args: 2,
             block: true,
         }),
+        "comp" => Some(OpInfo {
+            op: Op::Comp,
+            min_args: 1,
+            max_args: 2,
+            block: true,
+        }),
+        "trim" => info(Op::Trim, 0, 0),
         _ => None,
     }
 }
@@ -254,6 +264,8 @@ pub fn exec(
     match call.op {
         Op::Split => split::exec(cx, st, call, args, frame),
         Op::SplitArea => split_area::exec(cx, st, call, args, frame),
+        Op::Comp => comp::exec(cx, st, call, args, frame),
+        Op::Trim => crate::trim::exec(cx, st, call),
         Op::T | Op::Translate | Op::S | Op::R | Op::Rotate | Op::Center => {
             transform::exec(cx, st, call, args)
         }

@@ -363,7 +363,6 @@ fn insert_missing_asset_warns() {
 /// op_i, "Window insertion": a 47 m mass, facades split into floors and
 /// windows, a window asset in each window.
 #[test]
-#[ignore = "comp is not implemented yet (ops/comp.rs)"]
 fn insert_windows_into_a_facade() {
     let src = "Lot --> extrude(47) comp(f){side : Facade | top : X }\n\
                Facade --> split(y) { { ~1 : X | ~8 : Floor }* | ~1 : X }\n\
@@ -381,7 +380,6 @@ fn insert_windows_into_a_facade() {
 /// of a cube are cut by the trim planes of the component split, unless
 /// trim.vertical is disabled before the insert.
 #[test]
-#[ignore = "comp and trim planes are not implemented yet (ops/comp.rs)"]
 fn insert_is_cut_by_trim_planes() {
     let trimmed = "Lot--> primitiveCube() s(10,40,10) t(-5, 0, -5) comp(f) { side: Side }\n\
                    Side--> t(0,0,-5) s('1,'1,10) i(\"builtin:cylinder\")\n";

@@ -454,7 +454,6 @@ fn index_operator_page_examples() {
 
 /// func_index, "Recursive element selection" (needs the comp function).
 #[test]
-#[ignore = "the comp function is not implemented yet (eval.rs CompFn)"]
 fn index_longest_edge() {
     let src = "indexOfLargest(array) = indexOfLargest(array, 0, 0)\n\
                indexOfLargest(array, i, iLargest) =\n    case i == size(array) : iLargest\n    else :\n        case array[i] > array[iLargest] : indexOfLargest(array, i+1, i)\n        else                            : indexOfLargest(array, i+1, iLargest)\n\

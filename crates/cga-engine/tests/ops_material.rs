@@ -106,7 +106,6 @@ fn set_generic_attribute_floor_number() {
 
 /// op_set, "Generic Shape Attributes", the page's rule with `comp(f)`.
 #[test]
-#[ignore = "comp is not implemented yet (ops/comp.rs)"]
 fn set_generic_attribute_page_rule() {
     let src = "attr floorNumber = -1\nconst floorHeight = 4\n\
                Init --> extrude(30) comp(f) {side : Side }\n\

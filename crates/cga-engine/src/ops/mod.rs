@@ -275,12 +275,9 @@ pub fn exec(
         | Op::PrimitiveCone
         | Op::Insert
         | Op::ReverseNormals => create::exec(cx, st, call, args),
-        Op::Color
-        | Op::Set(_)
-        | Op::SetMaterial
-        | Op::ResetMaterial
-        | Op::Print
-        | Op::Report => attrs::exec(cx, st, call, args),
+        Op::Color | Op::Set(_) | Op::SetMaterial | Op::ResetMaterial | Op::Print | Op::Report => {
+            attrs::exec(cx, st, call, args)
+        }
         Op::SetupProjection
         | Op::ProjectUV
         | Op::TranslateUV

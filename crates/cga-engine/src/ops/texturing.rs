@@ -96,15 +96,17 @@ pub fn exec(
         Op::NormalizeUV => {
             let set = uv_set(&args[0])?;
             let mode = selector(&args[1], &["uv", "uvUniform", "u", "v"])?;
-            let per_face =
-                selector(&args[2], &["separatePerFace", "collectiveAllFaces"])? == "separatePerFace";
+            let per_face = selector(&args[2], &["separatePerFace", "collectiveAllFaces"])?
+                == "separatePerFace";
             let mode = match mode {
                 "uv" => Normalize::Both,
                 "uvUniform" => Normalize::Uniform,
                 "u" => Normalize::U,
                 _ => Normalize::V,
             };
-            edit_uvs(shape, set, |mesh, uvs| normalize_uvs(mesh, uvs, mode, per_face));
+            edit_uvs(shape, set, |mesh, uvs| {
+                normalize_uvs(mesh, uvs, mode, per_face)
+            });
             Ok(())
         }
         Op::TileUV => tile_uv(cx, shape, call, args),
@@ -180,14 +182,20 @@ fn setup_projection(
     } else {
         let mesh = shape.object_mesh();
         let span = |a: DVec3| {
-            let mut it = mesh.corners.iter().map(|&c| mesh.positions[c as usize].dot(a));
+            let mut it = mesh
+                .corners
+                .iter()
+                .map(|&c| mesh.positions[c as usize].dot(a));
             let first = it.next().unwrap_or(0.0);
             let (lo, hi) = it.fold((first, first), |(lo, hi), x| (lo.min(x), hi.max(x)));
             hi - lo
         };
         DVec2::new(span(au), span(av))
     };
-    let size = DVec2::new(tile_size(&args[2], extent.x)?, tile_size(&args[3], extent.y)?);
+    let size = DVec2::new(
+        tile_size(&args[2], extent.x)?,
+        tile_size(&args[3], extent.y)?,
+    );
     if size.x == 0.0 || size.y == 0.0 || !size.is_finite() {
         cx.warn_once(call.span, || {
             format!("setupProjection: the texture size must not be 0 (found {} x {}); no projection is set up", size.x, size.y)
@@ -283,9 +291,9 @@ fn normalize_uvs(mesh: &Mesh, uvs: &mut [DVec2], mode: Normalize, per_face: bool
     let apply = |uvs: &mut [DVec2], corners: &mut dyn Iterator<Item = usize>| {
         let idx: Vec<usize> = corners.collect();
         let Some(&first) = idx.first() else { return };
-        let (lo, hi) = idx
-            .iter()
-            .fold((uvs[first], uvs[first]), |(lo, hi), &c| (lo.min(uvs[c]), hi.max(uvs[c])));
+        let (lo, hi) = idx.iter().fold((uvs[first], uvs[first]), |(lo, hi), &c| {
+            (lo.min(uvs[c]), hi.max(uvs[c]))
+        });
         let range = hi - lo;
         let inv = |r: f64| if r.abs() > 1e-300 { 1.0 / r } else { 0.0 };
         let scale = match mode {
@@ -556,8 +564,14 @@ pub fn cut_along_uv(mesh: &Mesh, set: usize, axis: usize, cuts: &[f64]) -> Vec<M
             (lo.min(x), hi.max(x))
         });
         let eps = 1e-9 * (1.0 + lo.abs().max(hi.abs()));
-        let first = cuts.partition_point(|&c| c <= lo + eps);
-        let last = cuts.partition_point(|&c| c < hi - eps).max(first);
+        let mut first = cuts.partition_point(|&c| c <= lo + eps);
+        let mut last = cuts.partition_point(|&c| c < hi - eps).max(first);
+        if first == cuts.len() && first > 0 && hi <= cuts[first - 1] + eps {
+            // A face on the last cut (the far end of the range, an end
+            // wall) belongs to the slab below it, not to the empty one above.
+            first -= 1;
+            last = first;
+        }
         if first == last || mesh.outer_loop(f).len < 3 {
             copy_face(mesh, f, &mut slabs[first], &mut remaps[first]);
             continue;
@@ -625,10 +639,7 @@ fn copy_face(mesh: &Mesh, f: usize, out: &mut Mesh, remap: &mut Vec<u32>) {
         }
         out.loops.push(Loop { start, len: l.len });
     }
-    out.faces.push(Face {
-        first_loop,
-        ..face
-    });
+    out.faces.push(Face { first_loop, ..face });
 }
 
 /// Appends all faces of `piece` (a cut of one face) to `out` with the
@@ -770,9 +781,9 @@ fn affine_fit(points: &[DVec3], values: &[f64]) -> Option<AffineFit> {
     if !(g.length_squared() > 0.0) || !g.is_finite() {
         return None;
     }
-    let (lo, hi) = values
-        .iter()
-        .fold((values[0], values[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    let (lo, hi) = values.iter().fold((values[0], values[0]), |(lo, hi), &v| {
+        (lo.min(v), hi.max(v))
+    });
     let tol_value = 1e-6 * (hi - lo).max(1e-12);
     let unit_n = n / nn.sqrt();
     let tol_plane = 1e-7 * size.max(1e-9);
@@ -897,8 +908,15 @@ mod tests {
         assert!((areas[1] - 10.0).abs() < 1e-9);
         assert!((areas[2] - 20.0).abs() < 1e-9);
         // The cut corners carry the cut value.
-        let us: Vec<f64> = slabs[1].uvs[0].as_ref().unwrap().iter().map(|t| t.x).collect();
-        assert!(us.iter().all(|&u| (u - 0.25).abs() < 1e-12 || (u - 0.5).abs() < 1e-12));
+        let us: Vec<f64> = slabs[1].uvs[0]
+            .as_ref()
+            .unwrap()
+            .iter()
+            .map(|t| t.x)
+            .collect();
+        assert!(us
+            .iter()
+            .all(|&u| (u - 0.25).abs() < 1e-12 || (u - 0.5).abs() < 1e-12));
     }
 
     #[test]

@@ -89,6 +89,11 @@ pub(crate) struct GltfWriter {
     buckets: Vec<Bucket>,
     /// Colour map texture of each material id, if usable.
     colormaps: Vec<Option<u32>>,
+    /// Whether each material takes its opacity from the colour map's alpha
+    /// (its opacity map is the colour map).
+    alpha_maps: Vec<bool>,
+    /// Whether some material uses `KHR_texture_transform`.
+    uses_transform: bool,
     /// Output vertex of each corner of the mesh being added.
     corner_vertex: Vec<u32>,
     dedup: FastMap<VertexKey, u32>,
@@ -112,6 +117,8 @@ impl GltfWriter {
             bin_name: format!("{stem}.bin"),
             buckets: Vec::new(),
             colormaps: Vec::new(),
+            alpha_maps: Vec::new(),
+            uses_transform: false,
             corner_vertex: Vec::new(),
             dedup: FastMap::default(),
         })
@@ -151,8 +158,22 @@ impl GltfWriter {
             // A textured material needs TEXCOORD_0 on every vertex.
             bucket.uvs = Some(Vec::new());
         }
+        // glTF has no opacity map of its own: opacity is the base colour
+        // texture's alpha. An opacity map that is the colour map (what
+        // `texture()` sets for images with alpha) is exactly that.
+        let opacity_map = &material.maps[4].path;
+        let alpha = colormap.is_some() && !opacity_map.is_empty() && opacity_map == path;
+        if !opacity_map.is_empty() && !alpha {
+            warnings.push(format!(
+                "opacity map '{opacity_map}' is not the colour map; glTF takes opacity from the colour map's alpha: written without it"
+            ));
+        }
+        if colormap.is_some() && texture_transform(&material.maps[0]).is_some() {
+            self.uses_transform = true;
+        }
         self.buckets.push(bucket);
         self.colormaps.push(colormap);
+        self.alpha_maps.push(alpha);
     }
 
     pub(crate) fn begin_mesh(&mut self, mesh: &Mesh) {
@@ -280,7 +301,11 @@ impl GltfWriter {
                 json::texture::Info {
                     index,
                     tex_coord: 0,
-                    extensions: None,
+                    extensions: texture_transform(&table.get(id).maps[0]).map(|t| {
+                        let mut others = serde_json::Map::new();
+                        others.insert("KHR_texture_transform".into(), t);
+                        json::extensions::texture::Info { others }
+                    }),
                     extras: Default::default(),
                 }
             });
@@ -288,6 +313,7 @@ impl GltfWriter {
                 table.get(id),
                 name.clone(),
                 base_color_texture,
+                self.alpha_maps[id as usize],
             ));
             let mesh = root.push(json::Mesh {
                 extensions: None,
@@ -321,6 +347,10 @@ impl GltfWriter {
             }
         }
 
+        if self.uses_transform && !images.is_empty() {
+            root.extensions_used
+                .push("KHR_texture_transform".to_string());
+        }
         if !nodes.is_empty() {
             let scene = root.push(json::Scene {
                 extensions: None,
@@ -511,11 +541,40 @@ fn add_texture(
     })
 }
 
-/// The glTF material for a CGA material.
+/// The `KHR_texture_transform` of a texture channel's `su sv tu tv rw`, or
+/// `None` for the identity.
+///
+/// CGA's channel transform maps texture coordinates as
+/// `uv' = R(rw) * (su u, sv v) + (tu, tv)`, `rw` in degrees counter-clockwise
+/// (the order glTF's extension uses too). glTF's coordinates are CGA's with
+/// v flipped (`v_gltf = 1 - v`), which turns that map into: the same scale,
+/// the rotation `rw` (the extension rotates clockwise in CGA's terms), and
+/// the offset `(tu - sv sin rw, 1 - tv - sv cos rw)`.
+fn texture_transform(ch: &cga_geometry::TextureChannel) -> Option<serde_json::Value> {
+    let identity = ch.su == 1.0 && ch.sv == 1.0 && ch.tu == 0.0 && ch.tv == 0.0 && ch.rw == 0.0;
+    let finite = [ch.su, ch.sv, ch.tu, ch.tv, ch.rw]
+        .iter()
+        .all(|x| x.is_finite());
+    if identity || !finite {
+        return None;
+    }
+    let (s, c) = ch.rw.to_radians().sin_cos();
+    let offset = [ch.tu - ch.sv * s, 1.0 - ch.tv - ch.sv * c];
+    Some(serde_json::json!({
+        "offset": offset.map(|x| x as f32),
+        "rotation": ch.rw.to_radians() as f32,
+        "scale": [ch.su as f32, ch.sv as f32],
+    }))
+}
+
+/// The glTF material for a CGA material. `alpha_map`: the opacity comes
+/// from the colour map's alpha, blended, masked or ignored as
+/// `material.opacitymap.mode` says.
 fn gltf_material(
     m: &Material,
     name: String,
     base_color_texture: Option<json::texture::Info>,
+    alpha_map: bool,
 ) -> json::Material {
     let linear = m.color.map(|c| srgb_to_linear(c) as f32);
     let opacity = m.opacity.clamp(0.0, 1.0) as f32;
@@ -527,12 +586,19 @@ fn gltf_material(
         }
     };
     let emissive = m.emissive.map(|c| srgb_to_linear(c) as f32);
+    let (alpha_mode, alpha_cutoff) = match (alpha_map, &*m.opacitymap_mode) {
+        (true, "mask") => (
+            json::material::AlphaMode::Mask,
+            Some(json::material::AlphaCutoff(unit(m.opacitymap_cutoff))),
+        ),
+        (true, "opaque") if opacity >= 1.0 => (json::material::AlphaMode::Opaque, None),
+        (true, _) => (json::material::AlphaMode::Blend, None),
+        (false, _) if opacity < 1.0 => (json::material::AlphaMode::Blend, None),
+        _ => (json::material::AlphaMode::Opaque, None),
+    };
     json::Material {
-        alpha_mode: Valid(if opacity < 1.0 {
-            json::material::AlphaMode::Blend
-        } else {
-            json::material::AlphaMode::Opaque
-        }),
+        alpha_mode: Valid(alpha_mode),
+        alpha_cutoff,
         double_sided: m.double_sided,
         name: Some(name),
         pbr_metallic_roughness: json::material::PbrMetallicRoughness {
@@ -570,6 +636,12 @@ fn write_bin(
     }
     for &t in images {
         let tex = textures.get(t);
+        if let Some(data) = &tex.data {
+            w.write_all(data).map_err(io)?;
+            let pad = (tex.len.next_multiple_of(4) - tex.len) as usize;
+            w.write_all(&[0u8; 3][..pad]).map_err(io)?;
+            continue;
+        }
         let file = File::open(&tex.source).map_err(|e| ExportError::io(&tex.source, e))?;
         let copied = std::io::copy(&mut file.take(tex.len), w).map_err(io)?;
         if copied != tex.len {

@@ -773,12 +773,14 @@ fn affine_fit(points: &[DVec3], values: &[f64]) -> Option<AffineFit> {
     let n = e1.cross(e2);
     let nn = n.length_squared();
     let size = e1.length();
-    if !(nn > 1e-24 * size.powi(4)) || !nn.is_finite() {
+    let spread = nn.is_finite() && nn > 1e-24 * size.powi(4);
+    if !spread {
         return None;
     }
     let (d1, d2) = (values[i1] - values[0], values[i2] - values[0]);
     let g = (e2.cross(n) * d1 + n.cross(e1) * d2) / nn;
-    if !(g.length_squared() > 0.0) || !g.is_finite() {
+    let varies = g.is_finite() && g.length_squared() > 0.0;
+    if !varies {
         return None;
     }
     let (lo, hi) = values.iter().fold((values[0], values[0]), |(lo, hi), &v| {
@@ -833,7 +835,8 @@ fn cut_in_texture_space(face: &Mesh, set: usize, axis: usize, cuts: &[f64]) -> O
         .iter()
         .fold((uv[0], uv[0]), |(lo, hi), &t| (lo.min(t), hi.max(t)));
     let extent = (hi - lo).max_element();
-    if !(area2.abs() > 1e-12 * extent * extent) {
+    let has_area = area2.abs() > 1e-12 * extent * extent;
+    if !has_area {
         return None;
     }
     let mut m = face.clone();

@@ -42,6 +42,9 @@ enum Command {
     Check {
         /// The rule file.
         rules: PathBuf,
+        /// `text` for people, `json` (one object with all diagnostics) for tools.
+        #[arg(long, value_enum, default_value_t = CheckFormat::Text)]
+        format: CheckFormat,
     },
 }
 
@@ -68,6 +71,9 @@ struct GenerateArgs {
     /// Write the values of report() as JSON.
     #[arg(long, value_name = "FILE")]
     report: Option<PathBuf>,
+    /// Print timings on standard error: lots/s, shapes/s, triangles/s, peak memory.
+    #[arg(long)]
+    stats: bool,
     /// Worker threads (default: all cores). The output does not depend on it.
     #[arg(long, value_name = "N")]
     jobs: Option<usize>,
@@ -77,6 +83,12 @@ struct GenerateArgs {
     /// Maximum number of shapes per lot.
     #[arg(long, default_value_t = Limits::default().max_shapes)]
     max_shapes: usize,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum CheckFormat {
+    Text,
+    Json,
 }
 
 /// How a run ended.
@@ -98,7 +110,7 @@ fn main() -> ExitCode {
         .stack_size(DERIVATION_STACK)
         .spawn(move || match cli.command {
             Command::Generate(args) => generate(args),
-            Command::Check { rules } => check(&rules),
+            Command::Check { rules, format } => check(&rules, format),
         });
     let result = match worker.map(|w| w.join()) {
         Ok(Ok(r)) => r,
@@ -136,17 +148,63 @@ fn load(path: &Path, sources: &mut SourceMap) -> Result<cga_engine::Program, Fai
     loaded.program.ok_or(Failure::Rules)
 }
 
-fn check(path: &Path) -> Result<(), Failure> {
+fn check(path: &Path, format: CheckFormat) -> Result<(), Failure> {
+    if format == CheckFormat::Text {
+        let mut sources = SourceMap::new();
+        let program = load(path, &mut sources)?;
+        eprintln!(
+            "{}: ok ({} rules, {} attributes, {} functions)",
+            path.display(),
+            program.rules.len(),
+            program.attrs.len(),
+            program.functions.len()
+        );
+        return Ok(());
+    }
+    if !path.is_file() {
+        return Err(Failure::Usage(format!(
+            "rule file {} not found",
+            path.display()
+        )));
+    }
     let mut sources = SourceMap::new();
-    let program = load(path, &mut sources)?;
-    eprintln!(
-        "{}: ok ({} rules, {} attributes, {} functions)",
-        path.display(),
-        program.rules.len(),
-        program.attrs.len(),
-        program.functions.len()
-    );
-    Ok(())
+    let loaded = cga_engine::load(path, &mut sources);
+    let diagnostics: Vec<serde_json::Value> = loaded
+        .diagnostics
+        .iter()
+        .map(|d| diagnostic_json(d, &sources))
+        .collect();
+    let ok = loaded.program.is_some();
+    let doc = serde_json::json!({ "file": path.display().to_string(), "ok": ok, "diagnostics": diagnostics });
+    println!("{}", serde_json::to_string_pretty(&doc).unwrap_or_default());
+    if ok {
+        Ok(())
+    } else {
+        Err(Failure::Rules)
+    }
+}
+
+/// A diagnostic as JSON for tools: severity, message, file, 1-based line and
+/// column of the start and end, label and notes.
+fn diagnostic_json(d: &Diagnostic, sources: &SourceMap) -> serde_json::Value {
+    let severity = if d.is_error() { "error" } else { "warning" };
+    let mut v = serde_json::json!({
+        "severity": severity,
+        "message": d.message,
+        "label": d.label,
+        "notes": d.notes,
+    });
+    if let Some(span) = d.span {
+        let file = sources.get(span.file);
+        let (line, column) = file.line_col(span.start);
+        let (end_line, end_column) = file.line_col(span.end);
+        v["file"] = file.path.display().to_string().into();
+        v["line"] = line.into();
+        v["column"] = column.into();
+        v["end_line"] = end_line.into();
+        v["end_column"] = end_column.into();
+    }
+    v
 }
 
 fn read_lots(specs: &[String]) -> Result<Vec<Lot>, Failure> {
@@ -157,6 +215,10 @@ fn read_lots(specs: &[String]) -> Result<Vec<Lot>, Failure> {
     for spec in specs {
         if let Some(rect) = spec.strip_prefix("rect:") {
             lots.push(lot::parse_rect(rect).map_err(Failure::Usage)?);
+            continue;
+        }
+        if let Some(grid) = spec.strip_prefix("grid:") {
+            lots.extend(grid_lots(grid)?);
             continue;
         }
         let path = Path::new(spec);
@@ -178,7 +240,56 @@ fn read_lots(specs: &[String]) -> Result<Vec<Lot>, Failure> {
     Ok(lots)
 }
 
+/// `grid:COLSxROWS` (20 x 30 lots) or `grid:COLSxROWS:LOTS.obj` (copies of
+/// the OBJ's lots): a synthetic city of lots in a grid, for benchmarks.
+fn grid_lots(spec: &str) -> Result<Vec<Lot>, Failure> {
+    let (dims, source) = match spec.split_once(':') {
+        Some((d, s)) => (d, Some(s)),
+        None => (spec, None),
+    };
+    let bad = || {
+        Failure::Usage(format!(
+            "expected grid:COLSxROWS[:LOTS.obj], found `grid:{spec}`"
+        ))
+    };
+    let (c, r) = dims.split_once('x').ok_or_else(bad)?;
+    let cols: usize = c.trim().parse().map_err(|_| bad())?;
+    let rows: usize = r.trim().parse().map_err(|_| bad())?;
+    if cols == 0 || rows == 0 || cols.saturating_mul(rows) > 10_000_000 {
+        return Err(bad());
+    }
+    let base = match source {
+        Some(path) => lot::from_obj(Path::new(path)).map_err(Failure::Usage)?,
+        None => vec![lot::rect(20.0, 30.0)],
+    };
+    let (lo, hi) = base
+        .iter()
+        .filter_map(|l| cga_geometry::measure::bounds(&l.mesh))
+        .fold(
+            (
+                cga_geometry::DVec3::splat(f64::INFINITY),
+                cga_geometry::DVec3::splat(f64::NEG_INFINITY),
+            ),
+            |(lo, hi), (a, b)| (lo.min(a), hi.max(b)),
+        );
+    let step = (hi - lo) + cga_geometry::DVec3::splat(10.0);
+    let mut lots = Vec::with_capacity(cols * rows * base.len());
+    for row in 0..rows {
+        for col in 0..cols {
+            let shift = cga_geometry::DVec3::new(col as f64 * step.x, 0.0, -(row as f64) * step.z);
+            for b in &base {
+                let mut l = b.clone();
+                l.mesh.map_positions(|p| p + shift);
+                l.name = format!("grid {col},{row} {}", b.name);
+                lots.push(l);
+            }
+        }
+    }
+    Ok(lots)
+}
+
 fn generate(args: GenerateArgs) -> Result<(), Failure> {
+    let started = std::time::Instant::now();
     let format = match &args.output {
         Some(path) => Some(Format::from_path(path).ok_or_else(|| {
             Failure::Usage(format!(
@@ -206,6 +317,13 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
         let (name, value) = a
             .split_once('=')
             .ok_or_else(|| Failure::Usage(format!("expected --attr NAME=VALUE, found `{a}`")))?;
+        if name == "seed" && program.main_attr("seed").is_none() {
+            // As in CityEngine, `seed` is the initial shapes' random seed.
+            options.seed = value.trim().parse().map_err(|_| {
+                Failure::Usage(format!("the seed must be a whole number, found `{value}`"))
+            })?;
+            continue;
+        }
         let id = program.main_attr(name).ok_or_else(|| {
             let known: Vec<&str> = program.main_attrs.iter().map(|(n, _)| n.as_str()).collect();
             Failure::Usage(format!(
@@ -311,10 +429,12 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
             lots.len()
         );
     }
+    let mut triangles = 0u64;
     if let Some(w) = writer {
         let stats = w
             .finish()
             .map_err(|e| Failure::Usage(format!("export failed: {e}")))?;
+        triangles = stats.triangles;
         for warning in &stats.warnings {
             eprintln!("warning: {warning}");
         }
@@ -330,6 +450,20 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
             );
         }
     }
+    if args.stats {
+        let secs = started.elapsed().as_secs_f64().max(1e-9);
+        eprintln!(
+            "stats: {} lots, {} shapes, {} triangles written in {:.3} s: {:.1} lots/s, {:.0} shapes/s, {:.0} triangles/s, peak memory {}",
+            lots.len(),
+            shapes,
+            triangles,
+            secs,
+            lots.len() as f64 / secs,
+            shapes as f64 / secs,
+            triangles as f64 / secs,
+            peak_memory().map_or("unknown".to_string(), |kb| format!("{:.1} MiB", kb as f64 / 1024.0))
+        );
+    }
     if let Some(path) = &args.report {
         std::fs::write(path, reports.to_json())
             .map_err(|e| Failure::Usage(format!("cannot write {}: {e}", path.display())))?;
@@ -339,6 +473,13 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
     } else {
         Ok(())
     }
+}
+
+/// Peak resident memory of this process in KiB (Linux: `VmHWM`).
+fn peak_memory() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    line.split_whitespace().nth(1)?.parse().ok()
 }
 
 /// A progress bar on standard error for long runs; hidden when standard

@@ -310,6 +310,8 @@ fn glb_gltf_and_obj_outputs_are_written() {
         assert!(out.status.success(), "{ext}: {}", stderr(&out));
         assert!(std::fs::metadata(&path).unwrap().len() > 100, "{ext}");
     }
+    assert_valid_gltf(&dir.join("m.glb"));
+    assert_valid_gltf(&dir.join("m.gltf"));
     let s = summarize(&dir.join("m.obj"));
     assert_eq!(
         s.by_appearance.get("1.000,0.000,0.000|-").copied(),

@@ -84,9 +84,18 @@ pub struct Arg {
 }
 
 impl Arg {
+    /// A finite float: no operation can use NaN or infinity (a division by
+    /// zero in the rules, say), so they stop the derivation with a message.
     pub fn num(&self) -> Result<f64, RtError> {
         match &self.value {
-            Value::Float(x) => Ok(*x),
+            Value::Float(x) if x.is_finite() => Ok(*x),
+            Value::Float(x) => Err(RtError::new(
+                format!(
+                    "expected a finite number, found {}",
+                    crate::values::to_text(&Value::Float(*x))
+                ),
+                self.span,
+            )),
             Value::Bool(b) => Ok(if *b { 1.0 } else { 0.0 }),
             other => Err(RtError::new(
                 format!(

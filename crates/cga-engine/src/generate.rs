@@ -30,10 +30,20 @@ pub fn generate_lot(
     lot_index: usize,
     options: &GenerateOptions,
 ) -> (LotOutput, Option<RtError>) {
-    let seed = options
-        .seed
-        .wrapping_mul(0x9E37_79B9_7F4A_7C15)
-        .wrapping_add(lot_index as u64);
+    // Each lot has its own seed: the run's seed for the first lot, then the
+    // following numbers (`--seed 666` on one lot gives `seedian` 666).
+    let seed = options.seed.wrapping_add(lot_index as u64);
+    if let Some(why) = crate::lot::degenerate(lot) {
+        let mut out = LotOutput::default();
+        out.warnings.push(cga_syntax::Diagnostic {
+            severity: cga_syntax::Severity::Warning,
+            message: format!("lot `{}` is skipped: {why}", lot.name),
+            span: None,
+            label: None,
+            notes: Vec::new(),
+        });
+        return (out, None);
+    }
     let shape = initial_shape(lot, seed, program.rule_symbol(rule));
     let info = InitialInfo {
         name: lot.name.clone(),

@@ -106,9 +106,73 @@ pub fn from_obj(path: &std::path::Path) -> Result<Vec<Lot>, String> {
     Ok(lots)
 }
 
+/// Why a lot cannot be derived, if it cannot: a polygon with fewer than
+/// three distinct corners, or without area, or with coordinates that are
+/// not finite.
+pub fn degenerate(lot: &Lot) -> Option<String> {
+    let m = &lot.mesh;
+    if m.positions.iter().any(|p| !p.is_finite()) {
+        return Some("its coordinates are not all finite numbers".into());
+    }
+    let area = cga_geometry::measure::mesh_area(m);
+    let size = cga_geometry::measure::bounds(m)
+        .map(|(lo, hi)| (hi - lo).length())
+        .unwrap_or(0.0);
+    if !(area > 1e-12 * size.max(1.0).powi(2)) {
+        return Some(
+            "it has no area (fewer than three distinct corners, or collinear ones)".into(),
+        );
+    }
+    None
+}
+
+/// Removes repeated consecutive corners (GIS polygons often close their
+/// rings twice or repeat points), which would make zero-length edges.
+pub fn remove_repeated_corners(mesh: &mut Mesh) {
+    let tol = cga_geometry::topology::mesh_tolerance(mesh);
+    let mut out = Mesh::new();
+    out.materials = mesh.materials.clone();
+    out.positions = mesh.positions.clone();
+    for f in 0..mesh.faces.len() {
+        let loops: Vec<Vec<u32>> = mesh
+            .face_loops(f)
+            .iter()
+            .map(|&l| {
+                let idx = mesh.loop_indices(l);
+                let mut kept: Vec<u32> = Vec::with_capacity(idx.len());
+                for &i in idx {
+                    let p = mesh.positions[i as usize];
+                    if kept
+                        .last()
+                        .is_none_or(|&k| mesh.positions[k as usize].distance(p) > tol)
+                    {
+                        kept.push(i);
+                    }
+                }
+                while kept.len() > 1
+                    && mesh.positions[kept[0] as usize]
+                        .distance(mesh.positions[*kept.last().unwrap() as usize])
+                        <= tol
+                {
+                    kept.pop();
+                }
+                kept
+            })
+            .filter(|l| l.len() >= 3)
+            .collect();
+        if loops.is_empty() {
+            continue;
+        }
+        let refs: Vec<&[u32]> = loops.iter().map(|l| l.as_slice()).collect();
+        out.add_face(&refs, mesh.faces[f].material);
+    }
+    *mesh = out;
+}
+
 /// The initial shape of a lot, ready for derivation.
 pub fn initial_shape(lot: &Lot, seed: u64, name: u32) -> Shape {
     let mut mesh = lot.mesh.clone();
+    remove_repeated_corners(&mut mesh);
     let (mut normal, mut x) = first_edge_frame(&mesh);
     if normal.y < -1e-9 {
         cga_geometry::transform::reverse_faces(&mut mesh);
@@ -157,9 +221,15 @@ pub fn initial_shape(lot: &Lot, seed: u64, name: u32) -> Shape {
         comp: None,
         trim: TrimFlags::default(),
         projections: None,
-        rng: std::cell::Cell::new(seed ^ 0x5EED_0F_C6A_u64),
+        rng: std::cell::Cell::new(seed_stream(seed as f64)),
+        seedian: seed as f64,
         name,
     }
+}
+
+/// The random stream state that a seed value starts.
+pub fn seed_stream(seed: f64) -> u64 {
+    seed.to_bits() ^ 0x5EED_0F_C6A_u64
 }
 
 /// The normal of the first face and the direction of its first edge.

@@ -73,6 +73,9 @@ pub fn load(path: &Path, sources: &mut SourceMap) -> Loaded {
         rules.sort_by_key(|&(_, id)| id);
         r.program.main_rules = rules;
     }
+    // Report in file order, whatever stage found them.
+    r.diags
+        .sort_by_key(|d| d.span.map(|s| (s.file.0, s.start)).unwrap_or((0, 0)));
     let has_errors = r.diags.iter().any(|d| d.is_error());
     let mut program = r.program;
     program.symbols = {
@@ -297,9 +300,23 @@ impl Resolver<'_> {
                 continue;
             };
             if self.stack.contains(&target) || target == path {
-                self.error(
-                    format!("import cycle: \"{}\" imports itself", decl.path),
-                    decl.path_span,
+                let name = |p: &Path| {
+                    p.file_name()
+                        .map(|n| n.to_string_lossy().into_owned())
+                        .unwrap_or_default()
+                };
+                let start = self.stack.iter().position(|p| *p == target);
+                let mut chain: Vec<String> = start
+                    .map(|i| self.stack[i..].iter().map(|p| name(p)).collect())
+                    .unwrap_or_default();
+                chain.push(name(&path));
+                chain.push(name(&target));
+                self.diags.push(
+                    Diagnostic::error(
+                        format!("import cycle: {}", chain.join(" imports ")),
+                        decl.path_span,
+                    )
+                    .with_label("this import closes the cycle"),
                 );
                 continue;
             }
@@ -660,12 +677,23 @@ impl Resolver<'_> {
         candidates
             .into_iter()
             .map(|c| (strsim::damerau_levenshtein(name, c), c))
-            .filter(|&(d, c)| d <= 2.max(name.len() / 4) && d < c.len())
+            .filter(|&(d, c)| {
+                let allowed = match name.chars().count() {
+                    0..=3 => 1,
+                    4..=6 => 2,
+                    _ => 3,
+                };
+                d <= allowed && d < c.len()
+            })
             .min()
             .map(|(_, c)| c.to_string())
     }
 
     fn unknown(&mut self, what: &str, ident: &ast::Ident, rs: RuleSetId, kind: NameKind) {
+        if ident.name.is_empty() {
+            // The parser's stand-in for a missing expression: already reported.
+            return;
+        }
         let mut d = Diagnostic::error(format!("unknown {what} `{}`", ident.name), ident.span)
             .with_label(format!("not a known {what}"));
         if let Some(s) = self.suggest(rs, &ident.name, kind) {
@@ -1003,7 +1031,7 @@ impl Resolver<'_> {
         if !arities.is_empty() {
             self.error(
                 format!(
-                    "rule `{name}` takes {} parameters, called with {arity}",
+                    "rule `{name}` takes {} parameter(s), called with {arity}",
                     arities
                         .iter()
                         .map(|a| a.to_string())

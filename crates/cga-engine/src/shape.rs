@@ -199,6 +199,9 @@ pub struct Shape {
     pub projections: Option<Arc<[Option<Projection>; 10]>>,
     /// Random stream state (`rand`, `p`, stochastic rules).
     pub rng: Cell<u64>,
+    /// The `seedian` attribute: the initial shape's seed, inherited; setting
+    /// it restarts the random stream.
+    pub seedian: f64,
     /// The shape's symbol (rule or leaf name), an index into `Program::symbols`.
     pub name: u32,
 }

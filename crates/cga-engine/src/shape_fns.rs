@@ -300,7 +300,7 @@ mod eval {
                 ),
                 ShapeFn::CompIndex => fl(shape.comp.as_ref().map_or(0.0, |c| c.index)),
                 ShapeFn::CompTotal => fl(shape.comp.as_ref().map_or(0.0, |c| c.total)),
-                ShapeFn::Seedian => fl((shape.rng.get() >> 11) as f64),
+                ShapeFn::Seedian => fl(shape.seedian),
                 ShapeFn::TrimHorizontal => Value::Bool(shape.trim.horizontal),
                 ShapeFn::TrimVertical => Value::Bool(shape.trim.vertical),
                 ShapeFn::Material(field) => {

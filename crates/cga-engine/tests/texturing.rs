@@ -310,24 +310,20 @@ fn tile_uv_sizes() {
 fn tile_uv_street_examples() {
     // tileUV page, on a 47 x 8 street with u, v in [0, 1]: tiles of exactly
     // 20 x 10 units, then ~20 (2 tiles of 23.5) by '0.5 (2 tiles).
-    let street = street_lot(47.0, 8.0);
-    let out = run(
-        "tile_street",
-        r#"Lot --> texture("builtin:uvtest.png") tileUV(0, 20, 10) X."#,
-        &street,
+    let dir = project("tile_street");
+    street_asset(&dir, 47.0, 0.0, 47.0, 8.0);
+    let out = run_in(
+        &dir,
+        r#"Lot --> i("street.obj") texture("builtin:uvtest.png") tileUV(0, 20, 10) X."#,
+        &rect(47.0, 8.0),
     );
     assert_uvs(&out.meshes[0], 0, |p| uv(p.x / 20.0, -p.z / 10.0));
-    let out = run("tile_street2", "Lot --> tileUV(0, ~20, '0.5) X.", &street);
+    let out = run_in(
+        &dir,
+        r#"Lot --> i("street.obj") tileUV(0, ~20, '0.5) X."#,
+        &rect(47.0, 8.0),
+    );
     assert_uvs(&out.meshes[0], 0, |p| uv(p.x / 23.5, -p.z / 4.0));
-}
-
-/// A straight street segment from (0,0,0) along +x, `w` wide towards -z,
-/// with u along the street and v across it, both in [0, 1].
-fn street_lot(len: f64, w: f64) -> cga_engine::lot::Lot {
-    let mut lot = rect(len, w);
-    lot.name = "street".into();
-    lot.mesh.uvs[0] = Some(vec![uv(0.0, 0.0), uv(1.0, 0.0), uv(1.0, 1.0), uv(0.0, 1.0)]);
-    lot
 }
 
 #[test]

@@ -41,7 +41,14 @@ fn texture_sets_the_opacity_map_for_images_with_alpha() {
     );
     assert_eq!(
         out.prints,
-        ["tex/leaf.png", "tex/leaf.png", "", "", "builtin:uvtest.png", ""]
+        [
+            "tex/leaf.png",
+            "tex/leaf.png",
+            "",
+            "",
+            "builtin:uvtest.png",
+            ""
+        ]
     );
     // Emitted: the file found, for both maps; built-ins stay names.
     let m = &out.meshes[0].materials[0];

@@ -4,9 +4,8 @@
 
 mod texturing_common;
 
-use cga_engine::lot::Lot;
 use cga_engine::split_layout::{layout, Size, SplitPattern};
-use cga_geometry::{DVec2, DVec3, Mesh};
+use cga_geometry::{DVec2, Mesh};
 use texturing_common::*;
 
 fn uv(u: f64, v: f64) -> DVec2 {
@@ -162,21 +161,11 @@ fn shape_without_uvs_is_left_unchanged() {
     assert!(out.warnings.iter().any(|w| w.message.contains("uv set 0")));
 }
 
-/// A street segment in the x-z plane: the street's front edge from (0,0,0)
-/// to (`front`,0,0) and its back edge from (`back0`,0,-`w`) to
-/// (`back1`,0,-`w`); u runs along the street, v across, both in [0, 1], as
-/// CityEngine generates them for streets.
-fn street(front: f64, back0: f64, back1: f64, w: f64) -> Lot {
-    let mut lot = rect(1.0, 1.0);
-    lot.name = "street".into();
-    lot.mesh = Mesh::polygon(&[
-        DVec3::ZERO,
-        DVec3::new(front, 0.0, 0.0),
-        DVec3::new(back1, 0.0, -w),
-        DVec3::new(back0, 0.0, -w),
-    ]);
-    lot.mesh.uvs[0] = Some(vec![uv(0.0, 0.0), uv(1.0, 0.0), uv(1.0, 1.0), uv(0.0, 1.0)]);
-    lot
+/// Derives `rules` on a street segment (see `street_asset`).
+fn on_street(name: &str, rules: &str, front: f64, back0: f64, back1: f64, w: f64) -> Vec<Mesh> {
+    let dir = project(name);
+    street_asset(&dir, front, back0, back1, w);
+    run_in(&dir, rules, &rect(front, w)).meshes
 }
 
 const BANDS: &str =
@@ -187,13 +176,13 @@ fn street_bands_in_unit_space() {
     // Reference: "Every 20 meters a 3 meter wide band is drawn across the
     // street." A 47 m segment takes the 23 m pattern twice, stretched to
     // 23.5 m: bands at [10.217, 13.283] and [33.717, 36.783].
-    let out = run("street_straight", BANDS, &street(47.0, 0.0, 47.0, 8.0));
+    let meshes = on_street("street_straight", BANDS, 47.0, 0.0, 47.0, 8.0);
     let k = 47.0 / 46.0;
     assert_spans(
-        &x_spans(&out.meshes),
+        &x_spans(&meshes),
         &[(10.0 * k, 13.0 * k), (33.0 * k, 36.0 * k)],
     );
-    for m in &out.meshes {
+    for m in &meshes {
         assert!(close(area(m), 3.0 * k * 8.0));
         assert_eq!(m.materials[0].color, [1.0, 0.0, 0.0]);
         // The band keeps the street's coordinates: u = x / 47.
@@ -209,7 +198,7 @@ fn street_bands_follow_the_parameterisation_of_a_bent_segment() {
     // back. Metres per u, averaged by area over the two triangles (36 m on
     // the front one of 144 m², 30 m on the back one of 120 m²), give the
     // length the pattern is laid out on.
-    let out = run("street_bent", BANDS, &street(36.0, 3.0, 33.0, 8.0));
+    let meshes = on_street("street_bent", BANDS, 36.0, 3.0, 33.0, 8.0);
     let length = (36.0 * 144.0 + 30.0 * 120.0) / 264.0;
     let mut pattern = SplitPattern::new(true);
     for s in [10.0, 3.0, 10.0] {
@@ -222,8 +211,8 @@ fn street_bands_follow_the_parameterisation_of_a_bent_segment() {
         .map(|p| (p.start / length, p.end / length))
         .collect();
     assert!(!bands.is_empty());
-    assert_eq!(out.meshes.len(), bands.len());
-    for (m, &(u0, u1)) in out.meshes.iter().zip(&bands) {
+    assert_eq!(meshes.len(), bands.len());
+    for (m, &(u0, u1)) in meshes.iter().zip(&bands) {
         let mut front = Vec::new();
         let mut back = Vec::new();
         for (p, t) in corners(m, 0) {

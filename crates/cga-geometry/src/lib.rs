@@ -9,27 +9,44 @@
 //! | [`topology`] | welding, unique edges with their faces (`comp(e)` order), closedness |
 //! | [`triangulate`] | faces to triangles for export |
 //! | [`cut`] | plane cuts with caps: `split`, trim planes |
+//! | [`area_split`] | the area left of a moving plane and its inverse: `splitArea` |
 //! | [`extrude`] | `extrude` |
+//! | [`inner_rect`] | `innerRectangle` |
 //! | [`primitive`] | `primitive*` and `builtin:cube` |
 //! | [`obj`] | OBJ + MTL assets |
 //! | [`transform`] | affine transforms, reversing, merging |
+//! | [`roof`] | `roofHip`, `roofGable`, `roofPyramid`, `roofShed`, `roofRidge` |
+//! | [`setback`] | `offset`, `setback`, `setbackToArea`, `shapeL/U/O` |
+//! | [`skeleton`] | weighted straight skeletons and wavefront offsets |
 
+pub mod area_split;
 pub mod cut;
 pub mod extrude;
+pub mod inner_rect;
 pub mod material;
 pub mod measure;
 pub mod mesh;
 pub mod obj;
 pub mod primitive;
+pub mod roof;
+pub mod setback;
+pub mod skeleton;
 pub mod topology;
 pub mod transform;
 pub mod triangulate;
 
+pub use area_split::{split_by_areas, AreaProfile, Flatness};
 pub use cut::{cut_by_plane, split_along_axis, split_by_parallel_planes};
 pub use extrude::{extrude, extrude_with_roles, ExtrudeRole, Extrusion};
 pub use glam::{DAffine3, DMat3, DQuat, DVec2, DVec3};
+pub use inner_rect::{inner_rectangle, largest_inner_rectangle};
 pub use material::{Material, TextureChannel, TEXTURE_CHANNELS};
 pub use mesh::{Face, Loop, Mesh, UV_SETS};
 pub use obj::{load_obj, parse_obj, ObjAsset, ObjError};
+pub use roof::{roof, Roof, RoofEdgeKind, RoofFaceRole, RoofKind, RoofSlope, SourceEdge};
+pub use setback::{
+    merge_strips, offset, setback, setback_to_area, Offset, OffsetFace, SetbackEdgeTag,
+};
+pub use skeleton::{skeleton, straight_skeleton, Skeleton, SkeletonError, StopAt, WeightChange};
 pub use topology::Topology;
 pub use triangulate::triangulate_face;

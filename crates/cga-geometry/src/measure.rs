@@ -66,7 +66,10 @@ pub fn face_area(mesh: &Mesh, face: usize) -> f64 {
 
 /// Sum of the face areas.
 pub fn mesh_area(mesh: &Mesh) -> f64 {
-    (0..mesh.faces.len()).map(|f| face_area(mesh, f)).sum()
+    // A fold from +0.0: `sum()` of nothing is -0.0, which prints as "-0".
+    (0..mesh.faces.len())
+        .map(|f| face_area(mesh, f))
+        .fold(0.0, |a, b| a + b)
 }
 
 /// Sum of the areas of the faces for which `keep(face, unit_normal)` holds
@@ -75,7 +78,7 @@ pub fn mesh_area_where(mesh: &Mesh, mut keep: impl FnMut(usize, DVec3) -> bool) 
     (0..mesh.faces.len())
         .filter(|&f| keep(f, face_normal(mesh, f)))
         .map(|f| face_area(mesh, f))
-        .sum()
+        .fold(0.0, |a, b| a + b)
 }
 
 /// Signed volume enclosed by the mesh (divergence theorem): positive for a

@@ -195,3 +195,31 @@ pub fn compare(golden: &Summary, ours: &Summary, tol: f64) -> Vec<String> {
     }
     bad
 }
+
+/// Runs the Khronos glTF validator (`tools/gltf-validator`) on `file` and
+/// asserts no errors. Skipped with a note when the validator is not
+/// installed, unless `CGA_REQUIRE_GLTF_VALIDATOR=1` (as in CI).
+pub fn assert_valid_gltf(file: &Path) {
+    let tool = manifest_dir().join("../../tools/gltf-validator");
+    if !tool.join("node_modules/gltf-validator").is_dir() {
+        assert!(
+            std::env::var("CGA_REQUIRE_GLTF_VALIDATOR").as_deref() != Ok("1"),
+            "the glTF validator is not installed: run `npm ci --prefix tools/gltf-validator`"
+        );
+        eprintln!(
+            "note: glTF validator not installed; not validating {}",
+            file.display()
+        );
+        return;
+    }
+    let out = Command::new("node")
+        .arg(tool.join("validate.mjs"))
+        .arg(file)
+        .output()
+        .expect("node runs the glTF validator");
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("a JSON report");
+    assert_eq!(
+        report["issues"]["numErrors"], 0,
+        "validator errors: {report:#}"
+    );
+}

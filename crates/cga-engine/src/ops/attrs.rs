@@ -144,7 +144,10 @@ fn set(cx: &mut Interp, shape: &mut Shape, target: SetTarget, arg: &Arg) -> Resu
             }
             ShapeFn::TrimHorizontal => shape.trim.horizontal = arg.boolean()?,
             ShapeFn::TrimVertical => shape.trim.vertical = arg.boolean()?,
-            ShapeFn::Seedian => shape.rng.set(arg.num()?.to_bits()),
+            ShapeFn::Seedian => {
+                shape.seedian = arg.num()?;
+                shape.rng.set(crate::lot::seed_stream(shape.seedian));
+            }
             ShapeFn::Scope(i) => {
                 let x = arg.num()?;
                 let k = (i % 3) as usize;

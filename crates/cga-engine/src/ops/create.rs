@@ -308,7 +308,12 @@ fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {
     };
     let dir = match how {
         Extrusion::Direction(d) | Extrusion::DirectionFlatTop(d) => d,
-        _ => cga_geometry::measure::face_normal(&mesh, 0),
+        // The first face with an area gives the direction; geometry without
+        // area (an edge, a collapsed polygon) is extruded along the scope's y.
+        _ => (0..mesh.faces.len())
+            .map(|f| cga_geometry::measure::face_normal(&mesh, f))
+            .find(|n| n.length_squared() > 0.5)
+            .unwrap_or(shape.scope.frame.axes.y_axis),
     };
     let out = cga_geometry::extrude(&mesh, how, dist);
     // New scope: y along the extrusion, x the old x made orthogonal to it.

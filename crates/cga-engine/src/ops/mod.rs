@@ -6,6 +6,7 @@ mod attrs;
 mod create;
 mod scope_ops;
 pub mod split;
+pub mod split_area;
 pub mod texturing;
 mod transform;
 
@@ -54,6 +55,7 @@ pub enum Op {
     ResetGeometry,
     ReverseNormals,
     Split,
+    SplitArea,
     SetupProjection,
     ProjectUV,
     TranslateUV,
@@ -164,6 +166,12 @@ pub fn lookup(name: &str) -> Option<OpInfo> {
             max_args: 3,
             block: true,
         }),
+        "splitArea" => Some(OpInfo {
+            op: Op::SplitArea,
+            min_args: 1,
+            max_args: 2,
+            block: true,
+        }),
         _ => None,
     }
 }
@@ -263,6 +271,7 @@ pub fn exec(
 ) -> Result<(), RtError> {
     match call.op {
         Op::Split => split::exec(cx, st, call, args, frame),
+        Op::SplitArea => split_area::exec(cx, st, call, args, frame),
         Op::T | Op::Translate | Op::S | Op::R | Op::Rotate | Op::Center => {
             transform::exec(cx, st, call, args)
         }

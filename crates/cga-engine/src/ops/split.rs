@@ -89,7 +89,7 @@ pub fn exec(
 
 /// Evaluates the sizes of a split block into `pattern`, in source order;
 /// `bodies[k]` is the operations of part `k`.
-fn add_parts<'b>(
+pub(crate) fn add_parts<'b>(
     cx: &mut Interp,
     frame: &[Value],
     shape: &Shape,
@@ -167,7 +167,14 @@ fn cut_parts(mesh: &Arc<Mesh>, axis: usize, sign: f64, placed: &[Placed]) -> Vec
 /// Gives `child` the part's geometry (in the parent's scope-local frame)
 /// and its scope: the slab `[start, start + size]` along the axis, or the
 /// geometry's bounding box (`adjust`).
-fn place_part(child: &mut Shape, piece: Mesh, axis: usize, start: f64, size: f64, adjust: bool) {
+pub(crate) fn place_part(
+    child: &mut Shape,
+    piece: Mesh,
+    axis: usize,
+    start: f64,
+    size: f64,
+    adjust: bool,
+) {
     let mut offset = DVec3::ZERO;
     offset[axis] = start;
     let axes = child.scope.frame.axes;

@@ -104,3 +104,18 @@ pub fn span(mesh: &Mesh, axis: usize) -> (f64, f64) {
 pub fn close(a: f64, b: f64) -> bool {
     (a - b).abs() < 1e-9
 }
+
+/// Writes `assets/street.obj` into the project `dir`: a street segment in
+/// the x-z plane whose front edge runs from (0,0,0) to (`front`,0,0) and
+/// whose back edge runs from (`back0`,0,-`w`) to (`back1`,0,-`w`), with u
+/// along the street and v across it, both in [0, 1] as CityEngine gives
+/// streets their coordinates. Inserted with `i("street.obj")` on the lot
+/// `rect(front, w)` it keeps exactly these positions (the lot's scope is the
+/// segment's bounding box).
+pub fn street_asset(dir: &Path, front: f64, back0: f64, back1: f64, w: f64) {
+    let obj = format!(
+        "v 0 0 0\nv {front} 0 0\nv {back1} 0 {z}\nv {back0} 0 {z}\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n",
+        z = -w
+    );
+    std::fs::write(dir.join("assets/street.obj"), obj).unwrap();
+}

@@ -165,11 +165,13 @@ fn shape_without_uvs_is_left_unchanged() {
 fn on_street(name: &str, rules: &str, front: f64, back0: f64, back1: f64, w: f64) -> Vec<Mesh> {
     let dir = project(name);
     street_asset(&dir, front, back0, back1, w);
-    run_in(&dir, rules, &rect(front, w)).meshes
+    let out = run_in(&dir, rules, &rect(front, w));
+    assert!(out.warnings.is_empty(), "{:?}", out.warnings);
+    out.meshes
 }
 
-const BANDS: &str =
-    r##"Lot --> split(u, unitSpace, 0) { ~10 : NIL | ~3 : color("#ff0000") X | ~10 : NIL }*"##;
+const BANDS: &str = r##"Lot --> i("street.obj") Street
+Street --> split(u, unitSpace, 0) { ~10 : NIL | ~3 : color("#ff0000") X | ~10 : NIL }*"##;
 
 #[test]
 fn street_bands_in_unit_space() {

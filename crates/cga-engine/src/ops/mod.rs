@@ -65,6 +65,7 @@ pub enum Op {
     TileUV,
     DeleteUV,
     CopyUV,
+    InsertAlongUV,
 }
 
 /// How an operation's arguments are read by the resolver.
@@ -160,6 +161,7 @@ pub fn lookup(name: &str) -> Option<OpInfo> {
         "tileUV" => info(Op::TileUV, 3, 3),
         "deleteUV" => info(Op::DeleteUV, 1, 1),
         "copyUV" => info(Op::CopyUV, 2, 2),
+        "insertAlongUV" => info(Op::InsertAlongUV, 3, 5),
         "split" => Some(OpInfo {
             op: Op::Split,
             min_args: 1,
@@ -296,6 +298,7 @@ pub fn exec(
         | Op::TileUV
         | Op::DeleteUV
         | Op::CopyUV
+        | Op::InsertAlongUV
         | Op::Texture => texturing::exec(cx, st, call, args),
         Op::AlignScopeToAxes
         | Op::AlignScopeToGeometry

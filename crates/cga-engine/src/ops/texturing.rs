@@ -1,5 +1,6 @@
 //! Texturing: `setupProjection`, `projectUV`, `translateUV`, `scaleUV`,
-//! `rotateUV`, `normalizeUV`, `tileUV`, `deleteUV`, `copyUV`, `texture`;
+//! `rotateUV`, `normalizeUV`, `tileUV`, `deleteUV`, `copyUV`, `texture`,
+//! `insertAlongUV` (in [`insert_along_uv`]);
 //! the cut along iso-lines of a texture coordinate behind `split(u|v, ...)`;
 //! and how texture paths written in rules become files.
 //!
@@ -33,6 +34,8 @@
 //! replaced by the absolute path of the file found; paths that name no file
 //! stay as written (the exporter looks for them once more and warns).
 //! `builtin:` textures are left to the exporter, which generates them.
+
+pub mod insert_along_uv;
 
 use std::collections::HashMap;
 use std::io::Read;
@@ -131,8 +134,81 @@ pub fn exec(
             Ok(())
         }
         Op::Texture => texture(cx, shape, call, &args[0]),
+        Op::InsertAlongUV => insert_along(cx, shape, call, args),
         _ => unreachable!("not a texturing operation"),
     }
+}
+
+/// `insertAlongUV(set, path, height[, scope.y|vertex.normal[, alignPosition|keepPosition]])`.
+fn insert_along(
+    cx: &mut Interp,
+    shape: &mut Shape,
+    call: &OpCall,
+    args: &[Arg],
+) -> Result<(), RtError> {
+    let set = uv_set(&args[0])?;
+    let path = args[1].text()?;
+    let height = args[2].num()?;
+    let along_normals = match args.get(3) {
+        Some(a) => selector(a, &["scope.y", "vertex.normal"])? == "vertex.normal",
+        None => false,
+    };
+    let keep_position = match args.get(4) {
+        Some(a) => selector(a, &["alignPosition", "keepPosition"])? == "keepPosition",
+        None => false,
+    };
+    let asset = match builtin_geometry(path) {
+        Some(m) => Ok(Arc::new(m)),
+        None => cx.assets.mesh(call.span.file, path),
+    };
+    let asset = match asset {
+        Ok(a) => a,
+        Err(message) => {
+            // As with `i`: a missing asset must not lose the model.
+            cx.warn_once(args[1].span, || {
+                format!("{message}; the shape keeps its geometry")
+            });
+            return Ok(());
+        }
+    };
+    let surface = shape.geometry.local().clone();
+    if surface.uvs[set].is_none() {
+        cx.warn_once(call.span, || {
+            format!("insertAlongUV: the shape has no texture coordinates in uv set {set}; the asset is not inserted")
+        });
+        return Ok(());
+    }
+    let place = insert_along_uv::Placement {
+        height,
+        along_normals,
+        keep_position,
+    };
+    // Scope-local coordinates: the scope's y axis is (0, 1, 0).
+    match insert_along_uv::insert_along_uv(&surface, set, &asset, place, DVec3::Y) {
+        Some(mesh) => shape.set_local_mesh(mesh),
+        None => cx.warn_once(call.span, || {
+            format!(
+                "insertAlongUV: the uv range needs more than {} copies of the asset; the shape keeps its geometry",
+                insert_along_uv::MAX_TILES
+            )
+        }),
+    }
+    Ok(())
+}
+
+/// The built-in geometry assets (`builtin:cube`, ...) as `i` knows them.
+fn builtin_geometry(path: &str) -> Option<Mesh> {
+    use cga_geometry::primitive as p;
+    let name = path.strip_prefix("builtin:")?;
+    Some(match name.strip_suffix(".obj").unwrap_or(name) {
+        "cube" => p::builtin_cube(),
+        "quad" => p::quad(1.0, 1.0),
+        "disk" => p::disk(16, 1.0, 1.0),
+        "sphere" => p::sphere(16, 16, DVec3::ONE),
+        "cylinder" => p::cylinder(16, DVec3::ONE),
+        "cone" => p::cone(16, DVec3::ONE),
+        _ => return None,
+    })
 }
 
 /// A UV set argument: an integer in [0, 9].

@@ -235,7 +235,8 @@ fn target(
         .sum();
     let (lo, hi) = bounds(&uv);
     let extent = (hi - lo).max_element();
-    if !(area2.abs() > 1e-12 * extent * extent) {
+    let has_area = area2.abs() > 1e-12 * extent * extent;
+    if !has_area {
         return None;
     }
     // Clipping wants the uv polygon counter-clockwise.

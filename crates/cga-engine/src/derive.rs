@@ -424,9 +424,8 @@ impl<'a> Interp<'a> {
                     args.push(self.eval(a, frame, &st.shape)?);
                 }
                 let mut child = self.child(&st.shape, rc.span)?;
-                for (id, e) in &rc.attr_overrides {
-                    let v = self.eval(e, frame, &st.shape)?;
-                    child.set_attr(*id, v);
+                if !rc.attr_overrides.is_empty() {
+                    self.reinitialize_import(rc, frame, &st.shape, &mut child)?;
                 }
                 st.has_successor = true;
                 self.run_rule(rc.rule, args, child, rc.span)
@@ -458,6 +457,51 @@ impl<'a> Interp<'a> {
                 Ok(())
             }
         }
+    }
+
+    /// A dynamic import `imp(height = 20).Lot`: the overrides are evaluated
+    /// in the caller, then every other attribute of the imported rule set is
+    /// re-initialized, as at the start of the generation but seeing the new
+    /// values (`attr angle = case height > 10 : 0 else : 30` follows the
+    /// call's height), and values set on the shape before (`set(imp.x, ..)`)
+    /// are dropped. Attributes are re-evaluated in declaration order, so a
+    /// default that reads an attribute declared after it sees that one's
+    /// start value. Attributes propagated from the importer are the
+    /// importer's and keep their values.
+    fn reinitialize_import(
+        &mut self,
+        rc: &crate::expr::RuleCall,
+        frame: &[Value],
+        caller: &Shape,
+        child: &mut Shape,
+    ) -> Result<(), RtError> {
+        let program = self.program;
+        let ruleset = program.rules[rc.rule as usize].ruleset;
+        let mut values = Vec::with_capacity(rc.attr_overrides.len());
+        for (id, e) in &rc.attr_overrides {
+            values.push((*id, self.eval(e, frame, caller)?));
+        }
+        if let Some(list) = child.attrs.as_mut() {
+            let list = std::sync::Arc::make_mut(list);
+            list.retain(|(id, _)| program.attrs[*id as usize].ruleset != ruleset);
+        }
+        for (id, v) in values {
+            child.set_attr(id, v);
+        }
+        // The initial shape, carrying the values so far, is the context of
+        // the defaults (they are evaluated on the initial shape at start).
+        let mut context = self.initial.clone();
+        context.attrs = child.attrs.clone();
+        for (i, def) in program.attrs.iter().enumerate() {
+            let id = i as crate::program::AttrId;
+            if def.ruleset != ruleset || rc.attr_overrides.iter().any(|(o, _)| *o == id) {
+                continue;
+            }
+            let v = self.eval(&def.default, &[], &context)?;
+            context.set_attr(id, v.clone());
+            child.set_attr(id, v);
+        }
+        Ok(())
     }
 
     /// Evaluates an operation argument, noting a `'` or `~` prefix.

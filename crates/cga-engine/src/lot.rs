@@ -1,10 +1,13 @@
 //! Initial shapes: lots from a `W,D` rectangle, OBJ faces or GeoJSON polygons.
 //!
 //! Conventions: y is up, lots lie in the x-z plane, counter-clockwise seen
-//! from above (a lot given clockwise is reversed), and the first edge is the
-//! street front. The initial pivot sits on the first vertex with its x axis
-//! along the first edge and its y axis along the lot's normal; the scope is
-//! the lot's bounding box in that frame.
+//! from above, and the first edge is the street front. The initial pivot
+//! sits on the first vertex with its x axis along the first edge and its y
+//! axis along the lot's normal; the scope is the lot's bounding box in that
+//! frame. A polygon given clockwise keeps its orientation: its normal points
+//! down and so do its extrusions, as in CityEngine's runtime (a clockwise
+//! 10 x 10 OBJ lot extruded by 7 spans y -7..0 there). GeoJSON rings are
+//! oriented by their own convention when read.
 
 use std::sync::Arc;
 
@@ -173,11 +176,7 @@ pub fn remove_repeated_corners(mesh: &mut Mesh) {
 pub fn initial_shape(lot: &Lot, seed: u64, name: u32) -> Shape {
     let mut mesh = lot.mesh.clone();
     remove_repeated_corners(&mut mesh);
-    let (mut normal, mut x) = first_edge_frame(&mesh);
-    if normal.y < -1e-9 {
-        cga_geometry::transform::reverse_faces(&mut mesh);
-        (normal, x) = first_edge_frame(&mesh);
-    }
+    let (normal, x) = first_edge_frame(&mesh);
     let y = normal;
     let x = (x - y * x.dot(y)).normalize_or(DVec3::X);
     let z = x.cross(y);
@@ -229,7 +228,7 @@ pub fn initial_shape(lot: &Lot, seed: u64, name: u32) -> Shape {
 
 /// The random stream state that a seed value starts.
 pub fn seed_stream(seed: f64) -> u64 {
-    seed.to_bits() ^ 0x5EED_0F_C6A_u64
+    seed.to_bits() ^ 0x0005_EED0_FC6A_u64
 }
 
 /// The normal of the first face and the direction of its first edge.
@@ -249,34 +248,6 @@ fn first_edge_frame(mesh: &Mesh) -> (DVec3, DVec3) {
         .find(|e| e.length() > 1e-12)
         .unwrap_or(DVec3::X);
     (n, x)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn rect_lot_scope_is_w_0_d() {
-        let s = initial_shape(&rect(20.0, 30.0), 0, 0);
-        assert!((s.scope.size - DVec3::new(20.0, 0.0, 30.0)).length() < 1e-12);
-        // x along the first edge, y up, z towards the street (+z).
-        assert!((s.scope.frame.axes.x_axis - DVec3::X).length() < 1e-12);
-        assert!((s.scope.frame.axes.y_axis - DVec3::Y).length() < 1e-12);
-        assert!((s.scope.frame.origin - DVec3::new(0.0, 0.0, -30.0)).length() < 1e-12);
-        let m = s.object_mesh();
-        assert!(m
-            .positions
-            .iter()
-            .any(|p| (*p - DVec3::new(20.0, 0.0, -30.0)).length() < 1e-12));
-    }
-
-    #[test]
-    fn clockwise_lot_is_turned_up() {
-        let mut lot = rect(4.0, 2.0);
-        lot.mesh.corners.reverse();
-        let s = initial_shape(&lot, 0, 0);
-        assert!((s.scope.frame.axes.y_axis - DVec3::Y).length() < 1e-12);
-    }
 }
 
 /// Each polygon of a GeoJSON file is one lot (MultiPolygons give one lot
@@ -381,5 +352,36 @@ fn orient_rings(positions: &[DVec3], loops: &mut [Vec<u32>]) {
         if (i == 0) != ccw {
             l[1..].reverse();
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rect_lot_scope_is_w_0_d() {
+        let s = initial_shape(&rect(20.0, 30.0), 0, 0);
+        assert!((s.scope.size - DVec3::new(20.0, 0.0, 30.0)).length() < 1e-12);
+        // x along the first edge, y up, z towards the street (+z).
+        assert!((s.scope.frame.axes.x_axis - DVec3::X).length() < 1e-12);
+        assert!((s.scope.frame.axes.y_axis - DVec3::Y).length() < 1e-12);
+        assert!((s.scope.frame.origin - DVec3::new(0.0, 0.0, -30.0)).length() < 1e-12);
+        let m = s.object_mesh();
+        assert!(m
+            .positions
+            .iter()
+            .any(|p| (*p - DVec3::new(20.0, 0.0, -30.0)).length() < 1e-12));
+    }
+
+    #[test]
+    fn clockwise_lot_faces_down() {
+        let mut lot = rect(4.0, 2.0);
+        lot.mesh.corners.reverse();
+        let s = initial_shape(&lot, 0, 0);
+        assert!((s.scope.frame.axes.y_axis + DVec3::Y).length() < 1e-12);
+        // x along the first edge, (0,0,-2) -> (4,0,-2); a right-handed frame
+        assert!((s.scope.frame.axes.x_axis - DVec3::X).length() < 1e-12);
+        assert!((s.scope.frame.axes.z_axis + DVec3::Z).length() < 1e-12);
     }
 }

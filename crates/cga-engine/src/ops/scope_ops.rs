@@ -73,7 +73,8 @@ pub fn exec(
             align_pivot_and_scope(shape, axes);
         }
         Op::AlignScopeToGeometry => {
-            let up = selector(&args[0], &["yUp", "zUp", "xUp"])?;
+            // xUp is a selector of the reference that CityEngine does not support yet.
+            let up = selector(&args[0], &["yUp", "zUp"])?;
             let mesh = shape.object_mesh();
             if mesh.faces.is_empty() {
                 return Ok(());
@@ -104,24 +105,20 @@ pub fn exec(
             shape.fit_scope(axes);
         }
         Op::MirrorScope => {
+            // The scope is (t, r, s) as in CGA: a mirrored axis cannot be a
+            // rotation, so it is a negative size seen from the far side of
+            // the box (as `s` with a negative size makes). The box, the
+            // axes and scope.r stay; the geometry stays where it is.
             let flips = [args[0].boolean()?, args[1].boolean()?, args[2].boolean()?];
             let mut scope = shape.scope;
-            let mut cols = [
-                scope.frame.axes.x_axis,
-                scope.frame.axes.y_axis,
-                scope.frame.axes.z_axis,
-            ];
-            for i in 0..3 {
-                if flips[i] {
-                    scope.frame.origin += cols[i] * scope.size[i];
-                    cols[i] = -cols[i];
+            let axes = scope.frame.axes;
+            for (i, flip) in flips.into_iter().enumerate() {
+                if flip {
+                    scope.frame.origin += axes.col(i) * scope.size[i];
+                    scope.size[i] = -scope.size[i];
                 }
             }
-            scope.frame.axes = DMat3::from_cols(cols[0], cols[1], cols[2]);
             shape.reframe_scope(scope);
-            let pivot_axes = shape.pivot.axes;
-            let axes = shape.scope.frame.axes;
-            shape.scope.set_axes(&pivot_axes, axes);
         }
         Op::ResetGeometry => {
             let init = &cx.initial;
@@ -219,33 +216,48 @@ fn pick_face_edge(
     }
 }
 
-/// `setPivot(axisMap, corner)`: the pivot moves to a corner of the scope
-/// with axes along the scope's (permuted by `map`), pointing into the scope.
+/// `setPivot(axisMap, corner)`: the pivot moves to a corner of the scope,
+/// its axes along the scope's (permuted by `map`) and pointing into the
+/// scope; the scope becomes the same box seen from that corner, with zero
+/// translation and rotation; the geometry stays in place.
+///
+/// Corner bits: 1 = far in x, 2 = far in z, 4 = far in y (0..3 on the
+/// scope's floor, 4..7 on its top). In corner 0 the axes are the scope's
+/// (`xyz`), or `z, x, y` (`yzx`) or `y, z, x` (`zxy`). Pointing inside from
+/// another corner reverses the axes that lead away from it; a right-handed
+/// frame (CGA's pivots are right-handed) then keeps the new y-axis and swaps
+/// the new x- and z-axes where the reversal made the frame left-handed.
 fn set_pivot(shape: &mut Shape, map: &str, corner: usize) {
     let s = shape.scope;
-    let a = [
-        s.frame.axes.x_axis,
-        s.frame.axes.y_axis,
-        s.frame.axes.z_axis,
-    ];
-    // Corner bits: 1 = far in x, 2 = far in z, 4 = far in y.
     let far = [corner & 1 != 0, corner & 4 != 0, corner & 2 != 0];
     let mut origin = s.frame.origin;
-    let mut dirs = a;
-    for i in 0..3 {
-        if far[i] {
-            origin += a[i] * s.size[i];
-            dirs[i] = -a[i];
+    let mut inside = [DVec3::ZERO; 3];
+    for (i, &far) in far.iter().enumerate() {
+        let a = s.frame.axes.col(i);
+        // A negative size (a mirrored scope) extends the box along -a.
+        let along = if s.size[i] < 0.0 { -a } else { a };
+        if far {
+            origin += a * s.size[i];
+            inside[i] = -along;
+        } else {
+            inside[i] = along;
         }
     }
-    let (x, y) = match map {
-        "yzx" => (dirs[2], dirs[0]),
-        "zxy" => (dirs[1], dirs[2]),
-        _ => (dirs[0], dirs[1]),
+    // Old scope axis of the new x, y and z in corner 0.
+    let (mut first, up, mut second) = match map {
+        "yzx" => (2, 0, 1),
+        "zxy" => (1, 2, 0),
+        _ => (0, 1, 2),
     };
-    // Keep the frame right-handed: z follows from x and y.
-    let axes = DMat3::from_cols(x, y, x.cross(y));
+    if inside[first].cross(inside[up]).dot(inside[second]) < 0.0 {
+        std::mem::swap(&mut first, &mut second);
+    }
+    let axes = DMat3::from_cols(inside[first], inside[up], inside[second]);
+    let size = DVec3::new(s.size[first].abs(), s.size[up].abs(), s.size[second].abs());
     shape.pivot = Frame { origin, axes };
-    shape.fit_scope(axes);
-    shape.scope.rot = DVec3::ZERO;
+    let mut scope = s;
+    scope.frame = Frame { origin, axes };
+    scope.size = size;
+    scope.rot = DVec3::ZERO;
+    shape.reframe_scope(scope);
 }

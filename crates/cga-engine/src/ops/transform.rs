@@ -6,7 +6,7 @@ use cga_geometry::{DMat3, DVec3};
 use super::Op;
 use crate::derive::{Arg, Interp, RtError, ShapeState};
 use crate::expr::OpCall;
-use crate::shape::{euler_to_mat, Shape};
+use crate::shape::{euler_to_mat, mat_to_euler, Shape};
 
 pub fn exec(
     cx: &mut Interp,
@@ -58,17 +58,29 @@ pub fn exec(
             let system = selector(&args[1], &["scope", "pivot", "object", "world"])?;
             let angles = vec3(&args[2..], DVec3::ONE)?;
             let axes = system_axes(cx, shape, system);
-            let r = euler_to_mat(angles);
-            let target = match mode {
-                // The new orientation is the system's turned by the angles.
-                "abs" => axes * r,
-                _ => axes * r * axes.transpose() * shape.scope.frame.axes,
+            // The scope's orientation as Euler angles in the system: `abs`
+            // sets them, `rel` adds to them (so `rotate(rel, pivot, ..)` is
+            // `r(..)`, as the reference says). In the pivot system these are
+            // the stored scope.r, which keep what `r` accumulated.
+            let current = if system == "pivot" {
+                shape.scope.rot
+            } else {
+                mat_to_euler(&(axes.transpose() * shape.scope.frame.axes))
             };
+            let target_angles = match mode {
+                "abs" => angles,
+                _ => current + angles,
+            };
+            let target = axes * euler_to_mat(target_angles);
             let delta = target * shape.scope.frame.axes.transpose();
             rotate_about(shape, delta, false);
-            let pivot_axes = shape.pivot.axes;
-            let axes = shape.scope.frame.axes;
-            shape.scope.set_axes(&pivot_axes, axes);
+            if system == "pivot" {
+                shape.scope.rot = target_angles;
+            } else {
+                let pivot_axes = shape.pivot.axes;
+                let axes = shape.scope.frame.axes;
+                shape.scope.set_axes(&pivot_axes, axes);
+            }
         }
         Op::Center => {
             let which = selector(&args[0], &["x", "y", "z", "xy", "xz", "yz", "xyz"])?;

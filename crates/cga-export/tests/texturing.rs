@@ -213,3 +213,64 @@ fn opacity_from_the_colour_maps_alpha() {
         gltf::material::AlphaMode::Opaque
     );
 }
+
+#[test]
+fn other_texture_layers_become_pbr_textures_with_their_uv_sets() {
+    let dir = out_dir("pbr");
+    let png = dir.join("t.png");
+    std::fs::write(&png, tiny_png()).unwrap();
+    let path: std::sync::Arc<str> = png.to_string_lossy().as_ref().into();
+    let mut m = colored("pbr", [1.0, 1.0, 1.0]);
+    for k in [0, 5, 6, 7, 8] {
+        m.maps[k].path = path.clone();
+    }
+    // The normal map's layer 5 has its own coordinates on one quad; the
+    // other quad lacks set 5 and reads set 0. No quad has sets 6, 7 or 8.
+    let mut a = quad(DVec3::ZERO, 1.0, 1.0, m.clone(), true);
+    a.uvs[5] = Some(vec![DVec2::new(0.5, 0.5); 4]);
+    let b = quad(DVec3::X * 2.0, 1.0, 1.0, m, true);
+    let glb = dir.join("pbr.glb");
+    let stats = write(&glb, &[a, b], ExportOptions::default());
+    assert!(stats.warnings.is_empty(), "{:?}", stats.warnings);
+    assert_valid_gltf(&glb);
+    let g = read_gltf(&glb);
+    let mat = g.doc.materials().next().unwrap();
+    let pbr = mat.pbr_metallic_roughness();
+    assert_eq!(pbr.base_color_texture().unwrap().tex_coord(), 0);
+    assert_eq!(mat.normal_texture().unwrap().tex_coord(), 1);
+    assert_eq!(mat.emissive_texture().unwrap().tex_coord(), 0);
+    assert_eq!(mat.occlusion_texture().unwrap().tex_coord(), 0);
+    assert_eq!(pbr.metallic_roughness_texture().unwrap().tex_coord(), 0);
+    // A map replaces its scalar: emissive 1, roughness 1; metalness stays 0
+    // (a roughness map alone is written for non-metals only).
+    assert_eq!(mat.emissive_factor(), [1.0; 3]);
+    assert_eq!(pbr.roughness_factor(), 1.0);
+    assert_eq!(pbr.metallic_factor(), 0.0);
+    // One image, shared by all five.
+    assert_eq!(g.doc.images().count(), 1);
+    let prim = g.doc.meshes().next().unwrap().primitives().next().unwrap();
+    let r = prim.reader(|_| Some(&g.bin[..]));
+    let t0: Vec<[f32; 2]> = r.read_tex_coords(0).unwrap().into_f32().collect();
+    let t1: Vec<[f32; 2]> = r.read_tex_coords(1).unwrap().into_f32().collect();
+    assert!(r.read_tex_coords(2).is_none());
+    assert_eq!(&t1[..4], &[[0.5, 0.5]; 4]);
+    assert_eq!(&t1[4..], &t0[4..]);
+    // The normal map needs tangents: on the second quad (facing +z, u along
+    // +x, v up) the tangent is +x and glTF's bitangent, whose v runs down
+    // the image, is -y = cross(+z, +x) * -1.
+    let tangents: Vec<[f32; 4]> = r.read_tangents().unwrap().collect();
+    assert_eq!(tangents.len(), 8);
+    assert_eq!(&tangents[4..], &[[1.0, 0.0, 0.0, -1.0]; 4]);
+
+    // Roughness and metalness from two images cannot be packed: a warning.
+    let mut two = colored("two", [1.0, 1.0, 1.0]);
+    two.maps[8].path = path.clone();
+    two.maps[9].path = "metal.png".into();
+    let stats = write(
+        &dir.join("two.glb"),
+        &[quad(DVec3::ZERO, 1.0, 1.0, two, true)],
+        ExportOptions::default(),
+    );
+    assert_eq!(stats.warnings.len(), 1, "{:?}", stats.warnings);
+    assert!(stats.warnings[0].contains("metal.png"));
+}

@@ -424,7 +424,7 @@ impl<'a> Interp<'a> {
                     args.push(self.eval(a, frame, &st.shape)?);
                 }
                 let mut child = self.child(&st.shape, rc.span)?;
-                if !rc.attr_overrides.is_empty() {
+                if rc.dynamic {
                     self.reinitialize_import(rc, frame, &st.shape, &mut child)?;
                 }
                 st.has_successor = true;

@@ -141,8 +141,14 @@ impl Interp<'_> {
                 }
                 self.eval(body, &inner, shape)
             }
-            RExprKind::CompFn { .. } => Err(RtError::new(
-                "the comp function is not supported yet",
+            RExprKind::CompFn { args, block } => {
+                crate::ops::comp::eval_fn(self, args, block, frame, shape, e.span)
+            }
+            // A comp head outside a component split (never produced by the
+            // resolver): its expression.
+            RExprKind::CompHead { expr, .. } => self.eval(expr, frame, shape),
+            RExprKind::CompSelector(..) => Err(RtError::new(
+                "a selector keyword has a value only in the head of a comp entry",
                 e.span,
             )),
         }

@@ -2,12 +2,15 @@
 //! replaced by what it refers to (a frame slot, an attribute, a function, a
 //! built-in, an operation), ready to be evaluated without lookups.
 
+use std::sync::Arc;
+
 use cga_syntax::ast::{BinaryOp, BlockOp, UnaryOp};
 use cga_syntax::Span;
 use cga_value::Value;
 
 use crate::ops::Op;
 use crate::program::{AttrId, FuncId, RuleId};
+use crate::selectors::Selector;
 use crate::shape_fns::ShapeFn;
 
 #[derive(Debug, Clone)]
@@ -72,6 +75,17 @@ pub enum RExprKind {
         args: Vec<RExpr>,
         block: RBlock<RExpr>,
     },
+    /// A block head of `comp` (operation or function): the selector text as
+    /// written (for `comp.sel`) and the selection expression.
+    CompHead {
+        text: Arc<str>,
+        expr: Box<RExpr>,
+    },
+    /// A selector keyword (`front`, `world.up`, `border`, `isTagged(q)`)
+    /// inside a comp head, alone or combined with `!`, `&&`, `||`: true if
+    /// the component being selected matches. Only the component split
+    /// evaluates it (`ops::comp`); `args` are the arguments of `isTagged`.
+    CompSelector(Selector, Vec<RExpr>),
 }
 
 impl RExpr {
@@ -124,7 +138,10 @@ pub struct OpCall {
 pub struct RuleCall {
     pub rule: RuleId,
     pub args: Vec<RExpr>,
-    /// Attribute values set for this call only (dynamic import `imp(h = 2).Lot`).
+    /// A dynamic import call (`imp(h = 2).Lot`, also `imp().Lot`): the
+    /// imported rule set's attributes are initialised anew for this call.
+    pub dynamic: bool,
+    /// Attribute values set for this call only.
     pub attr_overrides: Vec<(AttrId, RExpr)>,
     pub span: Span,
 }

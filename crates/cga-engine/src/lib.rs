@@ -12,9 +12,11 @@ pub mod material_attr;
 pub mod ops;
 pub mod program;
 pub mod resolve;
+pub mod selectors;
 pub mod shape;
 pub mod shape_fns;
 pub mod split_layout;
+pub mod trim;
 pub mod values;
 
 pub use derive::{InitialInfo, Interp, Limits, LotOutput, RtError};

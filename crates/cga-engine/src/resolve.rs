@@ -157,17 +157,72 @@ struct Resolver<'s> {
     symbols: HashMap<Arc<str>, u32>,
 }
 
-/// Which items of a module are in the default style (those before the first
-/// `style` statement, and those after `style Default`).
-fn default_style_items(module: &ast::Module) -> impl Iterator<Item = &Item> {
-    let mut in_default = true;
-    module.items.iter().filter(move |item| {
-        if let Item::Style { name, .. } = item {
-            in_default = name.name == "Default";
-            return false;
+/// The items of a module as one style sees them: the items of the Default
+/// style (before the first `style` statement, or after `style Default`),
+/// with the attributes, functions and rules that `style` (and the styles it
+/// extends) redefines replaced by its versions, and its new ones added.
+fn style_items<'m>(module: &'m ast::Module, style: Option<&str>) -> Vec<&'m Item> {
+    // Sections: (style name, extends, items).
+    let mut sections: Vec<(&str, Option<&str>, Vec<&Item>)> = vec![("Default", None, Vec::new())];
+    for item in &module.items {
+        match item {
+            Item::Style { name, extends, .. } => sections.push((
+                name.name.as_str(),
+                Some(extends.as_ref().map_or("Default", |e| e.name.as_str())),
+                Vec::new(),
+            )),
+            Item::Import(_) | Item::Version { .. } => sections[0].2.push(item),
+            _ => sections
+                .last_mut()
+                .expect("the Default section")
+                .2
+                .push(item),
         }
-        in_default || matches!(item, Item::Import(_) | Item::Version { .. })
-    })
+    }
+    let mut items: Vec<&Item> = sections
+        .iter()
+        .filter(|s| s.0 == "Default")
+        .flat_map(|s| s.2.iter().copied())
+        .collect();
+    // The chain of styles from the most basic to the chosen one.
+    let mut chain = Vec::new();
+    let mut current = style.filter(|s| *s != "Default");
+    while let Some(name) = current {
+        if chain.contains(&name) || chain.len() > 32 {
+            break;
+        }
+        let Some(section) = sections.iter().find(|s| s.0 == name) else {
+            break;
+        };
+        chain.push(name);
+        current = section.1.filter(|s| *s != "Default");
+    }
+    for name in chain.into_iter().rev() {
+        for section in sections.iter().filter(|s| s.0 == name) {
+            for &item in &section.2 {
+                match items.iter().position(|&i| same_definition(i, item)) {
+                    Some(k) => items[k] = item,
+                    None => items.push(item),
+                }
+            }
+        }
+    }
+    items
+}
+
+/// Whether two items define the same attribute, function or rule (name and
+/// number of parameters).
+fn same_definition(a: &Item, b: &Item) -> bool {
+    match (a, b) {
+        (Item::Attr(x), Item::Attr(y)) => x.name.name == y.name.name,
+        (Item::Function(x), Item::Function(y)) => {
+            x.name.name == y.name.name && x.params.len() == y.params.len()
+        }
+        (Item::Rule(x), Item::Rule(y)) => {
+            x.name.name == y.name.name && x.params.len() == y.params.len()
+        }
+        _ => false,
+    }
 }
 
 /// Names in scope inside one definition: parameters, then `with` locals.
@@ -239,7 +294,14 @@ impl Resolver<'_> {
         let overrides: Option<Vec<ast::ImportOverride>> =
             importer.as_ref().and_then(|(_, d)| d.overrides.clone());
 
-        for item in default_style_items(&module) {
+        // An import that lists styles (`import imp (mystyle) : "f.cga"`)
+        // generates with the first of them; everything else with Default.
+        let style: Option<String> = importer
+            .as_ref()
+            .and_then(|(_, d)| d.styles.as_ref())
+            .and_then(|list| list.first())
+            .map(|s| s.name.clone());
+        for item in style_items(&module, style.as_deref()) {
             match item {
                 Item::Attr(decl) => {
                     self.declare_attr(rs, decl, importer.as_ref().map(|i| i.0), &overrides)
@@ -785,6 +847,7 @@ impl Resolver<'_> {
         RExpr { kind, span }
     }
 
+    /// The block of the comp function (the only expression with a block).
     fn expr_block(&mut self, cx: &Cx, b: &ast::Block<Expr>) -> RBlock<RExpr> {
         RBlock {
             parts: b
@@ -792,7 +855,7 @@ impl Resolver<'_> {
                 .iter()
                 .map(|p| match p {
                     BlockPart::Entry(e) => RPart::Entry {
-                        head: self.head(cx, &e.head),
+                        head: self.comp_head(cx, &e.head),
                         depth: e.depth.as_ref().map(|d| self.expr(cx, d)),
                         op: e.op,
                         body: self.expr(cx, &e.body),
@@ -876,6 +939,82 @@ impl Resolver<'_> {
         }
     }
 
+    /// A comp head: the selection expression with the selector text as
+    /// written (`comp.sel`).
+    fn comp_head(&mut self, cx: &Cx, e: &Expr) -> RExpr {
+        let text = self
+            .sources
+            .get(e.span.file)
+            .text
+            .get(e.span.range())
+            .unwrap_or("")
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
+        RExpr {
+            kind: RExprKind::CompHead {
+                text: Arc::from(text.as_str()),
+                expr: Box::new(self.comp_selection(cx, e)),
+            },
+            span: e.span,
+        }
+    }
+
+    /// A comp selection expression: selector keywords (and `isTagged(...)`)
+    /// are selectors, alone or under `!`, `&&`, `||` and comparisons; in
+    /// a comp head a keyword wins over an attribute or function of the same
+    /// name (`inside` is the selector there, not the occlusion query).
+    /// Anything else is an ordinary expression (an index, a condition on
+    /// the component shape such as `geometry.area() > 1`).
+    fn comp_selection(&mut self, cx: &Cx, e: &Expr) -> RExpr {
+        let span = e.span;
+        let kind = match &e.kind {
+            ExprKind::Name(ident) => match crate::selectors::Selector::parse(&ident.name) {
+                Some(sel) => RExprKind::CompSelector(sel, Vec::new()),
+                None => return self.name(cx, ident, false),
+            },
+            ExprKind::Call { name, args } if name.name == "isTagged" => {
+                if args.is_empty() || args.len() > 2 {
+                    self.error(
+                        format!(
+                            "`isTagged` takes 1 or 2 arguments (tag query, e|v), found {}",
+                            args.len()
+                        ),
+                        span,
+                    );
+                    return placeholder(span);
+                }
+                let mut list = vec![self.expr(cx, &args[0])];
+                if let Some(sub) = args.get(1) {
+                    list.push(self.selector_arg(cx, sub));
+                }
+                RExprKind::CompSelector(crate::selectors::Selector::IsTagged, list)
+            }
+            ExprKind::Unary {
+                op,
+                elementwise,
+                operand,
+            } => RExprKind::Unary {
+                op: *op,
+                elementwise: *elementwise,
+                operand: Box::new(self.comp_selection(cx, operand)),
+            },
+            ExprKind::Binary {
+                op,
+                elementwise,
+                lhs,
+                rhs,
+            } => RExprKind::Binary {
+                op: *op,
+                elementwise: *elementwise,
+                lhs: Box::new(self.comp_selection(cx, lhs)),
+                rhs: Box::new(self.comp_selection(cx, rhs)),
+            },
+            _ => return self.expr(cx, e),
+        };
+        RExpr { kind, span }
+    }
+
     fn selector_arg(&mut self, _cx: &Cx, e: &Expr) -> RExpr {
         match &e.kind {
             ExprKind::Name(ident) => {
@@ -909,20 +1048,25 @@ impl Resolver<'_> {
         }
     }
 
-    fn op_block(&mut self, cx: &Cx, b: &ast::Block<Body>) -> RBlock<RBody> {
+    /// The block of an operation; `comp`: the heads are comp selectors.
+    fn op_block(&mut self, cx: &Cx, b: &ast::Block<Body>, comp: bool) -> RBlock<RBody> {
         RBlock {
             parts: b
                 .parts
                 .iter()
                 .map(|p| match p {
                     BlockPart::Entry(e) => RPart::Entry {
-                        head: self.head(cx, &e.head),
+                        head: if comp {
+                            self.comp_head(cx, &e.head)
+                        } else {
+                            self.head(cx, &e.head)
+                        },
                         depth: e.depth.as_ref().map(|d| self.expr(cx, d)),
                         op: e.op,
                         body: self.body(cx, &e.body),
                         span: e.span,
                     },
-                    BlockPart::Group(g) => RPart::Group(self.op_block(cx, g)),
+                    BlockPart::Group(g) => RPart::Group(self.op_block(cx, g, comp)),
                     BlockPart::Unlabeled { body, span } => RPart::Unlabeled {
                         body: self.body(cx, body),
                         span: *span,
@@ -968,6 +1112,7 @@ impl Resolver<'_> {
             return RStmt::Rule(RuleCall {
                 rule,
                 args,
+                dynamic: call.import_overrides.is_some(),
                 attr_overrides,
                 span,
             });
@@ -984,7 +1129,10 @@ impl Resolver<'_> {
                 return RStmt::Nil;
             }
             let args = self.op_args(cx, name, call.args.as_deref().unwrap_or(&[]));
-            let block = call.block.as_ref().map(|b| self.op_block(cx, b));
+            let block = call
+                .block
+                .as_ref()
+                .map(|b| self.op_block(cx, b, name == "comp"));
             if block.is_some() && !info.block {
                 self.error(format!("`{name}` takes no `{{ ... }}` block"), span);
             }
@@ -999,7 +1147,7 @@ impl Resolver<'_> {
             // Resolve what is inside anyway, so that its errors are reported.
             let _ = self.op_args(cx, name, call.args.as_deref().unwrap_or(&[]));
             if let Some(b) = &call.block {
-                let _ = self.op_block(cx, b);
+                let _ = self.op_block(cx, b, false);
             }
             return RStmt::Unsupported {
                 name: name.to_string(),

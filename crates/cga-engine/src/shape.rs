@@ -128,11 +128,14 @@ pub fn transformed(mesh: &Mesh, t: &DAffine3) -> Mesh {
     m
 }
 
-/// Trim state of a shape (`trim.horizontal`, `trim.vertical`).
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Trim state of a shape: the switches `trim.horizontal` and
+/// `trim.vertical`, and the trim planes the last face component split gave
+/// the shape or an ancestor (see `crate::trim`; shared, so copies are cheap).
+#[derive(Clone, Debug, PartialEq)]
 pub struct TrimFlags {
     pub horizontal: bool,
     pub vertical: bool,
+    pub planes: Option<crate::trim::TrimPlanes>,
 }
 
 impl Default for TrimFlags {
@@ -140,6 +143,7 @@ impl Default for TrimFlags {
         TrimFlags {
             horizontal: false,
             vertical: true,
+            planes: None,
         }
     }
 }
@@ -325,11 +329,24 @@ pub fn euler_to_mat(angles: DVec3) -> DMat3 {
 pub fn mat_to_euler(m: &DMat3) -> DVec3 {
     // m = Rz*Ry*Rx: m[0][2] (col 0, row 2) = -sin(b).
     let sb = -m.x_axis.z;
-    let (a, b, g);
+    let (mut a, mut b, mut g);
     if sb.abs() < 1.0 - 1e-12 {
         b = sb.asin();
         a = m.y_axis.z.atan2(m.z_axis.z);
         g = m.x_axis.y.atan2(m.x_axis.x);
+        // The same rotation has a second set of angles (b' = 180° - b);
+        // prefer the smaller turn, so a back face is (0, 180, 0) rather
+        // than (180, 0, 180).
+        let b2 = if b >= 0.0 {
+            std::f64::consts::PI - b
+        } else {
+            -std::f64::consts::PI - b
+        };
+        let a2 = (-m.y_axis.z).atan2(-m.z_axis.z);
+        let g2 = (-m.x_axis.y).atan2(-m.x_axis.x);
+        if a2.abs() + b2.abs() + g2.abs() < a.abs() + b.abs() + g.abs() - 1e-9 {
+            (a, b, g) = (a2, b2, g2);
+        }
     } else {
         // Gimbal lock: put everything into x.
         b = if sb > 0.0 {
@@ -354,6 +371,12 @@ pub fn mat_to_euler(m: &DMat3) -> DVec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn euler_prefers_the_smaller_turn() {
+        let back = euler_to_mat(DVec3::new(180.0, 0.0, 180.0));
+        assert!((mat_to_euler(&back) - DVec3::new(0.0, 180.0, 0.0)).length() < 1e-9);
+    }
 
     #[test]
     fn euler_round_trip() {

@@ -65,6 +65,8 @@ pub fn arg_is_selector(name: &str, pos: usize) -> bool {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum GeometryFn {
     Area,
+    /// `geometry.isOriented(selector)`: some face matches the orientation.
+    IsOriented,
     Volume,
     NVertices,
     NFaces,
@@ -144,7 +146,8 @@ pub fn lookup(name: &str, arity: usize) -> Option<ShapeFn> {
     if let Some(rest) = name.strip_prefix("geometry.") {
         use GeometryFn::*;
         let (f, arities): (GeometryFn, &[usize]) = match rest {
-            "area" => (Area, &[0]),
+            "area" => (Area, &[0, 1]),
+            "isOriented" => (IsOriented, &[1]),
             "volume" => (Volume, &[0]),
             "nVertices" => (NVertices, &[0]),
             "nFaces" => (NFaces, &[0]),
@@ -235,7 +238,36 @@ mod eval {
     use super::{ContextFn, GeometryFn, ShapeFn};
     use crate::derive::{Interp, RtError};
     use crate::expr::RExpr;
+    use crate::selectors::{Frames, Selector};
     use crate::shape::{mat_to_euler, Shape};
+
+    /// The orientation selector argument of `geometry.area` and
+    /// `geometry.isOriented` (`all`/`surface`, quadrants, slopes, `side`).
+    fn orientation_selector(v: &Value, at: &RExpr) -> Result<Selector, RtError> {
+        let name = match v {
+            Value::Str(s) => &**s,
+            other => {
+                return Err(RtError::new(
+                    format!(
+                        "expected an orientation selector, found {}",
+                        crate::values::type_name(other)
+                    ),
+                    at.span,
+                ))
+            }
+        };
+        match name {
+            "surface" => Ok(Selector::All),
+            _ => Selector::parse(name)
+                .filter(|s| s.is_orientation())
+                .ok_or_else(|| {
+                    RtError::new(
+                        format!("`{name}` is not a face orientation selector (front, world.up, side, all, ...)"),
+                        at.span,
+                    )
+                }),
+        }
+    }
 
     fn num(v: &Value, at: &RExpr) -> Result<f64, RtError> {
         match v {
@@ -391,15 +423,28 @@ mod eval {
             let tolerance =
                 |i: usize| -> Result<f64, RtError> { args.get(i).map_or(Ok(0.0), |v| num(v, at)) };
             Ok(match g {
-                GeometryFn::Area => {
-                    if let Some(Value::Str(sel)) = args.first() {
-                        if !matches!(&**sel, "all" | "surface") {
-                            self.warn_once(at.span, || {
-                                format!("geometry.area({sel}) is not supported yet; the whole area is used")
-                            });
-                        }
+                GeometryFn::Area => match args.first() {
+                    None => fl(m::mesh_area(&mesh)),
+                    Some(sel) => {
+                        let sel = orientation_selector(sel, at)?;
+                        // The mesh is in object coordinates: read normals
+                        // in the scope frame through the scope axes.
+                        let frames =
+                            Frames::for_scope(shape.scope.frame.axes, self.initial.pivot.axes);
+                        let to_scope = shape.scope.frame.axes.transpose();
+                        fl(m::mesh_area_where(&mesh, |_, n| {
+                            frames.matches(sel, to_scope * n)
+                        }))
                     }
-                    fl(m::mesh_area(&mesh))
+                },
+                GeometryFn::IsOriented => {
+                    let sel = orientation_selector(&args[0], at)?;
+                    let frames = Frames::for_scope(shape.scope.frame.axes, self.initial.pivot.axes);
+                    let to_scope = shape.scope.frame.axes.transpose();
+                    Value::Bool(
+                        (0..mesh.faces.len())
+                            .any(|f| frames.matches(sel, to_scope * m::face_normal(&mesh, f))),
+                    )
                 }
                 GeometryFn::Volume => fl(if m::is_closed(&mesh) {
                     m::volume(&mesh).abs()

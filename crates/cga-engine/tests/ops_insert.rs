@@ -60,7 +60,6 @@ fn primitive_quad_fits_the_yz_scope() {
 /// in the yz centre of the 20 x 30 scope. The scope's y-axis points along
 /// the world's -x, so the quad spans x 5..15 and z -25..-5.
 #[test]
-#[ignore = "ops/create.rs: a sized flat primitive in a vertical scope plane is centred only along scope x and z, not along scope y"]
 fn primitive_quad_with_size_is_centred_in_yz() {
     let (s, geo, g) = run(
         "rotateScope(0, 0, 90) primitiveQuad(10,20) texture(\"builtin:uvtest.png\")",
@@ -112,7 +111,6 @@ fn primitive_disk_fits_the_xy_scope() {
 /// vertices, radius 10, and is positioned in the xy centre of the 20 x 30
 /// scope (whose y-axis points along the world's -z): z from -25 to -5.
 #[test]
-#[ignore = "ops/create.rs: a sized flat primitive in a vertical scope plane is centred only along scope x and z, not along scope y"]
 fn primitive_disk_with_radius_is_centred_in_xy() {
     let (s, geo, g) = run(
         "rotateScope(-90, 0, 0) primitiveDisk(8,10) texture(\"builtin:uvtest.png\")",
@@ -363,7 +361,6 @@ fn insert_missing_asset_warns() {
 /// op_i, "Window insertion": a 47 m mass, facades split into floors and
 /// windows, a window asset in each window.
 #[test]
-#[ignore = "comp is not implemented yet (ops/comp.rs)"]
 fn insert_windows_into_a_facade() {
     let src = "Lot --> extrude(47) comp(f){side : Facade | top : X }\n\
                Facade --> split(y) { { ~1 : X | ~8 : Floor }* | ~1 : X }\n\
@@ -381,7 +378,6 @@ fn insert_windows_into_a_facade() {
 /// of a cube are cut by the trim planes of the component split, unless
 /// trim.vertical is disabled before the insert.
 #[test]
-#[ignore = "comp and trim planes are not implemented yet (ops/comp.rs)"]
 fn insert_is_cut_by_trim_planes() {
     let trimmed = "Lot--> primitiveCube() s(10,40,10) t(-5, 0, -5) comp(f) { side: Side }\n\
                    Side--> t(0,0,-5) s('1,'1,10) i(\"builtin:cylinder\")\n";

@@ -208,7 +208,6 @@ fn import_reference() {
 /// import.md, syntax 2: importing only the style `mystyle` of the
 /// imported file gives its rules: the extrusion is 20 high.
 #[test]
-#[ignore = "resolve.rs: the styles listed in an import (`import imp ( mystyle ) : ...`) are not used; the Default style is imported"]
 fn import_selected_style() {
     let (_, h) = run_import("main_style.cga");
     assert_near(h, 20.0, 1e-9);
@@ -285,7 +284,6 @@ fn import_dynamic_reinitializes_attributes() {
 /// re-initialized from the static import": `set(imp.height, 20) imp( ).Lot`
 /// extrudes 10.
 #[test]
-#[ignore = "resolve.rs: an empty dynamic import `imp( ).Lot` resolves like `imp.Lot` (no overrides, no mark), so nothing is re-initialized"]
 fn import_empty_dynamic_reinitializes() {
     let (p, h) = run_import("main_dynamic_empty.cga");
     assert_eq!(p, ["10"]);
@@ -456,7 +454,6 @@ fn index_operator_page_examples() {
 
 /// func_index, "Recursive element selection" (needs the comp function).
 #[test]
-#[ignore = "the comp function is not implemented yet (eval.rs CompFn)"]
 fn index_longest_edge() {
     let src = "indexOfLargest(array) = indexOfLargest(array, 0, 0)\n\
                indexOfLargest(array, i, iLargest) =\n    case i == size(array) : iLargest\n    else :\n        case array[i] > array[iLargest] : indexOfLargest(array, i+1, i)\n        else                            : indexOfLargest(array, i+1, iLargest)\n\

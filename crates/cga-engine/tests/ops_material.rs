@@ -106,7 +106,6 @@ fn set_generic_attribute_floor_number() {
 
 /// op_set, "Generic Shape Attributes", the page's rule with `comp(f)`.
 #[test]
-#[ignore = "comp is not implemented yet (ops/comp.rs)"]
 fn set_generic_attribute_page_rule() {
     let src = "attr floorNumber = -1\nconst floorHeight = 4\n\
                Init --> extrude(30) comp(f) {side : Side }\n\
@@ -198,7 +197,6 @@ fn reset_material_lets_the_asset_material_through() {
 /// materials to the CGA default, `shape` (the default) only the shape's,
 /// `all` both.
 #[test]
-#[ignore = "ops/mod.rs registers resetMaterial with no arguments: resetMaterial(shape|geometry|all) does not load"]
 fn reset_material_targets() {
     let src = "Lot --> color(1,0,0) i(\"plant.obj\") [ resetMaterial(shape) A. ] [ resetMaterial(geometry) B. ] [ resetMaterial(all) C. ]\n";
     let g = gen(src).ok();

@@ -104,7 +104,6 @@ fn report_window_state() {
 
 /// op_report: the page's rule with comp(f).
 #[test]
-#[ignore = "comp is not implemented yet (ops/comp.rs)"]
 fn report_window_state_page_rule() {
     let src = "Lot -->\n    extrude(30)\n    comp(f) { side : Facade | top : Roof }\n\
                Facade -->\n    report(\"facades\", 1)\n    split(y) { ~5 : Floor  | ~0.5 : Ledge }*\n\
@@ -243,7 +242,6 @@ fn nil_creates_holes() {
 
 /// op_nil, "Using NIL to stop a Recursion" (the Erker rule).
 #[test]
-#[ignore = "comp is not implemented yet (ops/comp.rs)"]
 fn nil_stops_a_recursion() {
     let src = "attr ErkerFact = 0.8\nattr ErkerDepth = 0.8\nattr ErkerStop = 2\n\
                Lot-->\n   extrude(10)\n   X\n   comp(f) { all : Erker }\n\

@@ -81,7 +81,22 @@ pub fn exec(
                 set_field(m, field, &Value::Str(v.clone()), &args[0])?;
             }
         }
-        Op::ResetMaterial => shape.material = Arc::new(MaterialOverrides::default()),
+        Op::ResetMaterial => {
+            let target = match args.first() {
+                Some(a) => super::transform::selector(a, &["shape", "geometry", "all"])?,
+                None => "shape",
+            };
+            if target != "geometry" {
+                shape.material = Arc::new(MaterialOverrides::default());
+            }
+            if target != "shape" {
+                let mut mesh = (**shape.geometry.local()).clone();
+                for m in &mut mesh.materials {
+                    *m = cga_geometry::Material::default();
+                }
+                shape.set_local_mesh(mesh);
+            }
+        }
         Op::Texture => {
             let m = Arc::make_mut(&mut shape.material);
             set_field(m, MatField::Map(0), &args[0].value, &args[0])?;

@@ -113,25 +113,34 @@ fn primitive(shape: &mut Shape, op: Op, args: &[Arg]) -> Result<(), RtError> {
         _ => unreachable!("not a primitive"),
     };
     let mut mesh = mesh;
-    if flat {
-        orient_flat(&mut mesh, shape.scope.size);
-    }
-    let mode = if sized {
-        InsertMode::KeepSizeAlign
+    // A flat primitive goes into the plane of the scope's non-zero sizes,
+    // and with dimensions it is centred within that plane.
+    let plane = if flat {
+        orient_flat(&mut mesh, shape.scope.size)
     } else {
-        InsertMode::Fit
+        None
+    };
+    let mode = match (sized, plane) {
+        (true, Some(normal_axis)) => {
+            let mut centre = [true; 3];
+            centre[normal_axis] = false;
+            InsertMode::Centred(centre)
+        }
+        (true, None) => InsertMode::KeepSizeAlign,
+        (false, _) => InsertMode::Fit,
     };
     insert_fitted(shape, Arc::new(mesh), mode);
     Ok(())
 }
 
 /// A flat primitive (quad, disk; made in the xz-plane facing +y) goes into
-/// the plane of the scope's two non-zero sizes when exactly one size is zero.
-fn orient_flat(mesh: &mut Mesh, size: DVec3) {
+/// the plane of the scope's two non-zero sizes when exactly one size is
+/// zero; returns the axis it then faces (`None`: left in the xz-plane).
+fn orient_flat(mesh: &mut Mesh, size: DVec3) -> Option<usize> {
     let eps = 1e-12;
     let zero = [size.x.abs() < eps, size.y.abs() < eps, size.z.abs() < eps];
     if zero.iter().filter(|&&z| z).count() != 1 || zero[1] {
-        return;
+        return None;
     }
     let rot = if zero[0] {
         // Facing +x: the yz-plane.
@@ -141,6 +150,7 @@ fn orient_flat(mesh: &mut Mesh, size: DVec3) {
         DMat3::from_rotation_x(std::f64::consts::FRAC_PI_2)
     };
     cga_geometry::transform::transform(mesh, &DAffine3::from_mat3(rot));
+    Some(if zero[0] { 0 } else { 2 })
 }
 
 fn insert(cx: &mut Interp, shape: &mut Shape, call: &OpCall, args: &[Arg]) -> Result<(), RtError> {
@@ -215,6 +225,8 @@ pub enum InsertMode {
     Keep,
     /// Keep the asset's size, centred in x and z, standing on y = 0.
     KeepSizeAlign,
+    /// Keep the asset's size, centred along the marked scope axes.
+    Centred([bool; 3]),
 }
 
 /// Places `asset` (in its own coordinates) into the scope as CGA's insert
@@ -234,6 +246,14 @@ pub fn insert_fitted(shape: &mut Shape, asset: Arc<Mesh>, mode: InsertMode) {
         }
         InsertMode::KeepSizeAlign => {
             shift = DVec3::new((s.x - a.x) * 0.5, 0.0, (s.z - a.z) * 0.5);
+            s = a;
+        }
+        InsertMode::Centred(axes) => {
+            for k in 0..3 {
+                if axes[k] {
+                    shift[k] = (s[k] - a[k]) * 0.5;
+                }
+            }
             s = a;
         }
         InsertMode::Fit => {
@@ -275,6 +295,11 @@ pub fn insert_fitted(shape: &mut Shape, asset: Arc<Mesh>, mode: InsertMode) {
     let mut g = crate::shape::Geometry::new(asset);
     g.transform(to_local);
     shape.geometry = g;
+    if shape.trim.planes.is_some() {
+        // Inserted geometry is cut by the trim planes of a component split
+        // (op_i.md); it fills the box [0, size] of the new scope.
+        crate::trim::apply(shape, Some((DVec3::ZERO.min(s), DVec3::ZERO.max(s))));
+    }
 }
 
 fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {

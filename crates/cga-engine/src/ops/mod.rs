@@ -3,6 +3,7 @@
 //! Each family of operations lives in its own module.
 
 mod attrs;
+pub mod comp;
 mod create;
 mod scope_ops;
 pub mod split;
@@ -56,6 +57,8 @@ pub enum Op {
     ReverseNormals,
     Split,
     SplitArea,
+    Comp,
+    Trim,
     SetupProjection,
     ProjectUV,
     TranslateUV,
@@ -92,7 +95,11 @@ pub fn arg_mode(name: &str, arity: usize, pos: usize) -> ArgMode {
     match (name, arity, pos) {
         // The uv split's uv set is a number: `split(u, uvSpace, set)`.
         ("split", 3, 2) => Expr,
-        ("split" | "splitArea" | "comp" | "center" | "alignScopeToAxes", _, _) => Selector,
+        (
+            "split" | "splitArea" | "comp" | "center" | "alignScopeToAxes" | "resetMaterial",
+            _,
+            _,
+        ) => Selector,
         ("extrude", 2, 0) => Selector,
         ("r", 4, 0) => Selector,
         ("translate" | "rotate", _, 0 | 1) => Selector,
@@ -141,7 +148,7 @@ pub fn lookup(name: &str) -> Option<OpInfo> {
         "i" | "insert" => info(Op::Insert, 1, 4),
         "color" => info(Op::Color, 1, 4),
         "setMaterial" => info(Op::SetMaterial, 1, 1),
-        "resetMaterial" => info(Op::ResetMaterial, 0, 0),
+        "resetMaterial" => info(Op::ResetMaterial, 0, 1),
         "texture" => info(Op::Texture, 1, 1),
         "print" => info(Op::Print, 1, 1),
         "report" => info(Op::Report, 2, 2),
@@ -174,6 +181,13 @@ pub fn lookup(name: &str) -> Option<OpInfo> {
             max_args: 2,
             block: true,
         }),
+        "comp" => Some(OpInfo {
+            op: Op::Comp,
+            min_args: 1,
+            max_args: 2,
+            block: true,
+        }),
+        "trim" => info(Op::Trim, 0, 0),
         _ => None,
     }
 }
@@ -274,6 +288,8 @@ pub fn exec(
     match call.op {
         Op::Split => split::exec(cx, st, call, args, frame),
         Op::SplitArea => split_area::exec(cx, st, call, args, frame),
+        Op::Comp => comp::exec(cx, st, call, args, frame),
+        Op::Trim => crate::trim::exec(cx, st, call),
         Op::T | Op::Translate | Op::S | Op::R | Op::Rotate | Op::Center => {
             transform::exec(cx, st, call, args)
         }

@@ -1,0 +1,261 @@
+//! Trim planes: made by a face component split (`comp(f) { sel : ... }`)
+//! along the edges a new face shares with its neighbours, and applied when
+//! geometry is inserted (`i`, the primitives) or by `trim()`.
+//!
+//! A trim plane contains the shared edge and bisects the angle between the
+//! two faces, so that geometry inserted on two neighbouring faces (ledges,
+//! cornices, a beam wider than its facade) is mitred where they meet instead
+//! of intersecting. The part of the geometry on the face's side of the plane
+//! is kept, and the cut is left open: no cap faces close a trimmed solid.
+//! That is what CityEngine does: the Candler building's ledges and cornices
+//! (closed assets, mitred at every corner) have CityEngine's areas only
+//! without caps (see `tests/comp_candler.rs`).
+//!
+//! Planes are fixed in space: they are stored in object coordinates and do
+//! not move with the scope, so a shape translated after the split is still
+//! cut where the faces met. Each plane is classified by its edge: if the
+//! edge makes less than 40 degrees with the xz-plane of the new shape's
+//! pivot, the plane is *horizontal*, otherwise *vertical*
+//! (attr_trim.md). `trim.vertical` (default true) and `trim.horizontal`
+//! (default false) switch the two classes when the planes are applied.
+
+use std::sync::Arc;
+
+use cga_geometry::{DVec3, Mesh};
+
+use crate::derive::{Interp, RtError, ShapeState};
+use crate::expr::OpCall;
+use crate::shape::{local_bounds, Shape};
+
+/// One trim plane, in object coordinates: the geometry with
+/// `normal · (p - point) >= 0` is kept.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TrimPlane {
+    pub point: DVec3,
+    /// Unit normal pointing towards the kept side (into the face).
+    pub normal: DVec3,
+    /// Classified vertical (switched by `trim.vertical`) or horizontal.
+    pub vertical: bool,
+}
+
+/// The trim planes of a shape (shared between a shape and its successors).
+pub type TrimPlanes = Arc<[TrimPlane]>;
+
+/// Below this angle (degrees) between the generating edge and the pivot's
+/// xz-plane a plane is horizontal.
+pub const HORIZONTAL_LIMIT_DEGREES: f64 = 40.0;
+
+/// The trim plane through the edge `a -> b` shared by a face and its
+/// neighbour. `m_face` and `m_other` are the unit directions in each face's
+/// plane, perpendicular to the edge, pointing into that face. The plane
+/// bisects the two half-planes: its normal is `m_face - m_other` (which is
+/// perpendicular to both the edge and the bisector `m_face + m_other`), so
+/// for coplanar faces it is the plane perpendicular to both through the
+/// edge. `pivot_y` (unit) decides the classification. All vectors in one
+/// frame; the result is in that frame.
+pub fn bisecting_plane(
+    a: DVec3,
+    b: DVec3,
+    m_face: DVec3,
+    m_other: DVec3,
+    pivot_y: DVec3,
+) -> Option<TrimPlane> {
+    let d = (b - a).try_normalize()?;
+    let normal = (m_face - m_other)
+        .try_normalize()
+        .or_else(|| m_face.try_normalize())?;
+    let angle = d.dot(pivot_y).abs().clamp(0.0, 1.0).asin().to_degrees();
+    Some(TrimPlane {
+        point: a,
+        normal,
+        vertical: angle >= HORIZONTAL_LIMIT_DEGREES,
+    })
+}
+
+/// `trim()`: applies the shape's active trim planes to its geometry.
+pub fn exec(_cx: &mut Interp, st: &mut ShapeState, _call: &OpCall) -> Result<(), RtError> {
+    apply(&mut st.shape, None);
+    Ok(())
+}
+
+/// Cuts the shape's geometry with its active trim planes, keeping the part
+/// on the kept side of every plane. `bounds`: the geometry's bounding box in
+/// scope-local coordinates if the caller knows it (inserts do), so that
+/// planes that do not touch the geometry cost nothing and the geometry is
+/// not even transformed.
+pub fn apply(shape: &mut Shape, bounds: Option<(DVec3, DVec3)>) {
+    let Some(planes) = shape.trim.planes.clone() else {
+        return;
+    };
+    let (use_v, use_h) = (shape.trim.vertical, shape.trim.horizontal);
+    if !use_v && !use_h {
+        return;
+    }
+    let frame = shape.scope.frame;
+    let to_local = frame.axes.transpose();
+    let bounds = match bounds {
+        Some(b) => Some(b),
+        None => local_bounds(shape.geometry.local()),
+    };
+    let Some((lo, hi)) = bounds else {
+        return;
+    };
+    let scale = (hi - lo)
+        .abs()
+        .max_element()
+        .max(lo.abs().max_element())
+        .max(1.0);
+    let tol = 1e-9 * scale;
+    // Planes in scope-local coordinates that actually cut the box.
+    let mut cutting: Vec<(DVec3, f64)> = Vec::new();
+    for p in planes.iter() {
+        if !(if p.vertical { use_v } else { use_h }) {
+            continue;
+        }
+        let n = to_local * p.normal;
+        let offset = n.dot(to_local * (p.point - frame.origin));
+        // Smallest and largest n · corner over the box.
+        let (mut min, mut max) = (0.0, 0.0);
+        for i in 0..3 {
+            let (x, y) = (n[i] * lo[i], n[i] * hi[i]);
+            min += x.min(y);
+            max += x.max(y);
+        }
+        if min >= offset - tol {
+            continue; // entirely kept
+        }
+        if max <= offset + tol {
+            // Entirely on the trimmed side: nothing is left.
+            let mut empty = Mesh::new();
+            let src = shape.geometry.local();
+            empty.materials = src.materials.clone();
+            empty.groups = src.groups.clone();
+            shape.set_local_mesh(empty);
+            return;
+        }
+        cutting.push((n, offset));
+    }
+    if cutting.is_empty() {
+        return;
+    }
+    let mut mesh: Mesh = (**shape.geometry.local()).clone();
+    for (n, offset) in cutting {
+        if mesh.faces.is_empty() {
+            break;
+        }
+        let (_, above) = cga_geometry::cut_by_plane(&mesh, n, offset);
+        mesh = without_caps(above, n, offset);
+    }
+    shape.set_local_mesh(mesh);
+}
+
+/// `mesh` without the faces lying in the plane `n · p = offset` and facing
+/// away from `n`: the caps `cut_by_plane` adds to close a cut solid (a face
+/// of the input lying exactly in the plane and facing out of the kept part
+/// goes too; it would lie on the cut anyway).
+fn without_caps(mut mesh: Mesh, n: DVec3, offset: f64) -> Mesh {
+    let scale = mesh
+        .positions
+        .iter()
+        .fold(offset.abs(), |m, p| m.max(p.abs().max_element()))
+        .max(1.0);
+    let tol = 1e-9 * scale * n.length().max(1.0);
+    let on_plane = |p: DVec3| (n.dot(p) - offset).abs() <= tol;
+    let keep: Vec<bool> = (0..mesh.faces.len())
+        .map(|f| {
+            let flat = mesh
+                .face_loops(f)
+                .iter()
+                .all(|&l| mesh.loop_points(l).all(on_plane));
+            !(flat && cga_geometry::measure::face_normal(&mesh, f).dot(n) < 0.0)
+        })
+        .collect();
+    if keep.iter().all(|&k| k) {
+        return mesh;
+    }
+    let mut out = Mesh::new();
+    out.materials = std::mem::take(&mut mesh.materials);
+    out.groups = std::mem::take(&mut mesh.groups);
+    let mut src = mesh;
+    src.materials = out.materials.clone();
+    src.groups = out.groups.clone();
+    let mut faces = Vec::new();
+    for (f, k) in keep.iter().enumerate() {
+        if *k {
+            faces.push(f);
+        }
+    }
+    copy_faces(&src, &faces, &mut out);
+    out
+}
+
+/// Copies the faces `faces` of `src` (with their corner attributes) into
+/// `out`, which has `src`'s materials and groups; positions are shared as is.
+fn copy_faces(src: &Mesh, faces: &[usize], out: &mut Mesh) {
+    out.positions = src.positions.clone();
+    for (d, s) in out.uvs.iter_mut().zip(&src.uvs) {
+        if s.is_some() {
+            *d = Some(Vec::new());
+        }
+    }
+    if src.normals.is_some() {
+        out.normals = Some(Vec::new());
+    }
+    for &f in faces {
+        let face = src.faces[f];
+        let first_loop = out.loops.len() as u32;
+        for &l in src.face_loops(f) {
+            let start = out.corners.len() as u32;
+            for c in src.loop_corners(l) {
+                out.corners.push(src.corners[c]);
+                for (d, s) in out.uvs.iter_mut().zip(&src.uvs) {
+                    if let (Some(d), Some(s)) = (d.as_mut(), s.as_ref()) {
+                        d.push(s[c]);
+                    }
+                }
+                if let (Some(d), Some(s)) = (out.normals.as_mut(), src.normals.as_ref()) {
+                    d.push(s[c]);
+                }
+            }
+            out.loops.push(cga_geometry::Loop { start, len: l.len });
+        }
+        out.faces.push(cga_geometry::Face { first_loop, ..face });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn box_corner_plane_is_the_diagonal() {
+        // Front face (normal +z) and right face (normal +x) of a box meet at
+        // the vertical edge x = 1, z = 0. Into the front face from the edge
+        // is -x, into the right face is -z.
+        let p = bisecting_plane(
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+            -DVec3::X,
+            -DVec3::Z,
+            DVec3::Y,
+        )
+        .unwrap();
+        let s = std::f64::consts::FRAC_1_SQRT_2;
+        assert!((p.normal - DVec3::new(-s, 0.0, s)).length() < 1e-12);
+        assert!(p.vertical);
+        // A horizontal edge of the same face is horizontal.
+        let h = bisecting_plane(DVec3::ZERO, DVec3::X, DVec3::Y, -DVec3::Z, DVec3::Y).unwrap();
+        assert!(!h.vertical);
+    }
+
+    #[test]
+    fn coplanar_neighbours_give_the_perpendicular_plane() {
+        let p = bisecting_plane(DVec3::ZERO, DVec3::Y, -DVec3::X, DVec3::X, DVec3::Y).unwrap();
+        assert!((p.normal + DVec3::X).length() < 1e-12);
+    }
+
+    #[test]
+    fn degenerate_edge_gives_no_plane() {
+        assert!(bisecting_plane(DVec3::ONE, DVec3::ONE, DVec3::X, DVec3::Z, DVec3::Y).is_none());
+    }
+}

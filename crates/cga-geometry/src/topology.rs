@@ -94,6 +94,34 @@ fn cell_key(p: DVec3, cell: f64) -> [i64; 3] {
 pub fn weld_points(points: &[DVec3], tol: f64) -> Weld {
     let mut id = Vec::with_capacity(points.len());
     let mut representative: Vec<u32> = Vec::new();
+    weld_points_into(points, tol, &mut id, &mut representative);
+    Weld {
+        count: representative.len(),
+        id,
+        representative,
+    }
+}
+
+/// Up to this many points, [`weld_points_into`] first tries a plain scan of
+/// the representatives: cheaper than hashing for the boxes and quads most
+/// shapes are.
+const SMALL_WELD: usize = 40;
+
+/// [`weld_points`] into reused buffers: `id` and `representative` are
+/// cleared and filled as the fields of [`Weld`] are.
+pub(crate) fn weld_points_into(
+    points: &[DVec3],
+    tol: f64,
+    id: &mut Vec<u32>,
+    representative: &mut Vec<u32>,
+) {
+    id.clear();
+    representative.clear();
+    if points.len() <= SMALL_WELD && weld_small(points, tol, id, representative) {
+        return;
+    }
+    id.clear();
+    representative.clear();
     if tol <= 0.0 || !tol.is_finite() {
         let mut seen: FxHashMap<[u64; 3], u32> = fx_map(points.len());
         for (i, p) in points.iter().enumerate() {
@@ -155,11 +183,46 @@ pub fn weld_points(points: &[DVec3], tol: f64) -> Weld {
             id.push(v);
         }
     }
-    Weld {
-        count: representative.len(),
-        id,
-        representative,
+}
+
+/// Welding by scanning all representatives, for few points. It only
+/// decides the plain case, where every point is either bitwise equal (up to
+/// the sign of zero) to one representative and farther than `tol` from all
+/// others, or farther than `tol` from all: there the hash grid finds the
+/// same clusters. Anything closer (points within `tol` but not equal, or
+/// near several representatives) returns false, leaving the grid to decide,
+/// so the result never depends on the path taken.
+fn weld_small(
+    points: &[DVec3],
+    tol: f64,
+    id: &mut Vec<u32>,
+    representative: &mut Vec<u32>,
+) -> bool {
+    let exact = tol <= 0.0 || !tol.is_finite();
+    for (i, &p) in points.iter().enumerate() {
+        let p = p + DVec3::ZERO;
+        let mut found = u32::MAX;
+        for (r, &ri) in representative.iter().enumerate() {
+            let q = points[ri as usize] + DVec3::ZERO;
+            let equal = q.x.to_bits() == p.x.to_bits()
+                && q.y.to_bits() == p.y.to_bits()
+                && q.z.to_bits() == p.z.to_bits();
+            if equal {
+                if found != u32::MAX {
+                    return false;
+                }
+                found = r as u32;
+            } else if !exact && (q - p).abs().max_element() <= tol {
+                return false;
+            }
+        }
+        if found == u32::MAX {
+            found = representative.len() as u32;
+            representative.push(i as u32);
+        }
+        id.push(found);
     }
+    true
 }
 
 /// One use of an edge by a face: the corner the edge starts at (the edge runs

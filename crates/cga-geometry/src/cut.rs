@@ -53,7 +53,7 @@ use glam::{DVec2, DVec3};
 
 use crate::measure::face_normal;
 use crate::mesh::{Face, Loop, Mesh};
-use crate::topology::{mesh_tolerance, weld_points_into, FxHashMap};
+use crate::topology::{mesh_tolerance, weld_points_into};
 use crate::triangulate::plane_basis;
 
 /// Cuts `mesh` with the plane `normal · p = offset` into the part below
@@ -271,6 +271,44 @@ enum Side {
     Both,
 }
 
+/// How [`Cutter::split_simple`] came out.
+enum Simple {
+    NotApplicable,
+    /// The piece below is stored; the piece above, if it has area
+    /// (`above`), is in `cur`.
+    Done {
+        above: bool,
+    },
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Set by tests to run the general path only, to compare with it.
+    static GENERAL_PATH_ONLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    /// Number of splits done by [`Cutter::split_simple`], for tests.
+    static SIMPLE_SPLITS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
+#[cfg(test)]
+fn count_simple_split() {
+    SIMPLE_SPLITS.with(|c| c.set(c.get() + 1));
+}
+
+#[cfg(not(test))]
+#[inline(always)]
+fn count_simple_split() {}
+
+#[cfg(test)]
+fn fast_paths_enabled() -> bool {
+    !GENERAL_PATH_ONLY.with(|g| g.get())
+}
+
+#[cfg(not(test))]
+#[inline(always)]
+fn fast_paths_enabled() -> bool {
+    true
+}
+
 /// How a split came out.
 enum Split {
     /// The pieces are in `Bufs::pieces`.
@@ -278,6 +316,80 @@ enum Split {
     /// The polygon could not be split consistently and stays whole on one
     /// side (`true`: above).
     Whole(bool),
+}
+
+/// Crossing vertices by (welded edge, plane): a hash table with open
+/// addressing in reused memory. Cleared in constant time by stamping slots
+/// with a generation: a slot of another generation is empty. (A general
+/// hash map costs several times as much per lookup here, where a box split
+/// into floors does little else than look up its crossings.)
+#[derive(Default)]
+struct CrossingTable {
+    /// (edge key, plane, vertex, generation); the length is 0 or a power
+    /// of two.
+    slots: Vec<(u64, u32, u32, u32)>,
+    generation: u32,
+    len: usize,
+}
+
+impl CrossingTable {
+    fn clear(&mut self) {
+        self.len = 0;
+        self.generation = self.generation.wrapping_add(1);
+        if self.generation == 0 {
+            // Wrapped around: stamps of old generations could look current.
+            for s in &mut self.slots {
+                s.3 = 0;
+            }
+            self.generation = 1;
+        }
+    }
+
+    #[inline]
+    fn home(&self, key: u64, plane: u32) -> usize {
+        let h = (key ^ (plane as u64).rotate_right(16)).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+        (h >> 32) as usize & (self.slots.len() - 1)
+    }
+
+    /// The vertex stored for (`key`, `plane`), or the slot to insert it at
+    /// (valid until the next insertion).
+    fn find(&mut self, key: u64, plane: u32) -> Result<u32, usize> {
+        if 2 * (self.len + 1) > self.slots.len() {
+            self.grow();
+        }
+        let mask = self.slots.len() - 1;
+        let mut i = self.home(key, plane);
+        loop {
+            let s = self.slots[i];
+            if s.3 != self.generation {
+                return Err(i);
+            }
+            if s.0 == key && s.1 == plane {
+                return Ok(s.2);
+            }
+            i = (i + 1) & mask;
+        }
+    }
+
+    fn insert_at(&mut self, slot: usize, key: u64, plane: u32, v: u32) {
+        self.slots[slot] = (key, plane, v, self.generation);
+        self.len += 1;
+    }
+
+    fn grow(&mut self) {
+        let old = std::mem::take(&mut self.slots);
+        let generation = self.generation;
+        self.slots = vec![(0, 0, 0, 0); (old.len() * 2).max(64)];
+        self.generation = 1;
+        self.len = 0;
+        for s in old {
+            if s.3 == generation {
+                if let Err(i) = self.find(s.0, s.1) {
+                    self.insert_at(i, s.0, s.1, s.2);
+                }
+            }
+        }
+    }
 }
 
 /// Every buffer a cut needs, kept between calls (see
@@ -293,7 +405,7 @@ struct Bufs {
     /// Vertex pool: welded positions, then crossing vertices.
     verts: Vec<DVec3>,
     /// Crossing vertices by (welded edge ends, plane).
-    crossings: FxHashMap<(u32, u32, u32), u32>,
+    crossings: CrossingTable,
     /// Routed faces with their part, in routing order.
     items: Vec<(u32, Item)>,
     /// `items` sorted by part (stably): part `p` is
@@ -376,8 +488,8 @@ impl Bufs {
         trim(&mut self.vid);
         trim(&mut self.rep);
         trim(&mut self.verts);
-        if self.crossings.capacity() > KEEP {
-            self.crossings = FxHashMap::default();
+        if self.crossings.slots.len() > KEEP {
+            self.crossings = CrossingTable::default();
         }
         trim(&mut self.items);
         trim(&mut self.part_items);
@@ -433,6 +545,9 @@ struct Cutter<'m> {
     /// set exactly to the plane's, so caps are exactly planar).
     axis: Option<usize>,
     tol: f64,
+    /// The plane coordinates of the face being routed (see
+    /// [`Cutter::face_basis`]).
+    basis: (DVec3, DVec3),
     bufs: Bufs,
 }
 
@@ -469,6 +584,7 @@ impl<'m> Cutter<'m> {
             n,
             axis,
             tol,
+            basis: (DVec3::X, DVec3::Y),
             bufs,
         }
     }
@@ -595,6 +711,7 @@ impl<'m> Cutter<'m> {
     /// pieces reach each part is that of a recursion over the pieces).
     fn route(&mut self, face: u32, normal: DVec3, k: usize) {
         debug_assert!(self.bufs.stack.polys.is_empty());
+        self.basis = self.face_basis(normal);
         self.route_one(face, normal, k);
         while let Some((first, count, k)) = self.bufs.stack.polys.pop() {
             let b = &mut self.bufs;
@@ -634,6 +751,14 @@ impl<'m> Cutter<'m> {
                     k += 1;
                 }
                 Side::Both => {
+                    match self.split_simple(face, normal, k) {
+                        Simple::NotApplicable => {}
+                        Simple::Done { above: true } => {
+                            k += 1;
+                            continue;
+                        }
+                        Simple::Done { above: false } => return,
+                    }
                     let split = if self.bufs.cur.loops[0].1 < 3 {
                         self.split_segment(k)
                     } else {
@@ -666,6 +791,16 @@ impl<'m> Cutter<'m> {
                 }
             }
         }
+    }
+
+    /// Coordinates in the plane of a face with unit `normal` (or zero),
+    /// in which pieces are told from holes.
+    fn face_basis(&self, normal: DVec3) -> (DVec3, DVec3) {
+        plane_basis(if normal == DVec3::ZERO {
+            self.n
+        } else {
+            normal
+        })
     }
 
     fn classify(&self, k: usize) -> Side {
@@ -742,10 +877,10 @@ impl<'m> Cutter<'m> {
         };
         let (sa, sb) = (self.dist(va, k), self.dist(vb, k));
         let t_face = sa / (sa - sb);
-        let key = (va.min(vb), va.max(vb), k as u32);
-        let v = match self.bufs.crossings.get(&key) {
-            Some(&v) => v,
-            None => {
+        let key = edge_key(va, vb);
+        let v = match self.bufs.crossings.find(key, k as u32) {
+            Ok(v) => v,
+            Err(slot) => {
                 // Compute from the lower id to the higher so that the point
                 // does not depend on which face asks first.
                 let (p, q, sp, sq) = if va < vb {
@@ -761,7 +896,7 @@ impl<'m> Cutter<'m> {
                 }
                 self.bufs.verts.push(x);
                 let v = self.bufs.verts.len() as u32 - 1;
-                self.bufs.crossings.insert(key, v);
+                self.bufs.crossings.insert_at(slot, key, k as u32, v);
                 v
             }
         };
@@ -803,6 +938,165 @@ impl<'m> Cutter<'m> {
     /// Splits the polygon in `cur`, with vertices strictly on both sides of
     /// plane `k`, into pieces below and above (see the module docs), left in
     /// `pieces`.
+    /// The common case of a split, done directly: a polygon without holes
+    /// and without repeated vertices, no vertex of which lies on plane `k`,
+    /// crossing it at exactly two edges (every convex face that is cut).
+    /// The piece below is stored, the piece above left in `cur`. The result
+    /// is exactly what [`Cutter::split_polygon`] gives (the same crossing
+    /// vertices created in the same order, the same corners in the same
+    /// order, the same pieces dropped for a negative area); it returns
+    /// `NotApplicable` for anything else, having at most created crossing
+    /// vertices the general path finds again.
+    fn split_simple(&mut self, face: u32, normal: DVec3, k: usize) -> Simple {
+        const MAX: usize = 16;
+        if !fast_paths_enabled() {
+            return Simple::NotApplicable;
+        }
+        let tol = self.tol;
+        let cur = &self.bufs.cur;
+        let n = cur.corners.len();
+        if cur.loops.len() != 1 || !(3..=MAX).contains(&n) {
+            return Simple::NotApplicable;
+        }
+        let mut above = [false; MAX];
+        let mut dist = [0.0; MAX];
+        for (i, c) in cur.corners.iter().enumerate() {
+            let s = self.dist(c.v, k);
+            // On the plane (or NaN): the general path decides.
+            if s.abs() <= tol || s.is_nan() {
+                return Simple::NotApplicable;
+            }
+            above[i] = s > tol;
+            dist[i] = s;
+        }
+        let mut edges = [0usize; 2];
+        let mut m = 0;
+        for e in 0..n {
+            if above[e] != above[if e + 1 == n { 0 } else { e + 1 }] {
+                if m == 2 {
+                    return Simple::NotApplicable;
+                }
+                edges[m] = e;
+                m += 1;
+            }
+        }
+        if m != 2 {
+            return Simple::NotApplicable;
+        }
+        for i in 1..n {
+            let v = cur.corners[i].v;
+            if cur.corners[..i].iter().any(|c| c.v == v) {
+                return Simple::NotApplicable;
+            }
+        }
+        // The crossings, created in edge order as the general path does,
+        // with their position and tie-break along the cut line.
+        let d = normal.cross(self.n);
+        let mut xs = [(
+            WCorner {
+                v: 0,
+                a: 0,
+                b: 0,
+                t: 0.0,
+            },
+            0.0,
+            0.0,
+            false,
+        ); 2];
+        for (x, &e) in xs.iter_mut().zip(&edges) {
+            let j = if e + 1 == n { 0 } else { e + 1 };
+            let (ci, cj) = (self.bufs.cur.corners[e], self.bufs.cur.corners[j]);
+            let corner = self.crossing_corner(ci, cj, k);
+            let (lo, hi, slo, shi) = if above[e] {
+                (cj, ci, dist[j], dist[e])
+            } else {
+                (ci, cj, dist[e], dist[j])
+            };
+            let verts = &self.bufs.verts;
+            let dl = verts[hi.v as usize] - verts[lo.v as usize];
+            *x = (
+                corner,
+                verts[corner.v as usize].dot(d),
+                dl.dot(d) / (shi - slo),
+                above[j],
+            );
+        }
+        if xs[0].0.v == xs[1].0.v {
+            return Simple::NotApplicable;
+        }
+        // The general path pairs the crossings in order along the line (a
+        // stable sort): the first must go up, the second down.
+        let second_first = xs[1]
+            .1
+            .total_cmp(&xs[0].1)
+            .then(xs[1].2.total_cmp(&xs[0].2))
+            .is_lt();
+        let (first, second) = if second_first {
+            (xs[1], xs[0])
+        } else {
+            (xs[0], xs[1])
+        };
+        if !first.3 || second.3 {
+            return Simple::NotApplicable;
+        }
+        // Below: from the crossing going down along the loop to the one
+        // going up; above: the rest.
+        let (xd, ed, xu, eu) = if xs[0].3 {
+            (xs[1].0, edges[1], xs[0].0, edges[0])
+        } else {
+            (xs[0].0, edges[0], xs[1].0, edges[1])
+        };
+        // Pieces with a negative area are dropped, as the general path
+        // does (they would be holes with no piece around them).
+        let basis = self.basis;
+        let mut p2 = [DVec2::ZERO; MAX];
+        for (q, c) in p2.iter_mut().zip(&self.bufs.cur.corners) {
+            *q = self.to2d(c.v, basis);
+        }
+        let (pd, pu) = (self.to2d(xd.v, basis), self.to2d(xu.v, basis));
+        let area = |x0: DVec2, e0: usize, x1: DVec2, e1: usize| {
+            let mut seq = [DVec2::ZERO; MAX + 2];
+            seq[0] = x0;
+            let mut len = 1;
+            let mut e = e0;
+            loop {
+                e = if e + 1 == n { 0 } else { e + 1 };
+                seq[len] = p2[e];
+                len += 1;
+                if e == e1 {
+                    break;
+                }
+            }
+            seq[len] = x1;
+            signed_area_by(len + 1, |i| seq[i])
+        };
+        let mut piece = std::mem::take(&mut self.bufs.split.cleaned);
+        if area(pd, ed, pu, eu) >= 0.0 {
+            trace_piece(&self.bufs.cur.corners, &mut piece, (xd, ed), (xu, eu));
+            let b = &mut self.bufs;
+            b.store_loops
+                .push((b.store_corners.len() as u32, piece.len() as u32));
+            b.store_corners.extend_from_slice(&piece);
+            b.pieces_rec.push(PieceRec {
+                face,
+                first: b.store_loops.len() as u32 - 1,
+                count: 1,
+            });
+            b.items
+                .push((k as u32, Item::Piece(b.pieces_rec.len() as u32 - 1)));
+        }
+        let keep = area(pu, eu, pd, ed) >= 0.0;
+        if keep {
+            trace_piece(&self.bufs.cur.corners, &mut piece, (xu, eu), (xd, ed));
+            let cur = &mut self.bufs.cur;
+            std::mem::swap(&mut cur.corners, &mut piece);
+            cur.loops[0] = (0, cur.corners.len() as u32);
+        }
+        self.bufs.split.cleaned = piece;
+        count_simple_split();
+        Simple::Done { above: keep }
+    }
+
     fn split_polygon(&mut self, normal: DVec3, k: usize) -> Split {
         let poly = std::mem::take(&mut self.bufs.cur);
         let mut sc = std::mem::take(&mut self.bufs.split);
@@ -815,7 +1109,7 @@ impl<'m> Cutter<'m> {
             let c = poly.corners.iter().map(|c| self.dist(c.v, k)).sum::<f64>()
                 / poly.corners.len() as f64;
             self.bufs.cur = poly;
-            return Split::Whole(!(c <= 0.0));
+            return Split::Whole(c > 0.0 || c.is_nan());
         }
         self.bufs.cur = poly;
         split
@@ -896,11 +1190,7 @@ impl<'m> Cutter<'m> {
             return Split::Whole(false);
         }
 
-        let basis = plane_basis(if normal == DVec3::ZERO {
-            self.n
-        } else {
-            normal
-        });
+        let basis = self.basis;
         // The face's vertices on the cut line, by position along it. A jump
         // along the line passes through those lying between its ends: this
         // keeps edges of the line shared between pieces and caps (no
@@ -1547,6 +1837,28 @@ impl<'m> Cutter<'m> {
     }
 }
 
+/// The loop `corners` from crossing `x0` on edge `e0` along the loop to
+/// crossing `x1` on edge `e1`, into `piece`.
+fn trace_piece(
+    corners: &[WCorner],
+    piece: &mut Vec<WCorner>,
+    (x0, e0): (WCorner, usize),
+    (x1, e1): (WCorner, usize),
+) {
+    let n = corners.len();
+    piece.clear();
+    piece.push(x0);
+    let mut e = e0;
+    loop {
+        e = if e + 1 == n { 0 } else { e + 1 };
+        piece.push(corners[e]);
+        if e == e1 {
+            break;
+        }
+    }
+    piece.push(x1);
+}
+
 /// An undirected edge as one sortable key (lower id in the high half).
 fn edge_key(a: u32, b: u32) -> u64 {
     ((a.min(b) as u64) << 32) | a.max(b) as u64
@@ -2106,6 +2418,124 @@ pub(crate) mod tests {
             prop_assert!(a.is_empty() || closed(&a));
             prop_assert!(b.is_empty() || closed(&b));
             prop_assert!((non_cap_area(&a) + non_cap_area(&b) - mesh_area(&m)).abs() <= 1e-9 * mesh_area(&m));
+        }
+    }
+
+    /// `split_along_axis` by the general path only, and the number of
+    /// splits the fast path did in the normal run.
+    fn split_both_ways(m: &Mesh, axis: usize, cuts: &[f64]) -> (Vec<Mesh>, Vec<Mesh>, usize) {
+        SIMPLE_SPLITS.with(|c| c.set(0));
+        let fast = split_along_axis(m, axis, cuts);
+        let used = SIMPLE_SPLITS.with(|c| c.get());
+        GENERAL_PATH_ONLY.with(|g| g.set(true));
+        let general = split_along_axis(m, axis, cuts);
+        GENERAL_PATH_ONLY.with(|g| g.set(false));
+        (fast, general, used)
+    }
+
+    #[test]
+    fn fast_path_splits_boxes_and_quads_as_the_general_path() {
+        // Floors of a mass: every side face crosses 3 planes, all split by
+        // the fast path; the output is the same, face for face.
+        let mass = prism(&[(0., 0.), (20., 0.), (20., -30.), (0., -30.)], &[], 10.0);
+        let (fast, general, used) = split_both_ways(&mass, 1, &[0.0, 3.0, 6.0, 9.0, 10.0]);
+        assert_eq!(used, 12);
+        assert_eq!(fast, general);
+        assert_eq!(
+            fast.iter().map(|m| m.faces.len()).collect::<Vec<_>>(),
+            vec![0, 6, 6, 6, 6, 0]
+        );
+        // A facade with UVs into tiles, cuts on its borders included.
+        let mut q = Mesh::polygon(&[
+            v(0., 0., 0.),
+            v(20., 0., 0.),
+            v(20., 10., 0.),
+            v(0., 10., 0.),
+        ]);
+        q.uvs[0] = Some(vec![
+            DVec2::new(0., 0.),
+            DVec2::new(1., 0.),
+            DVec2::new(1., 1.),
+            DVec2::new(0., 1.),
+        ]);
+        let cuts: Vec<f64> = (0..=10).map(|i| i as f64 * 2.0).collect();
+        let (fast, general, used) = split_both_ways(&q, 0, &cuts);
+        assert_eq!(used, 9);
+        assert_eq!(fast, general);
+        // Tile 3 spans x in [4, 6]; UVs are interpolated along the edges.
+        let t = &fast[3];
+        assert_eq!((t.faces.len(), t.positions.len()), (1, 4));
+        let uv = t.uvs[0].as_ref().unwrap();
+        for (k, &c) in t.corners.iter().enumerate() {
+            let p = t.positions[c as usize];
+            assert!(p.x == 4.0 || p.x == 6.0);
+            assert!((uv[k] - DVec2::new(p.x / 20.0, p.y / 10.0)).length() < 1e-15);
+        }
+        // A cut through a vertex is left to the general path.
+        let (fast, general, used) = split_both_ways(&q, 0, &[20.0]);
+        assert_eq!((used, fast.len()), (0, 2));
+        assert_eq!(fast, general);
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 300, .. ProptestConfig::default() })]
+
+        /// Random planar convex quads in any orientation, with UVs and
+        /// normals, cut along any axis, some cuts through their vertices.
+        #[test]
+        fn fast_path_equals_general_path_on_quads(
+            o in prop::array::uniform3(-5.0f64..5.0),
+            u in prop::array::uniform3(-3.0f64..3.0),
+            w in prop::array::uniform3(-3.0f64..3.0),
+            stretch in 0.3f64..1.7,
+            shear in -0.4f64..0.4,
+            axis in 0usize..3,
+            fr in prop::collection::vec(-0.2f64..1.2, 1..8),
+            through_vertex in prop::option::of(0usize..4),
+        ) {
+            let (o, u, w) = (DVec3::from(o), DVec3::from(u), DVec3::from(w));
+            prop_assume!(u.cross(w).length() > 0.1);
+            // Convex: a parallelogram with one corner pushed outwards.
+            let pts = [o, o + u, o + u + w * stretch, o + w + u * shear];
+            let mut m = Mesh::polygon(&pts);
+            m.uvs[0] = Some((0..4).map(|i| DVec2::new(i as f64, 0.5 * i as f64)).collect());
+            m.normals = Some(vec![u.cross(w).normalize(); 4]);
+            let lo = pts.iter().map(|p| p[axis]).fold(f64::INFINITY, f64::min);
+            let hi = pts.iter().map(|p| p[axis]).fold(f64::NEG_INFINITY, f64::max);
+            let mut cuts: Vec<f64> = fr.iter().map(|f| lo + f * (hi - lo)).collect();
+            if let Some(k) = through_vertex {
+                cuts.push(pts[k][axis]);
+            }
+            cuts.sort_by(f64::total_cmp);
+            let (fast, general, _) = split_both_ways(&m, axis, &cuts);
+            prop_assert_eq!(fast, general);
+        }
+
+        /// Boxes, axis-aligned or rotated, split along any axis.
+        #[test]
+        fn fast_path_equals_general_path_on_boxes(
+            size in prop::array::uniform3(0.1f64..10.0),
+            at in prop::array::uniform3(-10.0f64..10.0),
+            turn in prop::option::of((0.0f64..3.0, 0.0f64..1.0)),
+            axis in 0usize..3,
+            fr in prop::collection::vec(-0.2f64..1.2, 1..8),
+            snap in any::<bool>(),
+        ) {
+            let mut b = crate::primitive::cube(DVec3::from(size));
+            if let Some((y, x)) = turn {
+                let r = glam::DAffine3::from_rotation_y(y) * glam::DAffine3::from_rotation_x(x);
+                crate::transform::transform(&mut b, &r);
+            }
+            b.map_positions(|p| p + DVec3::from(at));
+            let lo = b.positions.iter().map(|p| p[axis]).fold(f64::INFINITY, f64::min);
+            let hi = b.positions.iter().map(|p| p[axis]).fold(f64::NEG_INFINITY, f64::max);
+            let mut cuts: Vec<f64> = fr.iter().map(|f| {
+                let f = if snap { (f * 4.0).round() / 4.0 } else { *f };
+                lo + f * (hi - lo)
+            }).collect();
+            cuts.sort_by(f64::total_cmp);
+            let (fast, general, _) = split_both_ways(&b, axis, &cuts);
+            prop_assert_eq!(fast, general);
         }
     }
 }

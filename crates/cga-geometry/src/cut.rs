@@ -46,6 +46,20 @@
 //! edge they lie on: every corner of a piece is stored as an original edge
 //! `(a, b)` and a parameter `t`, which stays exact through successive cuts of
 //! [`split_along_axis`].
+//!
+//! # Speed
+//!
+//! Typical calls are small (a building mass into floors, a facade into
+//! tiles) and frequent, so the cut allocates nothing but its output: all
+//! working arrays live in a per-thread `Bufs` reused from call to call
+//! (freed when a huge input made them grow past a bound), pieces are ranges
+//! of flat arrays, pieces above a plane wait on an explicit stack instead of
+//! a recursion, crossing vertices are found in an open-addressing table
+//! cleared in constant time, and cap edges are matched by sorting instead of
+//! hashing. The common split (a polygon without holes crossing the plane at
+//! two edges, no vertex on it: every convex face) takes a direct path,
+//! `Cutter::split_simple`, that gives exactly the general path's result;
+//! the tests compare both. `benches/cut.rs` measures the typical calls.
 
 use std::cell::RefCell;
 
@@ -103,10 +117,9 @@ pub fn split_by_parallel_planes(mesh: &Mesh, normal: DVec3, offsets: &[f64]) -> 
     // `try_borrow_mut` never fails (nothing here calls back into a cut);
     // both fall back to fresh buffers rather than panic.
     let run = |bufs: &mut Bufs| {
-        let mut cutter = Cutter::new(mesh, normal, offsets, std::mem::take(bufs));
+        let mut cutter = Cutter::new(mesh, normal, offsets, bufs);
         cutter.run();
         let out = cutter.build();
-        *bufs = cutter.bufs;
         bufs.trim();
         out
     };
@@ -538,7 +551,7 @@ impl Bufs {
     }
 }
 
-struct Cutter<'m> {
+struct Cutter<'m, 'b> {
     mesh: &'m Mesh,
     n: DVec3,
     /// For axis-aligned cuts, the axis (crossing vertices get that coordinate
@@ -548,11 +561,11 @@ struct Cutter<'m> {
     /// The plane coordinates of the face being routed (see
     /// [`Cutter::face_basis`]).
     basis: (DVec3, DVec3),
-    bufs: Bufs,
+    bufs: &'b mut Bufs,
 }
 
-impl<'m> Cutter<'m> {
-    fn new(mesh: &'m Mesh, n: DVec3, offsets: &[f64], mut bufs: Bufs) -> Cutter<'m> {
+impl<'m, 'b> Cutter<'m, 'b> {
+    fn new(mesh: &'m Mesh, n: DVec3, offsets: &[f64], bufs: &'b mut Bufs) -> Cutter<'m, 'b> {
         // Sanitise the offsets: ascending, finite (NaN sorts as "no cut": it
         // is replaced by its predecessor, or -inf for the first).
         let planes = &mut bufs.planes;

@@ -120,6 +120,11 @@ pub(crate) fn weld_points_into(
     if points.len() <= SMALL_WELD && weld_small(points, tol, id, representative) {
         return;
     }
+    weld_grid(points, tol, id, representative);
+}
+
+/// Welding with a hash grid (or, for `tol <= 0`, a hash of the bits).
+fn weld_grid(points: &[DVec3], tol: f64, id: &mut Vec<u32>, representative: &mut Vec<u32>) {
     id.clear();
     representative.clear();
     if tol <= 0.0 || !tol.is_finite() {
@@ -385,6 +390,42 @@ impl Topology {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// The scan for few points agrees with the grid whenever it
+        /// decides: points on a coarse lattice (so many coincide, up to
+        /// the sign of zero), some moved by less than the tolerance.
+        #[test]
+        fn small_welding_agrees_with_the_grid(
+            pts in prop::collection::vec((prop::array::uniform3(-2i32..3), 0u8..4), 1..40),
+            tol in prop::sample::select(vec![0.0, 1e-9, 1e-3]),
+        ) {
+            let points: Vec<DVec3> = pts
+                .iter()
+                .map(|(c, jitter)| {
+                    let p = DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64) * 0.5;
+                    match jitter {
+                        0 => p + DVec3::X * 0.3 * tol,
+                        1 => -p,
+                        _ => p,
+                    }
+                })
+                .collect();
+            let (mut id, mut rep) = (Vec::new(), Vec::new());
+            let decided = weld_small(&points, tol, &mut id, &mut rep);
+            let (mut gid, mut grep) = (Vec::new(), Vec::new());
+            weld_grid(&points, tol, &mut gid, &mut grep);
+            if decided {
+                prop_assert_eq!(&id, &gid);
+                prop_assert_eq!(&rep, &grep);
+            }
+            // Whichever path it takes, `weld_points` gives the grid's result.
+            let w = weld_points(&points, tol);
+            prop_assert_eq!(w.id, gid);
+            prop_assert_eq!(w.representative, grep);
+        }
+    }
 
     #[test]
     fn welding_exact_and_with_tolerance() {
@@ -408,6 +449,29 @@ mod tests {
         let b = a + DVec3::splat(0.5 * t);
         let c = a + DVec3::new(2.0 * t, 0.0, 0.0);
         assert_eq!(weld_points(&[a, b, c], t).id, vec![0, 0, 1]);
+    }
+
+    #[test]
+    fn few_points_are_welded_by_the_scan() {
+        // The 24 corners of a cube (each position repeated per face, one
+        // with a negative zero) weld to 8 without the grid.
+        let cube = crate::primitive::cube(DVec3::new(1.0, 2.0, 3.0));
+        let mut points: Vec<DVec3> = cube
+            .corners
+            .iter()
+            .map(|&c| cube.positions[c as usize])
+            .collect();
+        assert_eq!(points.len(), 24);
+        let zero_x = points.iter().position(|p| p.x == 0.0).unwrap();
+        points[zero_x].x = -0.0;
+        let (mut id, mut rep) = (Vec::new(), Vec::new());
+        assert!(weld_small(&points, 1e-9, &mut id, &mut rep));
+        assert_eq!(rep.len(), 8);
+        assert_eq!(weld_points(&points, 1e-9).id, id);
+        // A point within the tolerance but not equal is left to the grid.
+        points.push(points[3] + DVec3::X * 1e-12);
+        assert!(!weld_small(&points, 1e-9, &mut id, &mut rep));
+        assert_eq!(weld_points(&points, 1e-9).count, 8);
     }
 
     #[test]

@@ -1887,7 +1887,9 @@ fn signed_area_by(n: usize, pt: impl Fn(usize) -> DVec2) -> f64 {
     0.5 * a
 }
 
-/// Even-odd point in polygon test.
+/// Even-odd point in polygon test. The cut itself uses
+/// [`point_in_polygon_by`]; this slice form stays for the other geometry
+/// modules of the crate.
 #[allow(dead_code)]
 pub(crate) fn point_in_polygon(q: DVec2, pts: &[DVec2]) -> bool {
     point_in_polygon_by(q, pts.len(), |i| pts[i])

@@ -157,11 +157,7 @@ fn insert_along(
         Some(a) => selector(a, &["alignPosition", "keepPosition"])? == "keepPosition",
         None => false,
     };
-    let asset = match builtin_geometry(path) {
-        Some(m) => Ok(Arc::new(m)),
-        None => cx.assets.mesh(call.span.file, path),
-    };
-    let asset = match asset {
+    let asset = match cx.assets.mesh(call.span.file, path) {
         Ok(a) => a,
         Err(message) => {
             // As with `i`: a missing asset must not lose the model.
@@ -194,21 +190,6 @@ fn insert_along(
         }),
     }
     Ok(())
-}
-
-/// The built-in geometry assets (`builtin:cube`, ...) as `i` knows them.
-fn builtin_geometry(path: &str) -> Option<Mesh> {
-    use cga_geometry::primitive as p;
-    let name = path.strip_prefix("builtin:")?;
-    Some(match name.strip_suffix(".obj").unwrap_or(name) {
-        "cube" => p::builtin_cube(),
-        "quad" => p::quad(1.0, 1.0),
-        "disk" => p::disk(16, 1.0, 1.0),
-        "sphere" => p::sphere(16, 16, DVec3::ONE),
-        "cylinder" => p::cylinder(16, DVec3::ONE),
-        "cone" => p::cone(16, DVec3::ONE),
-        _ => return None,
-    })
 }
 
 /// A UV set argument: an integer in [0, 9].

@@ -1685,6 +1685,40 @@ impl<'m, 'b> Cutter<'m, 'b> {
     }
 
     /// Builds the output meshes.
+    /// Where a piece of `face` starts its outer loop `cs`: at the edge that
+    /// runs most nearly like the source face's first edge (ties: the earliest
+    /// in the loop). A facade split into tiles and floors so keeps its first
+    /// edges along the ground, and the pieces' `comp(f)` scopes keep the
+    /// facade's orientation, whichever corner the cut reached first.
+    fn first_corner(&self, cs: &[WCorner], face: u32) -> usize {
+        let mesh = self.mesh;
+        let outer = mesh.loop_indices(mesh.outer_loop(face as usize));
+        let reference = (0..outer.len())
+            .map(|i| {
+                mesh.positions[outer[(i + 1) % outer.len()] as usize]
+                    - mesh.positions[outer[i] as usize]
+            })
+            .find(|e| e.length() > self.tol)
+            .map(|e| e.normalize());
+        let Some(reference) = reference else {
+            return 0;
+        };
+        let verts = &self.bufs.verts;
+        let mut best = (f64::NEG_INFINITY, 0);
+        for i in 0..cs.len() {
+            let e = verts[cs[(i + 1) % cs.len()].v as usize] - verts[cs[i].v as usize];
+            let len = e.length();
+            if len <= self.tol {
+                continue;
+            }
+            let along = e.dot(reference) / len;
+            if along > best.0 + 1e-9 {
+                best = (along, i);
+            }
+        }
+        best.1
+    }
+
     fn build(&mut self) -> Vec<Mesh> {
         let mesh = self.mesh;
         let closed = self.bufs.planes.is_empty() || self.input_is_closed();
@@ -1753,8 +1787,17 @@ impl<'m, 'b> Cutter<'m, 'b> {
                         let f = mesh.faces[rec.face as usize];
                         for li in rec.first..rec.first + rec.count {
                             let (s, n) = self.bufs.store_loops[li as usize];
+                            let cs = &self.bufs.store_corners[s as usize..(s + n) as usize];
+                            // The outer loop starts where its first edge runs
+                            // like the source face's first edge.
+                            let shift = if li == rec.first {
+                                self.first_corner(cs, rec.face)
+                            } else {
+                                0
+                            };
                             let start = corners.len() as u32;
-                            for c in &self.bufs.store_corners[s as usize..(s + n) as usize] {
+                            for i in 0..cs.len() {
+                                let c = &cs[(i + shift) % cs.len()];
                                 corners.push(map(c.v));
                                 sources.push(*c);
                             }

@@ -255,11 +255,22 @@ fn first_edge_frame(mesh: &Mesh) -> (DVec3, DVec3) {
 /// per polygon); holes are kept; feature properties become attribute values.
 /// GeoJSON `[x, y, z]` maps to `(x, z, -y)`: y up, north away from the viewer.
 pub fn from_geojson(path: &std::path::Path) -> Result<Vec<Lot>, String> {
+    from_geojson_georeferenced(path).map(|(lots, _)| lots)
+}
+
+/// The lots of a GeoJSON file and, when its coordinates are geographic
+/// (longitude, latitude in degrees, as RFC 7946 specifies), the origin of
+/// the local metric frame they were projected into: x east and -z north in
+/// metres from that origin (see [`crate::geo`]).
+pub fn from_geojson_georeferenced(
+    path: &std::path::Path,
+) -> Result<(Vec<Lot>, Option<crate::geo::GeoOrigin>), String> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| format!("cannot read lot file {}: {e}", path.display()))?;
-    let gj: geojson::GeoJson = text
+    let mut gj: geojson::GeoJson = text
         .parse()
         .map_err(|e| format!("{} is not valid GeoJSON: {e}", path.display()))?;
+    let origin = crate::geo::localize_geojson(&mut gj);
     let features: Vec<geojson::Feature> = match gj {
         geojson::GeoJson::FeatureCollection(fc) => fc.features,
         geojson::GeoJson::Feature(f) => vec![f],
@@ -336,7 +347,7 @@ pub fn from_geojson(path: &std::path::Path) -> Result<Vec<Lot>, String> {
     if lots.is_empty() {
         return Err(format!("{} has no polygons to use as lots", path.display()));
     }
-    Ok(lots)
+    Ok((lots, origin))
 }
 
 /// Outer ring counter-clockwise seen from above (+y), holes clockwise.

@@ -390,3 +390,46 @@ fn geographic_geojson_is_projected_to_metres() {
     );
     assert!((area - 30.1 * 22.2).abs() < 5.0, "{area}");
 }
+
+#[test]
+fn flatgeobuf_lots_with_attributes() {
+    use flatgeobuf::{ColumnType, FgbWriter, FgbWriterOptions, GeometryType};
+    use geozero::{ColumnValue, PropertyProcessor};
+    let dir = temp_dir("fgb");
+    let path = dir.join("lots.fgb");
+    let options = FgbWriterOptions {
+        write_index: false,
+        ..Default::default()
+    };
+    let mut fgb = FgbWriter::create_with_options("lots", GeometryType::Polygon, options).unwrap();
+    fgb.add_column("height", ColumnType::Double, |_, _| {});
+    for (x, h) in [(0.0, 12.0), (30.0, 7.5)] {
+        let geometry = format!(
+            r#"{{"type":"Polygon","coordinates":[[[{x},0],[{},0],[{},10],[{x},10],[{x},0]]]}}"#,
+            x + 20.0,
+            x + 20.0
+        );
+        fgb.add_feature_geom(geozero::geojson::GeoJson(&geometry), |feature| {
+            feature
+                .property(0, "height", &ColumnValue::Double(h))
+                .unwrap();
+        })
+        .unwrap();
+    }
+    let mut file = std::io::BufWriter::new(std::fs::File::create(&path).unwrap());
+    fgb.write(&mut file).unwrap();
+    drop(file);
+    let rules = rule_file(
+        &dir,
+        "f.cga",
+        "attr height = 1\nLot --> extrude(height) print(geometry.volume)\n",
+    );
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--lot",
+        path.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(stdout(&out), "2400\n1500\n");
+}

@@ -267,6 +267,32 @@ pub fn from_geojson_georeferenced(
 ) -> Result<(Vec<Lot>, Option<crate::geo::GeoOrigin>), String> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| format!("cannot read lot file {}: {e}", path.display()))?;
+    lots_from_geojson_text(path, &text)
+}
+
+/// The lots of a FlatGeobuf file (each polygon one lot, attributes from the
+/// feature properties), like [`from_geojson_georeferenced`].
+pub fn from_flatgeobuf(
+    path: &std::path::Path,
+) -> Result<(Vec<Lot>, Option<crate::geo::GeoOrigin>), String> {
+    use geozero::GeozeroDatasource;
+    let bad = |e: &dyn std::fmt::Display| format!("cannot read FlatGeobuf {}: {e}", path.display());
+    let file = std::fs::File::open(path).map_err(|e| bad(&e))?;
+    let mut reader = std::io::BufReader::new(file);
+    let mut fgb = flatgeobuf::FgbReader::open(&mut reader)
+        .and_then(|r| r.select_all())
+        .map_err(|e| bad(&e))?;
+    let mut json = Vec::new();
+    fgb.process(&mut geozero::geojson::GeoJsonWriter::new(&mut json))
+        .map_err(|e| bad(&e))?;
+    let text = String::from_utf8(json).map_err(|e| bad(&e))?;
+    lots_from_geojson_text(path, &text)
+}
+
+fn lots_from_geojson_text(
+    path: &std::path::Path,
+    text: &str,
+) -> Result<(Vec<Lot>, Option<crate::geo::GeoOrigin>), String> {
     let mut gj: geojson::GeoJson = text
         .parse()
         .map_err(|e| format!("{} is not valid GeoJSON: {e}", path.display()))?;

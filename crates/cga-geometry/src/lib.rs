@@ -8,27 +8,39 @@
 //! | [`measure`] | normals, areas, volume, bounds, the `geometry.*` measures |
 //! | [`topology`] | welding, unique edges with their faces (`comp(e)` order), closedness |
 //! | [`triangulate`] | faces to triangles for export |
+//! | [`cleanup`] | `cleanupGeometry`, `reduceGeometry`, `rectify` |
+//! | [`convexify`] | `convexify` |
 //! | [`cut`] | plane cuts with caps: `split`, trim planes |
 //! | [`area_split`] | the area left of a moving plane and its inverse: `splitArea` |
 //! | [`extrude`] | `extrude` |
+//! | [`envelope`] | `envelope` |
+//! | [`footprint`] | `footprint`, polygon union and difference (`i_overlay`) |
 //! | [`inner_rect`] | `innerRectangle` |
 //! | [`primitive`] | `primitive*` and `builtin:cube` |
+//! | [`normals`] | `setNormals`, `softenNormals` |
 //! | [`obj`] | OBJ + MTL assets |
 //! | [`transform`] | affine transforms, reversing, merging |
 //! | [`roof`] | `roofHip`, `roofGable`, `roofPyramid`, `roofShed`, `roofRidge` |
+//! | [`roof_edges`] | `comp(e)`'s roof edge classes of any mesh |
 //! | [`setback`] | `offset`, `setback`, `setbackToArea`, `shapeL/U/O` |
 //! | [`skeleton`] | weighted straight skeletons and wavefront offsets |
 
 pub mod area_split;
+pub mod cleanup;
+pub mod convexify;
 pub mod cut;
+pub mod envelope;
 pub mod extrude;
+pub mod footprint;
 pub mod inner_rect;
 pub mod material;
 pub mod measure;
 pub mod mesh;
+pub mod normals;
 pub mod obj;
 pub mod primitive;
 pub mod roof;
+pub mod roof_edges;
 pub mod setback;
 pub mod skeleton;
 pub mod topology;

@@ -7,14 +7,9 @@ use libfuzzer_sys::fuzz_target;
 use cga_engine::{generate_lot, lot, GenerateOptions, Limits};
 
 fuzz_target!(|data: &[u8]| {
-    let dir = std::env::temp_dir().join(format!("cga-fuzz-derive-{}", std::process::id()));
-    let _ = std::fs::create_dir_all(&dir);
-    let path = dir.join("rules.cga");
-    if std::fs::write(&path, data).is_err() {
-        return;
-    }
+    let text = String::from_utf8_lossy(data).into_owned();
     let mut sources = cga_syntax::SourceMap::new();
-    let loaded = cga_engine::load(&path, &mut sources);
+    let loaded = cga_engine::load_text(std::path::Path::new("fuzz.cga"), text, &mut sources);
     let Some(program) = loaded.program else { return };
     let Ok(rule) = program.start_rule(None) else { return };
     let assets = cga_engine::assets::Assets::new(&sources);

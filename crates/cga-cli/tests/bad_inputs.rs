@@ -118,7 +118,7 @@ fn bad_lot_files_are_usage_errors() {
     expect(
         &["generate", &ex, "--lot", &file("bad_vertex.obj")],
         2,
-        &["bad_vertex.obj:3: bad vertex line"],
+        &["bad_vertex.obj: line 3: expected three coordinates"],
     );
     expect(
         &["generate", &ex, "--lot", &file("no_faces.obj")],

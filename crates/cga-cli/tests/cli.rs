@@ -320,3 +320,38 @@ fn glb_gltf_and_obj_outputs_are_written() {
     assert_eq!(s.min, [0.0, 0.0, -30.0]);
     assert_eq!(s.max, [20.0, 10.0, 0.0]);
 }
+
+#[test]
+fn obj_lots_keep_their_texture_coordinates() {
+    // A 60 m street segment whose u runs along it from 0 to 1: the seed
+    // page's street bands (`split(u, unitSpace, 0)`) work on the lot itself.
+    let dir = temp_dir("street");
+    let street = dir.join("street.obj");
+    std::fs::write(
+        &street,
+        "v 0 0 0\nv 60 0 0\nv 60 0 -10\nv 0 0 -10\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n",
+    )
+    .unwrap();
+    let rules = rule_file(
+        &dir,
+        "s.cga",
+        "Street --> print(geometry.du(0, unitSpace)) split(u, unitSpace, 0) { ~10 : NIL | ~3 : Band | ~10 : NIL }*\n\
+         Band --> print(scope.sx) X.\n",
+    );
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--lot",
+        street.to_str().unwrap(),
+        "--start-rule",
+        "Street",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let lines: Vec<f64> = stdout(&out).lines().map(|l| l.parse().unwrap()).collect();
+    assert_eq!(lines.len(), 4, "{lines:?}");
+    assert!((lines[0] - 60.0).abs() < 1e-9);
+    // 3 repetitions of 69 m of pattern squeezed into 60 m: bands of 3 * 60/69.
+    for w in &lines[1..] {
+        assert!((w - 3.0 * 60.0 / 69.0).abs() < 1e-6, "{w}");
+    }
+}

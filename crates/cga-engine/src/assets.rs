@@ -50,8 +50,13 @@ impl Assets {
         find_relative(rule_file, path)
     }
 
-    /// The geometry of the asset file `path` (OBJ), loaded once.
+    /// The geometry of the asset `path`: a built-in (`builtin:cube`, ...)
+    /// or an OBJ file, loaded once.
     pub fn mesh(&self, from: FileId, path: &str) -> Result<Arc<Mesh>, String> {
+        if let Some(name) = path.strip_prefix("builtin:") {
+            return builtin_geometry(name)
+                .ok_or_else(|| format!("there is no built-in asset \"{path}\""));
+        }
         let file = self
             .resolve(from, path)
             .ok_or_else(|| format!("asset \"{path}\" not found"))?;
@@ -63,6 +68,27 @@ impl Assets {
         cache.insert(file, r.clone());
         r
     }
+}
+
+/// The built-in geometry assets as unit shapes, made once.
+fn builtin_geometry(name: &str) -> Option<Arc<Mesh>> {
+    use cga_geometry::primitive as p;
+    use cga_geometry::DVec3;
+    static BUILTINS: std::sync::LazyLock<Vec<(&str, Arc<Mesh>)>> = std::sync::LazyLock::new(|| {
+        vec![
+            ("cube", Arc::new(p::builtin_cube())),
+            ("quad", Arc::new(p::quad(1.0, 1.0))),
+            ("disk", Arc::new(p::disk(16, 1.0, 1.0))),
+            ("sphere", Arc::new(p::sphere(16, 16, DVec3::ONE))),
+            ("cylinder", Arc::new(p::cylinder(16, DVec3::ONE))),
+            ("cone", Arc::new(p::cone(16, DVec3::ONE))),
+        ]
+    });
+    let name = name.strip_suffix(".obj").unwrap_or(name);
+    BUILTINS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, m)| m.clone())
 }
 
 /// Loads an OBJ asset; its warnings (missing MTL, unknown materials) are

@@ -194,6 +194,11 @@ pub struct Interp<'a> {
     pub(crate) const_values: Vec<Option<Value>>,
     pub(crate) depth: usize,
     warned: HashSet<(u32, u32, u32)>,
+    /// Texture files found so far (see `ops::texturing`).
+    pub(crate) textures: ops::texturing::TextureFiles,
+    /// The rule file of the rule being applied: texture paths of the shapes
+    /// it emits are resolved from there.
+    pub(crate) current_file: cga_syntax::FileId,
 }
 
 impl<'a> Interp<'a> {
@@ -222,6 +227,8 @@ impl<'a> Interp<'a> {
             const_values: vec![None; program.functions.len()],
             depth: 0,
             warned: HashSet::new(),
+            textures: Default::default(),
+            current_file: cga_syntax::FileId(0),
         }
     }
 
@@ -275,11 +282,12 @@ impl<'a> Interp<'a> {
             frame.push(v);
         }
         let mut st = ShapeState::new(shape);
+        let caller_file = std::mem::replace(&mut self.current_file, def.span.file);
         let r = self.exec_body(&def.body, &frame, &mut st);
         self.depth -= 1;
-        r?;
-        self.finish(st);
-        Ok(())
+        let r = r.map(|()| self.finish(st));
+        self.current_file = caller_file;
+        r
     }
 
     /// A shape ends its operations: a leaf if it created nothing.
@@ -324,6 +332,9 @@ impl<'a> Interp<'a> {
                 *m = shape.material.apply(m);
             }
         }
+        // Texture paths as written become the files they name.
+        self.textures
+            .resolve_mesh(self.assets, self.current_file, &mut mesh);
         self.out.meshes.push(mesh);
     }
 

@@ -22,4 +22,4 @@ pub mod values;
 pub use derive::{InitialInfo, Interp, Limits, LotOutput, RtError};
 pub use generate::{generate_lot, GenerateOptions};
 pub use program::Program;
-pub use resolve::{load, Loaded};
+pub use resolve::{load, load_text, Loaded};

@@ -55,54 +55,28 @@ pub fn parse_rect(spec: &str) -> Result<Lot, String> {
     Ok(rect(parse(w)?, parse(d)?))
 }
 
-/// Each face of an OBJ file is one lot.
+/// Each face of an OBJ file is one lot, with its texture coordinates and
+/// normals (a street given with UVs can be split in uv space).
 pub fn from_obj(path: &std::path::Path) -> Result<Vec<Lot>, String> {
-    let text = std::fs::read_to_string(path)
+    let asset = cga_geometry::load_obj(path)
         .map_err(|e| format!("cannot read lot file {}: {e}", path.display()))?;
-    let mut positions: Vec<DVec3> = Vec::new();
-    let mut lots = Vec::new();
-    for (n, line) in text.lines().enumerate() {
-        let mut it = line.split_whitespace();
-        match it.next() {
-            Some("v") => {
-                let c: Vec<f64> = it.take(3).filter_map(|t| t.parse().ok()).collect();
-                if c.len() != 3 || c.iter().any(|x| !x.is_finite()) {
-                    return Err(format!("{}:{}: bad vertex line", path.display(), n + 1));
-                }
-                positions.push(DVec3::new(c[0], c[1], c[2]));
+    let mesh = asset.mesh;
+    let lots: Vec<Lot> = (0..mesh.faces.len())
+        .filter(|&f| mesh.outer_loop(f).len >= 3)
+        .enumerate()
+        .map(|(n, f)| {
+            let loops: Vec<Vec<usize>> = mesh
+                .face_loops(f)
+                .iter()
+                .map(|&l| mesh.loop_corners(l).collect())
+                .collect();
+            Lot {
+                name: format!("{} face {n}", path.display()),
+                mesh: face_mesh(&mesh, &loops, mesh.faces[f].material),
+                attrs: Vec::new(),
             }
-            Some("f") => {
-                let mut pts = Vec::new();
-                for t in it {
-                    let i: i64 = t
-                        .split('/')
-                        .next()
-                        .and_then(|s| s.parse().ok())
-                        .ok_or_else(|| format!("{}:{}: bad face index", path.display(), n + 1))?;
-                    let idx = if i < 0 {
-                        positions.len() as i64 + i
-                    } else {
-                        i - 1
-                    };
-                    let p = usize::try_from(idx)
-                        .ok()
-                        .and_then(|i| positions.get(i))
-                        .ok_or_else(|| {
-                            format!("{}:{}: face index {i} out of range", path.display(), n + 1)
-                        })?;
-                    pts.push(*p);
-                }
-                if pts.len() >= 3 {
-                    lots.push(Lot {
-                        name: format!("{} face {}", path.display(), lots.len()),
-                        mesh: Mesh::polygon(&pts),
-                        attrs: Vec::new(),
-                    });
-                }
-            }
-            _ => {}
-        }
-    }
+        })
+        .collect();
     if lots.is_empty() {
         return Err(format!("{} has no faces to use as lots", path.display()));
     }
@@ -131,32 +105,23 @@ pub fn degenerate(lot: &Lot) -> Option<String> {
 
 /// Removes repeated consecutive corners (GIS polygons often close their
 /// rings twice or repeat points), which would make zero-length edges.
+/// Texture coordinates and normals of the kept corners stay.
 pub fn remove_repeated_corners(mesh: &mut Mesh) {
     let tol = cga_geometry::topology::mesh_tolerance(mesh);
-    let mut out = Mesh::new();
-    out.materials = mesh.materials.clone();
-    out.positions = mesh.positions.clone();
+    let pos = |c: usize| mesh.positions[mesh.corners[c] as usize];
+    let mut out: Option<Mesh> = None;
     for f in 0..mesh.faces.len() {
-        let loops: Vec<Vec<u32>> = mesh
+        let loops: Vec<Vec<usize>> = mesh
             .face_loops(f)
             .iter()
             .map(|&l| {
-                let idx = mesh.loop_indices(l);
-                let mut kept: Vec<u32> = Vec::with_capacity(idx.len());
-                for &i in idx {
-                    let p = mesh.positions[i as usize];
-                    if kept
-                        .last()
-                        .is_none_or(|&k| mesh.positions[k as usize].distance(p) > tol)
-                    {
-                        kept.push(i);
+                let mut kept: Vec<usize> = Vec::with_capacity(l.len as usize);
+                for c in mesh.loop_corners(l) {
+                    if kept.last().is_none_or(|&k| pos(k).distance(pos(c)) > tol) {
+                        kept.push(c);
                     }
                 }
-                while kept.len() > 1
-                    && mesh.positions[kept[0] as usize]
-                        .distance(mesh.positions[*kept.last().unwrap() as usize])
-                        <= tol
-                {
+                while kept.len() > 1 && pos(kept[0]).distance(pos(*kept.last().unwrap())) <= tol {
                     kept.pop();
                 }
                 kept
@@ -166,10 +131,46 @@ pub fn remove_repeated_corners(mesh: &mut Mesh) {
         if loops.is_empty() {
             continue;
         }
-        let refs: Vec<&[u32]> = loops.iter().map(|l| l.as_slice()).collect();
-        out.add_face(&refs, mesh.faces[f].material);
+        let face = face_mesh(mesh, &loops, mesh.faces[f].material);
+        match &mut out {
+            Some(o) => cga_geometry::transform::merge(o, &face),
+            None => out = Some(face),
+        }
     }
+    let mut out = out.unwrap_or_default();
+    out.materials = mesh.materials.clone();
     *mesh = out;
+}
+
+/// A mesh of one face made of the given corners of `src` (outer loop, then
+/// holes), with their texture coordinates and normals.
+fn face_mesh(src: &Mesh, loops: &[Vec<usize>], material: u32) -> Mesh {
+    let mut m = Mesh::new();
+    m.materials = src.materials.clone();
+    let mut index_loops: Vec<Vec<u32>> = Vec::with_capacity(loops.len());
+    for l in loops {
+        let mut idx = Vec::with_capacity(l.len());
+        for &c in l {
+            idx.push(m.positions.len() as u32);
+            m.positions.push(src.positions[src.corners[c] as usize]);
+        }
+        index_loops.push(idx);
+    }
+    for (k, set) in src.uvs.iter().enumerate() {
+        if let Some(uv) = set {
+            m.uvs[k] = Some(loops.iter().flatten().map(|&c| uv[c]).collect());
+        }
+    }
+    if let Some(n) = &src.normals {
+        m.normals = Some(loops.iter().flatten().map(|&c| n[c]).collect());
+    }
+    // `add_face` keeps the attribute arrays, which already have one entry per corner.
+    let refs: Vec<&[u32]> = index_loops.iter().map(|l| l.as_slice()).collect();
+    m.add_face(
+        &refs,
+        material.min(src.materials.len().saturating_sub(1) as u32),
+    );
+    m
 }
 
 /// The initial shape of a lot, ready for derivation.

@@ -76,6 +76,8 @@ impl MatField {
         if let Some((head, tail)) = rest.split_once('.') {
             return match head {
                 "color" if tail == "rgb" => Some(MatField::ColorHex),
+                // An older name of the opacity, still used in the reference's examples.
+                "color" if tail == "a" => Some(MatField::Opacity),
                 "color" => rgb(tail).map(MatField::Color),
                 "ambient" => rgb(tail).map(MatField::Ambient),
                 "specular" => rgb(tail).map(MatField::Specular),

@@ -35,6 +35,21 @@ pub struct Loaded {
 
 /// Loads `path` and everything it imports into `sources`, parses and resolves.
 pub fn load(path: &Path, sources: &mut SourceMap) -> Loaded {
+    match std::fs::read_to_string(path) {
+        Ok(text) => load_text(path, text, sources),
+        Err(e) => Loaded {
+            program: None,
+            diagnostics: vec![plain_error(format!(
+                "cannot read rule file {}: {e}",
+                path.display()
+            ))],
+        },
+    }
+}
+
+/// Like [`load`] for rule text already in memory; `path` names it in
+/// diagnostics and is where its imports are searched from.
+pub fn load_text(path: &Path, text: String, sources: &mut SourceMap) -> Loaded {
     let mut r = Resolver {
         sources,
         program: Program::default(),
@@ -45,18 +60,6 @@ pub fn load(path: &Path, sources: &mut SourceMap) -> Loaded {
         stack: Vec::new(),
         pending: Vec::new(),
         symbols: HashMap::new(),
-    };
-    let text = match std::fs::read_to_string(path) {
-        Ok(t) => t,
-        Err(e) => {
-            return Loaded {
-                program: None,
-                diagnostics: vec![plain_error(format!(
-                    "cannot read rule file {}: {e}",
-                    path.display()
-                ))],
-            }
-        }
     };
     let main = r.parse_file(path, text);
     r.instantiate(main, String::new(), None);

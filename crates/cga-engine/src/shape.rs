@@ -156,12 +156,34 @@ pub struct CompInfo {
     pub total: f64,
 }
 
-/// A texture projection set up by `setupProjection` (for `projectUV`): maps
-/// object coordinates to (u, v).
+/// A texture projection set up by `setupProjection` (for `projectUV`), kept
+/// in object coordinates so that the shapes derived from the one that set it
+/// up (the tiles of a facade) get continuous texture coordinates.
+///
+/// A point `p` with coordinates `(a, b, c)` along the frame's u, v and w
+/// axes gets `u = (a - offset.x - uw * c) / size.x` and
+/// `v = (b - offset.y) / size.y` (see `ops::texturing`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Projection {
-    /// Object → projection space; u = x / width, v = y / height after the map.
-    pub to_uv: DAffine3,
+    /// Origin and axes (columns u, v, w = u × v) of the uvw system.
+    pub frame: Frame,
+    /// Texture tile width and height in scene units (negative: mirrored).
+    pub size: cga_geometry::DVec2,
+    /// Offsets along u and v in scene units.
+    pub offset: cga_geometry::DVec2,
+    /// How much the w coordinate adds to u (`uwFactor`).
+    pub uw: f64,
+}
+
+impl Projection {
+    /// The texture coordinates of a point given in object coordinates.
+    pub fn uv(&self, p: DVec3) -> cga_geometry::DVec2 {
+        let l = self.frame.to_local(p);
+        cga_geometry::DVec2::new(
+            (l.x - self.offset.x - self.uw * l.z) / self.size.x,
+            (l.y - self.offset.y) / self.size.y,
+        )
+    }
 }
 
 #[derive(Clone, Debug)]

@@ -71,6 +71,22 @@ Floor --> print("floor " + split.index + " " + scope.ty + " " + scope.elevation 
 }
 
 #[test]
+fn split_pieces_keep_the_facade_orientation() {
+    // Tiles and floors cut from a facade start their outline along the
+    // ground like the facade, so comp(f) on them gives x along the ground
+    // and y up (scope 5 x 3, not 3 x 5 or turned by 180 degrees).
+    let text = r#"Lot --> extrude(9) comp(f) { front : split(y) { 3 : split(x) { 5 : Tile }* }* }
+Tile --> comp(f) { 0 : print("tile " + scope.sx + " " + scope.sy + " " + scope.elevation) }
+"#;
+    let r = run("split_orientation", text).ok();
+    let tiles = r.numbers("tile");
+    assert_eq!(tiles.len(), 12);
+    for (i, t) in tiles.iter().enumerate() {
+        assert_close(&[t.clone()], &[&[5.0, 3.0, 3.0 * (i / 4) as f64]], 1e-9);
+    }
+}
+
+#[test]
 fn comp_attributes_per_selector() {
     // attr_comp.md: primitiveCube() comp(f) { front : Front | side : Side | all = All }.
     let text = r#"Lot --> s(2,2,2) primitiveCube() comp(f) { front : P | side : P | all = P }

@@ -7,8 +7,16 @@
 //! when every accessor's size is known.
 //!
 //! Binary layout: for each material in order of first appearance, positions,
-//! normals, texture coordinates (when present) and `u32` indices, each in its
-//! own buffer view; then the embedded images (GLB only). Everything is 4-byte
+//! normals, texture coordinates (when present: one array per distinct UV set
+//! its textures read), tangents (normal-mapped materials) and `u32` indices,
+//! each in its own buffer view; then the embedded images (GLB only).
+//!
+//! Textures: the colour map is the base colour texture (with the alpha when
+//! the opacity map is the same image), the normal, emissive and occlusion
+//! maps are glTF's, roughness and metallic maps its packed
+//! metallic-roughness texture; each reads its own UV set (set 0 where a mesh
+//! lacks it) and carries its `su sv tu tv rw` as `KHR_texture_transform`.
+//! The dirt, bump and specular maps have no glTF counterpart. Everything is 4-byte
 //! aligned because every component is 4 bytes.
 
 use std::collections::HashMap;
@@ -16,7 +24,9 @@ use std::fs::File;
 use std::io::{BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
 
-use cga_geometry::{DVec2, DVec3, Material, Mesh};
+use std::sync::Arc;
+
+use cga_geometry::{DVec3, Material, Mesh};
 use gltf_json as json;
 use json::validation::{Checked::Valid, USize64};
 
@@ -30,9 +40,19 @@ use crate::{ExportError, ExportStats, FaceData};
 struct Bucket {
     positions: Vec<f32>,
     normals: Vec<f32>,
-    /// TEXCOORD_0 (v flipped); `None` while no vertex had UVs. Vertices
-    /// from meshes without UVs get (0, 0) once the bucket has them.
-    uvs: Option<Vec<f32>>,
+    /// The UV sets written as `TEXCOORD` arrays, set 0 first when present,
+    /// and their coordinates (v flipped, two per vertex). A set a mesh lacks
+    /// reads set 0 instead, as CGA does for texture layers; vertices without
+    /// either get (0, 0). Set 0 is added when the first mesh with UVs comes
+    /// (earlier vertices get (0, 0)); a textured material has it from the
+    /// start, with one more set per other texture layer it uses.
+    sets: Vec<usize>,
+    coords: Vec<Vec<f32>>,
+    /// After [`Bucket::merge_equal_coords`]: the `TEXCOORD` index of each
+    /// set (sets with equal coordinates share one array).
+    tex_coords: Vec<u32>,
+    /// `TANGENT` (xyz, w) per vertex, for normal-mapped materials.
+    tangents: Option<Vec<f32>>,
     indices: Vec<u32>,
     min: [f32; 3],
     max: [f32; 3],
@@ -43,7 +63,31 @@ impl Bucket {
         self.normals.len() / 3
     }
 
-    fn push_vertex(&mut self, p: DVec3, n: DVec3, uv: Option<DVec2>) -> Result<u32, ExportError> {
+    /// Keeps one coordinate array per distinct content: a layer whose UV set
+    /// no mesh had reads set 0's array.
+    fn merge_equal_coords(&mut self) {
+        let mut distinct: Vec<Vec<f32>> = Vec::new();
+        self.tex_coords.clear();
+        for c in std::mem::take(&mut self.coords) {
+            match distinct.iter().position(|d| *d == c) {
+                Some(i) => self.tex_coords.push(i as u32),
+                None => {
+                    self.tex_coords.push(distinct.len() as u32);
+                    distinct.push(c);
+                }
+            }
+        }
+        self.coords = distinct;
+    }
+
+    fn push_vertex(
+        &mut self,
+        p: DVec3,
+        n: DVec3,
+        mesh: &Mesh,
+        corner: usize,
+        tangent: (DVec3, f64),
+    ) -> Result<u32, ExportError> {
         let index = u32::try_from(self.vertex_count()).map_err(|_| {
             ExportError::TooLarge("more than 2^32 vertices with one material".into())
         })?;
@@ -59,13 +103,92 @@ impl Bucket {
         }
         self.positions.extend_from_slice(&p);
         self.normals.extend_from_slice(&n.as_vec3().to_array());
-        if let Some(uvs) = &mut self.uvs {
+        for (&set, coords) in self.sets.iter().zip(&mut self.coords) {
+            let uv = mesh.uvs[set]
+                .as_deref()
+                .or(mesh.uvs[0].as_deref())
+                .and_then(|u| u.get(corner));
             // glTF puts v = 0 at the top of the image, CGA at the bottom.
             let (u, v) = uv.map_or((0.0, 0.0), |t| (t.x as f32, (1.0 - t.y) as f32));
-            uvs.extend_from_slice(&[u, v]);
+            coords.extend_from_slice(&[u, v]);
+        }
+        if let Some(tangents) = &mut self.tangents {
+            // Perpendicular to this vertex's normal, as glTF requires.
+            let (t, w) = tangent;
+            let t = (t - n * n.dot(t))
+                .try_normalize()
+                .unwrap_or_else(|| n.any_orthonormal_vector());
+            let t = t.as_vec3();
+            tangents.extend_from_slice(&[t.x, t.y, t.z, w as f32]);
         }
         Ok(index)
     }
+}
+
+/// The texture `path` names if it was found and glTF can use it (PNG or
+/// JPEG), else `None` with a warning.
+fn usable(textures: &mut Textures, warnings: &mut Vec<String>, path: &Arc<str>) -> Option<u32> {
+    textures.resolve(path, warnings).filter(|&t| {
+        let ok = textures.get(t).mime.is_some();
+        if !ok {
+            warnings.push(format!(
+                "texture '{path}' is neither PNG nor JPEG, which glTF requires; written without it"
+            ));
+        }
+        ok
+    })
+}
+
+/// The tangent (direction of growing u) and bitangent sign of a face for
+/// its normal map, whose coordinates are UV set 5 or else set 0. glTF's
+/// bitangent is `cross(normal, tangent) * w` and points along its own v,
+/// which runs opposite to CGA's.
+fn face_tangent(f: &FaceData) -> (DVec3, f64) {
+    let mesh = f.mesh;
+    let Some(uvs) = mesh.uvs[5].as_deref().or(mesh.uvs[0].as_deref()) else {
+        return (f.normal.any_orthonormal_vector(), 1.0);
+    };
+    for t in f.triangles {
+        let c = t.map(|c| c as usize);
+        let p = c.map(|c| mesh.positions[mesh.corners[c] as usize]);
+        let q = c.map(|c| uvs.get(c).copied().unwrap_or_default());
+        let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+        let (d1, d2) = (q[1] - q[0], q[2] - q[0]);
+        let det = d1.perp_dot(d2);
+        if det.abs() < 1e-300 {
+            continue;
+        }
+        let dpdu = (e1 * d2.y - e2 * d1.y) / det;
+        let dpdv = (e2 * d1.x - e1 * d2.x) / det;
+        if let Some(t) = dpdu.try_normalize() {
+            let w = if f.normal.cross(t).dot(-dpdv) < 0.0 {
+                -1.0
+            } else {
+                1.0
+            };
+            return (t, w);
+        }
+    }
+    (f.normal.any_orthonormal_vector(), 1.0)
+}
+
+/// Where a CGA texture layer goes in a glTF material.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Slot {
+    BaseColor,
+    Normal,
+    Emissive,
+    Occlusion,
+    MetallicRoughness,
+}
+
+/// A texture a material uses: its glTF slot, the texture, and the CGA
+/// texture layer it comes from (its transform, and its UV set).
+#[derive(Clone, Copy, Debug)]
+struct MapUse {
+    slot: Slot,
+    texture: u32,
+    channel: usize,
 }
 
 /// Identifies a vertex within one input mesh that carries its own normals,
@@ -87,8 +210,13 @@ pub(crate) struct GltfWriter {
     /// `.gltf`: file name of the `.bin` beside it.
     bin_name: String,
     buckets: Vec<Bucket>,
-    /// Colour map texture of each material id, if usable.
-    colormaps: Vec<Option<u32>>,
+    /// The textures of each material id.
+    maps: Vec<Vec<MapUse>>,
+    /// Whether each material takes its opacity from the colour map's alpha
+    /// (its opacity map is the colour map).
+    alpha_maps: Vec<bool>,
+    /// Whether some material uses `KHR_texture_transform`.
+    uses_transform: bool,
     /// Output vertex of each corner of the mesh being added.
     corner_vertex: Vec<u32>,
     dedup: FastMap<VertexKey, u32>,
@@ -111,7 +239,9 @@ impl GltfWriter {
             embed_images: binary && embed_images,
             bin_name: format!("{stem}.bin"),
             buckets: Vec::new(),
-            colormaps: Vec::new(),
+            maps: Vec::new(),
+            alpha_maps: Vec::new(),
+            uses_transform: false,
             corner_vertex: Vec::new(),
             dedup: FastMap::default(),
         })
@@ -136,23 +266,81 @@ impl GltfWriter {
         textures: &mut Textures,
         warnings: &mut Vec<String>,
     ) {
-        let path = &material.maps[0].path;
-        let colormap = textures.resolve(path, warnings).filter(|&t| {
-            let usable = textures.get(t).mime.is_some();
-            if !usable {
-                warnings.push(format!(
-                    "texture '{path}' is neither PNG nor JPEG, which glTF requires; written without it"
-                ));
+        let mut maps = Vec::new();
+        for (slot, channel) in [
+            (Slot::BaseColor, 0),
+            (Slot::Normal, 5),
+            (Slot::Emissive, 6),
+            (Slot::Occlusion, 7),
+        ] {
+            if let Some(texture) = usable(textures, warnings, &material.maps[channel].path) {
+                maps.push(MapUse {
+                    slot,
+                    texture,
+                    channel,
+                });
             }
-            usable
-        });
+        }
+        // glTF packs roughness (green) and metalness (blue) into one image.
+        // The same image for both layers is exactly that; a roughness map
+        // alone works too when the material is not metallic (the factor
+        // zeroes the blue channel). Other combinations cannot be written.
+        let (rough, metal) = (&material.maps[8].path, &material.maps[9].path);
+        let packed = match (rough.is_empty(), metal.is_empty()) {
+            (false, false) if rough == metal => Some(8),
+            (false, true) if material.metallic == 0.0 => Some(8),
+            (true, true) => None,
+            _ => {
+                warnings.push(format!(
+                    "roughness map '{rough}' and metallic map '{metal}' are not one image, as glTF requires; written without them"
+                ));
+                None
+            }
+        };
+        if let Some(texture) =
+            packed.and_then(|k| usable(textures, warnings, &material.maps[k].path))
+        {
+            maps.push(MapUse {
+                slot: Slot::MetallicRoughness,
+                texture,
+                channel: 8,
+            });
+        }
+        // glTF has no opacity map of its own: opacity is the base colour
+        // texture's alpha. An opacity map that is the colour map (what
+        // `texture()` sets for images with alpha) is exactly that.
+        let colormap = &material.maps[0].path;
+        let opacity_map = &material.maps[4].path;
+        let has_base = maps.iter().any(|m| m.slot == Slot::BaseColor);
+        let alpha = has_base && !opacity_map.is_empty() && opacity_map == colormap;
+        if !opacity_map.is_empty() && !alpha {
+            warnings.push(format!(
+                "opacity map '{opacity_map}' is not the colour map; glTF takes opacity from the colour map's alpha: written without it"
+            ));
+        }
         let mut bucket = Bucket::default();
-        if colormap.is_some() {
-            // A textured material needs TEXCOORD_0 on every vertex.
-            bucket.uvs = Some(Vec::new());
+        if !maps.is_empty() {
+            // Textured: every vertex needs coordinates, set 0 first.
+            bucket.sets.push(0);
+            for m in &maps {
+                if !bucket.sets.contains(&m.channel) {
+                    bucket.sets.push(m.channel);
+                }
+            }
+            bucket.coords = vec![Vec::new(); bucket.sets.len()];
+        }
+        if maps.iter().any(|m| m.slot == Slot::Normal) {
+            bucket.tangents = Some(Vec::new());
+        }
+        if maps
+            .iter()
+            .any(|m| texture_transform(&material.maps[m.channel]).is_some())
+        {
+            self.uses_transform = true;
         }
         self.buckets.push(bucket);
-        self.colormaps.push(colormap);
+        self.maps.push(maps);
+        self.alpha_maps.push(alpha);
     }
 
     pub(crate) fn begin_mesh(&mut self, mesh: &Mesh) {
@@ -165,19 +353,25 @@ impl GltfWriter {
         let mesh = f.mesh;
         let bucket = &mut self.buckets[f.material as usize];
         let uvs = mesh.uvs[0].as_deref();
-        if uvs.is_some() && bucket.uvs.is_none() {
-            bucket.uvs = Some(vec![0.0; bucket.vertex_count() * 2]);
+        if uvs.is_some() && bucket.sets.is_empty() {
+            bucket.sets.push(0);
+            bucket.coords.push(vec![0.0; bucket.vertex_count() * 2]);
         }
+        // Vertices are shared only where one UV set is written (the key
+        // holds set 0's coordinates) and no tangents (which are per face).
+        let shared = bucket.sets.len() <= 1 && bucket.tangents.is_none();
+        let tangent = match bucket.tangents {
+            Some(_) => face_tangent(f),
+            None => (DVec3::X, 1.0),
+        };
         for &l in mesh.face_loops(f.face) {
             for c in mesh.loop_corners(l) {
                 let position = mesh.corners[c];
                 let p = mesh.positions[position as usize];
-                let uv = uvs.map(|u| u[c]);
                 let vertex = match &mesh.normals {
-                    // Flat shading: each face has its own vertices.
-                    None => bucket.push_vertex(p, f.normal, uv)?,
-                    Some(normals) => {
+                    Some(normals) if shared => {
                         let n = normals[c].try_normalize().unwrap_or(f.normal);
+                        let uv = uvs.map(|u| u[c]);
                         let key = VertexKey {
                             material: f.material,
                             position,
@@ -187,12 +381,18 @@ impl GltfWriter {
                         match self.dedup.get(&key) {
                             Some(&v) => v,
                             None => {
-                                let v = bucket.push_vertex(p, n, uv)?;
+                                let v = bucket.push_vertex(p, n, mesh, c, tangent)?;
                                 self.dedup.insert(key, v);
                                 v
                             }
                         }
                     }
+                    Some(normals) => {
+                        let n = normals[c].try_normalize().unwrap_or(f.normal);
+                        bucket.push_vertex(p, n, mesh, c, tangent)?
+                    }
+                    // Flat shading: each face has its own vertices.
+                    None => bucket.push_vertex(p, f.normal, mesh, c, tangent)?,
                 };
                 self.corner_vertex[c] = vertex;
             }
@@ -223,6 +423,9 @@ impl GltfWriter {
         let mut images: Vec<u32> = Vec::new();
         let mut nodes = Vec::new();
 
+        for b in &mut self.buckets {
+            b.merge_equal_coords();
+        }
         for (id, bucket) in self.buckets.iter().enumerate() {
             if bucket.indices.is_empty() {
                 continue;
@@ -252,16 +455,27 @@ impl GltfWriter {
                 Some(json::buffer::Target::ArrayBuffer),
             );
             attributes.insert(Valid(json::mesh::Semantic::Normals), normals);
-            if let Some(uvs) = &bucket.uvs {
+            for (n, coords) in bucket.coords.iter().enumerate() {
                 let tex = layout.accessor(
                     &mut root,
-                    uvs.len(),
+                    coords.len(),
                     count,
                     json::accessor::Type::Vec2,
                     json::accessor::ComponentType::F32,
                     Some(json::buffer::Target::ArrayBuffer),
                 );
-                attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), tex);
+                attributes.insert(Valid(json::mesh::Semantic::TexCoords(n as u32)), tex);
+            }
+            if let Some(tangents) = &bucket.tangents {
+                let acc = layout.accessor(
+                    &mut root,
+                    tangents.len(),
+                    count,
+                    json::accessor::Type::Vec4,
+                    json::accessor::ComponentType::F32,
+                    Some(json::buffer::Target::ArrayBuffer),
+                );
+                attributes.insert(Valid(json::mesh::Semantic::Tangents), acc);
             }
             let indices = layout.accessor(
                 &mut root,
@@ -272,22 +486,38 @@ impl GltfWriter {
                 Some(json::buffer::Target::ElementArrayBuffer),
             );
 
-            let base_color_texture = self.colormaps[id as usize].map(|t| {
-                let index = *gltf_textures.entry(t).or_insert_with(|| {
-                    images.push(t);
-                    add_texture(&mut root, textures, t, self.embed_images)
+            let material = table.get(id);
+            let mut infos: Vec<(Slot, json::texture::Info)> = Vec::new();
+            for m in &self.maps[id as usize] {
+                let index = *gltf_textures.entry(m.texture).or_insert_with(|| {
+                    images.push(m.texture);
+                    add_texture(&mut root, textures, m.texture, self.embed_images)
                 });
-                json::texture::Info {
-                    index,
-                    tex_coord: 0,
-                    extensions: None,
-                    extras: Default::default(),
-                }
-            });
+                let set = if m.slot == Slot::BaseColor {
+                    0
+                } else {
+                    m.channel
+                };
+                let k = bucket.sets.iter().position(|&s| s == set).unwrap_or(0);
+                infos.push((
+                    m.slot,
+                    json::texture::Info {
+                        index,
+                        tex_coord: bucket.tex_coords.get(k).copied().unwrap_or(0),
+                        extensions: texture_transform(&material.maps[m.channel]).map(|t| {
+                            let mut others = serde_json::Map::new();
+                            others.insert("KHR_texture_transform".into(), t);
+                            json::extensions::texture::Info { others }
+                        }),
+                        extras: Default::default(),
+                    },
+                ));
+            }
             let material = root.push(gltf_material(
-                table.get(id),
+                material,
                 name.clone(),
-                base_color_texture,
+                infos,
+                self.alpha_maps[id as usize],
             ));
             let mesh = root.push(json::Mesh {
                 extensions: None,
@@ -321,6 +551,10 @@ impl GltfWriter {
             }
         }
 
+        if self.uses_transform && !images.is_empty() {
+            root.extensions_used
+                .push("KHR_texture_transform".to_string());
+        }
         if !nodes.is_empty() {
             let scene = root.push(json::Scene {
                 extensions: None,
@@ -511,11 +745,42 @@ fn add_texture(
     })
 }
 
-/// The glTF material for a CGA material.
+/// The `KHR_texture_transform` of a texture channel's `su sv tu tv rw`, or
+/// `None` for the identity.
+///
+/// CGA's channel transform maps texture coordinates as
+/// `uv' = R(rw) * (su u, sv v) + (tu, tv)`, `rw` in degrees counter-clockwise
+/// (the order glTF's extension uses too). glTF's coordinates are CGA's with
+/// v flipped (`v_gltf = 1 - v`), which turns that map into: the same scale,
+/// the rotation `rw` (the extension rotates clockwise in CGA's terms), and
+/// the offset `(tu - sv sin rw, 1 - tv - sv cos rw)`.
+fn texture_transform(ch: &cga_geometry::TextureChannel) -> Option<serde_json::Value> {
+    let identity = ch.su == 1.0 && ch.sv == 1.0 && ch.tu == 0.0 && ch.tv == 0.0 && ch.rw == 0.0;
+    let finite = [ch.su, ch.sv, ch.tu, ch.tv, ch.rw]
+        .iter()
+        .all(|x| x.is_finite());
+    if identity || !finite {
+        return None;
+    }
+    let (s, c) = ch.rw.to_radians().sin_cos();
+    let offset = [ch.tu - ch.sv * s, 1.0 - ch.tv - ch.sv * c];
+    Some(serde_json::json!({
+        "offset": offset.map(|x| x as f32),
+        "rotation": ch.rw.to_radians() as f32,
+        "scale": [ch.su as f32, ch.sv as f32],
+    }))
+}
+
+/// The glTF material for a CGA material with its textures. `alpha_map`:
+/// the opacity comes from the colour map's alpha, blended, masked or
+/// ignored as `material.opacitymap.mode` says. As in CityEngine, a texture
+/// replaces the scalar it maps (emissive colour, metalness and roughness
+/// become factors of 1), except the colour map, which multiplies the colour.
 fn gltf_material(
     m: &Material,
     name: String,
-    base_color_texture: Option<json::texture::Info>,
+    textures: Vec<(Slot, json::texture::Info)>,
+    alpha_map: bool,
 ) -> json::Material {
     let linear = m.color.map(|c| srgb_to_linear(c) as f32);
     let opacity = m.opacity.clamp(0.0, 1.0) as f32;
@@ -526,27 +791,79 @@ fn gltf_material(
             0.0
         }
     };
-    let emissive = m.emissive.map(|c| srgb_to_linear(c) as f32);
-    json::Material {
-        alpha_mode: Valid(if opacity < 1.0 {
-            json::material::AlphaMode::Blend
-        } else {
-            json::material::AlphaMode::Opaque
-        }),
+    let mut emissive = m.emissive.map(|c| srgb_to_linear(c) as f32);
+    let (mut metallic, mut roughness) = (unit(m.metallic), unit(m.roughness));
+    let (alpha_mode, alpha_cutoff) = match (alpha_map, &*m.opacitymap_mode) {
+        (true, "mask") => (
+            json::material::AlphaMode::Mask,
+            Some(json::material::AlphaCutoff(unit(m.opacitymap_cutoff))),
+        ),
+        (true, "opaque") if opacity >= 1.0 => (json::material::AlphaMode::Opaque, None),
+        (true, _) => (json::material::AlphaMode::Blend, None),
+        (false, _) if opacity < 1.0 => (json::material::AlphaMode::Blend, None),
+        _ => (json::material::AlphaMode::Opaque, None),
+    };
+    let mut out = json::Material {
+        alpha_mode: Valid(alpha_mode),
+        alpha_cutoff,
         double_sided: m.double_sided,
         name: Some(name),
-        pbr_metallic_roughness: json::material::PbrMetallicRoughness {
-            base_color_factor: json::material::PbrBaseColorFactor([
-                linear[0], linear[1], linear[2], opacity,
-            ]),
-            base_color_texture,
-            metallic_factor: json::material::StrengthFactor(unit(m.metallic)),
-            roughness_factor: json::material::StrengthFactor(unit(m.roughness)),
-            ..Default::default()
-        },
-        emissive_factor: json::material::EmissiveFactor(emissive),
         ..Default::default()
+    };
+    let mut base_color_texture = None;
+    let mut metallic_roughness_texture = None;
+    for (slot, info) in textures {
+        match slot {
+            Slot::BaseColor => base_color_texture = Some(info),
+            Slot::MetallicRoughness => {
+                metallic_roughness_texture = Some(info);
+                // A roughness map alone is only written for non-metals,
+                // whose factor 0 keeps the image's blue channel out.
+                if !m.maps[9].path.is_empty() {
+                    metallic = 1.0;
+                }
+                roughness = 1.0;
+            }
+            Slot::Emissive => {
+                emissive = [1.0; 3];
+                out.emissive_texture = Some(info);
+            }
+            Slot::Normal => {
+                out.normal_texture = Some(json::material::NormalTexture {
+                    index: info.index,
+                    scale: 1.0,
+                    tex_coord: info.tex_coord,
+                    extensions: info
+                        .extensions
+                        .map(|e| json::extensions::material::NormalTexture { others: e.others }),
+                    extras: Default::default(),
+                })
+            }
+            Slot::Occlusion => {
+                out.occlusion_texture = Some(json::material::OcclusionTexture {
+                    index: info.index,
+                    strength: json::material::StrengthFactor(1.0),
+                    tex_coord: info.tex_coord,
+                    extensions: info
+                        .extensions
+                        .map(|e| json::extensions::material::OcclusionTexture { others: e.others }),
+                    extras: Default::default(),
+                })
+            }
+        }
     }
+    out.pbr_metallic_roughness = json::material::PbrMetallicRoughness {
+        base_color_factor: json::material::PbrBaseColorFactor([
+            linear[0], linear[1], linear[2], opacity,
+        ]),
+        base_color_texture,
+        metallic_factor: json::material::StrengthFactor(metallic),
+        roughness_factor: json::material::StrengthFactor(roughness),
+        metallic_roughness_texture,
+        ..Default::default()
+    };
+    out.emissive_factor = json::material::EmissiveFactor(emissive);
+    out
 }
 
 /// Writes the binary buffer in [`Layout`] order: per non-empty bucket its
@@ -563,13 +880,22 @@ fn write_bin(
     for b in buckets.iter().filter(|b| !b.indices.is_empty()) {
         write_f32s(w, &b.positions, &mut scratch).map_err(io)?;
         write_f32s(w, &b.normals, &mut scratch).map_err(io)?;
-        if let Some(uvs) = &b.uvs {
-            write_f32s(w, uvs, &mut scratch).map_err(io)?;
+        for coords in &b.coords {
+            write_f32s(w, coords, &mut scratch).map_err(io)?;
+        }
+        if let Some(tangents) = &b.tangents {
+            write_f32s(w, tangents, &mut scratch).map_err(io)?;
         }
         write_u32s(w, &b.indices, &mut scratch).map_err(io)?;
     }
     for &t in images {
         let tex = textures.get(t);
+        if let Some(data) = &tex.data {
+            w.write_all(data).map_err(io)?;
+            let pad = (tex.len.next_multiple_of(4) - tex.len) as usize;
+            w.write_all(&[0u8; 3][..pad]).map_err(io)?;
+            continue;
+        }
         let file = File::open(&tex.source).map_err(|e| ExportError::io(&tex.source, e))?;
         let copied = std::io::copy(&mut file.take(tex.len), w).map_err(io)?;
         if copied != tex.len {

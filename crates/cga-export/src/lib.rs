@@ -26,6 +26,7 @@
 //! # Ok::<(), cga_export::ExportError>(())
 //! ```
 
+pub mod builtin;
 mod faces;
 mod gltf;
 mod hash;

@@ -6,6 +6,10 @@
 //! leading `/`, CityEngine's workspace-absolute form, is dropped for that).
 //! A texture that cannot be found is a warning, never an error: the model is
 //! still worth having without it.
+//!
+//! `builtin:` names are CGA's built-in textures ([`crate::builtin`]): they
+//! are generated in memory, embedded in GLB files and otherwise always
+//! written next to the output (there is no file to refer to).
 
 use std::collections::{HashMap, HashSet};
 use std::fs::File;
@@ -27,6 +31,8 @@ pub(crate) struct Texture {
     /// File name next to the output when textures are copied there; unique
     /// among the textures and output files of the model.
     pub out_name: String,
+    /// The image itself, for built-in textures (which are no files).
+    pub data: Option<Arc<[u8]>>,
 }
 
 pub(crate) struct Textures {
@@ -67,6 +73,16 @@ impl Textures {
         }
         if let Some(&known) = self.by_rule_path.get(rule_path) {
             return known;
+        }
+        if rule_path.starts_with(crate::builtin::PREFIX) {
+            let found = self.add_builtin(rule_path);
+            if found.is_none() {
+                warnings.push(format!(
+                    "'{rule_path}' is not a built-in texture (builtin:default, builtin:uvtest.png); written without it"
+                ));
+            }
+            self.by_rule_path.insert(rule_path.clone(), found);
+            return found;
         }
         let found = self.locate(rule_path).and_then(|p| self.add(&p).ok());
         if found.is_none() {
@@ -123,9 +139,29 @@ impl Textures {
             len,
             mime,
             out_name,
+            data: None,
         });
         self.by_source.insert(source, i);
         Ok(i)
+    }
+
+    fn add_builtin(&mut self, name: &str) -> Option<u32> {
+        let t = crate::builtin::builtin_texture(name)?;
+        let source = PathBuf::from(name);
+        if let Some(&i) = self.by_source.get(&source) {
+            return Some(i);
+        }
+        let out_name = self.unique_name(Path::new(t.file_name));
+        let i = self.list.len() as u32;
+        self.list.push(Texture {
+            source: source.clone(),
+            len: t.png.len() as u64,
+            mime: Some("image/png"),
+            out_name,
+            data: Some(t.png),
+        });
+        self.by_source.insert(source, i);
+        Some(i)
     }
 
     /// `wall.jpg`, or `wall_2.jpg` when another texture already took that
@@ -157,7 +193,7 @@ impl Textures {
     /// copied file name, or the path from the output's folder to the source.
     pub(crate) fn reference(&self, i: u32) -> String {
         let t = self.get(i);
-        if self.copy {
+        if self.copy || t.data.is_some() {
             return t.out_name.clone();
         }
         let out_dir = self
@@ -170,13 +206,18 @@ impl Textures {
         }
     }
 
-    /// Copies the given textures next to the output, when copying.
+    /// Copies the given textures next to the output, when copying, and
+    /// writes the built-in ones there in any case.
     pub(crate) fn copy_all(&self, which: impl IntoIterator<Item = u32>) -> Result<(), ExportError> {
-        if !self.copy {
-            return Ok(());
-        }
         for t in which.into_iter().map(|i| self.get(i)) {
             let dest = self.out_dir.join(&t.out_name);
+            if let Some(data) = &t.data {
+                std::fs::write(&dest, data).map_err(|e| ExportError::io(&dest, e))?;
+                continue;
+            }
+            if !self.copy {
+                continue;
+            }
             let same = dest.canonicalize().is_ok_and(|d| d == t.source);
             if !same {
                 std::fs::copy(&t.source, &dest).map_err(|e| ExportError::io(&dest, e))?;

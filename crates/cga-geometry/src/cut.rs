@@ -46,12 +46,28 @@
 //! edge they lie on: every corner of a piece is stored as an original edge
 //! `(a, b)` and a parameter `t`, which stays exact through successive cuts of
 //! [`split_along_axis`].
+//!
+//! # Speed
+//!
+//! Typical calls are small (a building mass into floors, a facade into
+//! tiles) and frequent, so the cut allocates nothing but its output: all
+//! working arrays live in a per-thread `Bufs` reused from call to call
+//! (freed when a huge input made them grow past a bound), pieces are ranges
+//! of flat arrays, pieces above a plane wait on an explicit stack instead of
+//! a recursion, crossing vertices are found in an open-addressing table
+//! cleared in constant time, and cap edges are matched by sorting instead of
+//! hashing. The common split (a polygon without holes crossing the plane at
+//! two edges, no vertex on it: every convex face) takes a direct path,
+//! `Cutter::split_simple`, that gives exactly the general path's result;
+//! the tests compare both. `benches/cut.rs` measures the typical calls.
+
+use std::cell::RefCell;
 
 use glam::{DVec2, DVec3};
 
 use crate::measure::face_normal;
 use crate::mesh::{Face, Loop, Mesh};
-use crate::topology::{fx_map, mesh_tolerance, weld_points, FxHashMap};
+use crate::topology::{mesh_tolerance, weld_points_into};
 use crate::triangulate::plane_basis;
 
 /// Cuts `mesh` with the plane `normal · p = offset` into the part below
@@ -94,26 +110,45 @@ pub fn split_along_axis(mesh: &Mesh, axis: usize, cuts: &[f64]) -> Vec<Mesh> {
 /// unit length, `offsets` ascending) into `offsets.len() + 1` parts, as
 /// [`split_along_axis`] does for a general direction.
 pub fn split_by_parallel_planes(mesh: &Mesh, normal: DVec3, offsets: &[f64]) -> Vec<Mesh> {
-    // Sanitise the offsets: ascending, finite (NaN sorts as "no cut": it is
-    // replaced by its predecessor, or -inf for the first).
-    let mut planes = Vec::with_capacity(offsets.len());
-    let mut prev = f64::NEG_INFINITY;
-    for &o in offsets {
-        let o = if o.is_nan() { prev } else { o.max(prev) };
-        planes.push(o);
-        prev = o;
-    }
-    let mut cutter = Cutter::new(mesh, normal, planes);
-    cutter.run();
-    cutter.build()
+    // The working buffers of the cut are kept per thread and reused: a
+    // split of a box into floors is a few microseconds of arithmetic, and
+    // allocating its dozens of small buffers anew each time cost several
+    // times that. `try_with` fails only while the thread shuts down, and
+    // `try_borrow_mut` never fails (nothing here calls back into a cut);
+    // both fall back to fresh buffers rather than panic.
+    let run = |bufs: &mut Bufs| {
+        let mut cutter = Cutter::new(mesh, normal, offsets, bufs);
+        cutter.run();
+        let out = cutter.build();
+        bufs.trim();
+        out
+    };
+    SCRATCH
+        .try_with(|cell| match cell.try_borrow_mut() {
+            Ok(mut bufs) => run(&mut bufs),
+            Err(_) => run(&mut Bufs::default()),
+        })
+        .unwrap_or_else(|_| run(&mut Bufs::default()))
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Bufs> = RefCell::new(Bufs::default());
 }
 
 /// An empty mesh with the same material slots and groups as `mesh`.
 fn empty_like(mesh: &Mesh) -> Mesh {
-    let mut m = Mesh::new();
-    m.materials = mesh.materials.clone();
-    m.groups = mesh.groups.clone();
-    m
+    // Not `Mesh::new()`: its default material would be built only to be
+    // replaced.
+    Mesh {
+        positions: Vec::new(),
+        corners: Vec::new(),
+        loops: Vec::new(),
+        faces: Vec::new(),
+        uvs: Default::default(),
+        normals: None,
+        materials: mesh.materials.clone(),
+        groups: mesh.groups.clone(),
+    }
 }
 
 /// A corner of a piece: a vertex (welded id, or a new crossing vertex) and
@@ -159,13 +194,74 @@ impl Poly {
         self.corners.clear();
         self.loops.clear();
     }
-    fn push_loop(&mut self, l: &[WCorner]) {
-        self.loops.push((self.corners.len() as u32, l.len() as u32));
-        self.corners.extend_from_slice(l);
-    }
     fn loop_slice(&self, k: usize) -> &[WCorner] {
         let (s, n) = self.loops[k];
         &self.corners[s as usize..(s + n) as usize]
+    }
+}
+
+/// Polygons waiting to be routed from plane `k` on, last in first out:
+/// `polys` holds `(first loop, loop count, k)` into `loops`, whose corner
+/// ranges index `corners`. The top polygon's loops and corners are always
+/// at the ends of the arrays, so popping it truncates them.
+#[derive(Default)]
+struct PolyStack {
+    corners: Vec<WCorner>,
+    loops: Vec<(u32, u32)>,
+    polys: Vec<(u32, u32, u32)>,
+}
+
+/// The pieces of one split: loops in `corners`, each on a side (0 below,
+/// 1 above) and owned by a piece (or, for a hole not yet placed, none).
+#[derive(Default)]
+struct Pieces {
+    corners: Vec<WCorner>,
+    loops: Vec<PieceLoop>,
+    /// Per piece: its side and its outer loop (index into `loops`).
+    pieces: Vec<(u8, u32)>,
+}
+
+#[derive(Clone, Copy)]
+struct PieceLoop {
+    start: u32,
+    len: u32,
+    side: u8,
+    owner: u32,
+}
+
+impl Pieces {
+    fn clear(&mut self) {
+        self.corners.clear();
+        self.loops.clear();
+        self.pieces.clear();
+    }
+    fn corners_of(&self, l: usize) -> &[WCorner] {
+        let pl = self.loops[l];
+        &self.corners[pl.start as usize..(pl.start + pl.len) as usize]
+    }
+    /// A loop appended to `corners` from `start` on, not yet owned.
+    fn add_loop(&mut self, start: usize, side: usize) -> usize {
+        self.loops.push(PieceLoop {
+            start: start as u32,
+            len: (self.corners.len() - start) as u32,
+            side: side as u8,
+            owner: NONE,
+        });
+        self.loops.len() - 1
+    }
+    /// Makes loop `l` the outer loop of a new piece.
+    fn add_piece(&mut self, l: usize) {
+        let p = self.pieces.len() as u32;
+        self.loops[l].owner = p;
+        self.pieces.push((self.loops[l].side, l as u32));
+    }
+    /// The loops of piece `p`: its outer loop, then its holes in the order
+    /// they were given to it.
+    fn piece_loops(&self, p: usize) -> impl Iterator<Item = usize> + '_ {
+        let outer = self.pieces[p].1 as usize;
+        std::iter::once(outer).chain(
+            (0..self.loops.len()).filter(move |&l| l != outer && self.loops[l].owner == p as u32),
+        )
     }
 }
 
@@ -188,31 +284,162 @@ enum Side {
     Both,
 }
 
-struct Cutter<'m> {
-    mesh: &'m Mesh,
-    n: DVec3,
-    /// For axis-aligned cuts, the axis (crossing vertices get that coordinate
-    /// set exactly to the plane's, so caps are exactly planar).
-    axis: Option<usize>,
+/// How [`Cutter::split_simple`] came out.
+enum Simple {
+    NotApplicable,
+    /// The piece below is stored; the piece above, if it has area
+    /// (`above`), is in `cur`.
+    Done {
+        above: bool,
+    },
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Set by tests to run the general path only, to compare with it.
+    static GENERAL_PATH_ONLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    /// Number of splits done by [`Cutter::split_simple`], for tests.
+    static SIMPLE_SPLITS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
+#[cfg(test)]
+fn count_simple_split() {
+    SIMPLE_SPLITS.with(|c| c.set(c.get() + 1));
+}
+
+#[cfg(not(test))]
+#[inline(always)]
+fn count_simple_split() {}
+
+#[cfg(test)]
+fn fast_paths_enabled() -> bool {
+    !GENERAL_PATH_ONLY.with(|g| g.get())
+}
+
+#[cfg(not(test))]
+#[inline(always)]
+fn fast_paths_enabled() -> bool {
+    true
+}
+
+/// How a split came out.
+enum Split {
+    /// The pieces are in `Bufs::pieces`.
+    Pieces,
+    /// The polygon could not be split consistently and stays whole on one
+    /// side (`true`: above).
+    Whole(bool),
+}
+
+/// Crossing vertices by (welded edge, plane): a hash table with open
+/// addressing in reused memory. Cleared in constant time by stamping slots
+/// with a generation: a slot of another generation is empty. (A general
+/// hash map costs several times as much per lookup here, where a box split
+/// into floors does little else than look up its crossings.)
+#[derive(Default)]
+struct CrossingTable {
+    /// (edge key, plane, vertex, generation); the length is 0 or a power
+    /// of two.
+    slots: Vec<(u64, u32, u32, u32)>,
+    generation: u32,
+    len: usize,
+}
+
+impl CrossingTable {
+    fn clear(&mut self) {
+        self.len = 0;
+        self.generation = self.generation.wrapping_add(1);
+        if self.generation == 0 {
+            // Wrapped around: stamps of old generations could look current.
+            for s in &mut self.slots {
+                s.3 = 0;
+            }
+            self.generation = 1;
+        }
+    }
+
+    #[inline]
+    fn home(&self, key: u64, plane: u32) -> usize {
+        let h = (key ^ (plane as u64).rotate_right(16)).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+        (h >> 32) as usize & (self.slots.len() - 1)
+    }
+
+    /// The vertex stored for (`key`, `plane`), or the slot to insert it at
+    /// (valid until the next insertion).
+    fn find(&mut self, key: u64, plane: u32) -> Result<u32, usize> {
+        if 2 * (self.len + 1) > self.slots.len() {
+            self.grow();
+        }
+        let mask = self.slots.len() - 1;
+        let mut i = self.home(key, plane);
+        loop {
+            let s = self.slots[i];
+            if s.3 != self.generation {
+                return Err(i);
+            }
+            if s.0 == key && s.1 == plane {
+                return Ok(s.2);
+            }
+            i = (i + 1) & mask;
+        }
+    }
+
+    fn insert_at(&mut self, slot: usize, key: u64, plane: u32, v: u32) {
+        self.slots[slot] = (key, plane, v, self.generation);
+        self.len += 1;
+    }
+
+    fn grow(&mut self) {
+        let old = std::mem::take(&mut self.slots);
+        let generation = self.generation;
+        self.slots = vec![(0, 0, 0, 0); (old.len() * 2).max(64)];
+        self.generation = 1;
+        self.len = 0;
+        for s in old {
+            if s.3 == generation {
+                if let Err(i) = self.find(s.0, s.1) {
+                    self.insert_at(i, s.0, s.1, s.2);
+                }
+            }
+        }
+    }
+}
+
+/// Every buffer a cut needs, kept between calls (see
+/// [`split_by_parallel_planes`]). Each call clears what it uses; nothing
+/// carries meaning from one call to the next.
+#[derive(Default)]
+struct Bufs {
     planes: Vec<f64>,
-    tol: f64,
     /// Welded vertex id of each original position.
     vid: Vec<u32>,
+    /// Original position of each welded vertex.
+    rep: Vec<u32>,
     /// Vertex pool: welded positions, then crossing vertices.
     verts: Vec<DVec3>,
     /// Crossing vertices by (welded edge ends, plane).
-    crossings: FxHashMap<(u32, u32, u32), u32>,
-    /// Routed faces per part.
-    parts: Vec<Vec<Item>>,
+    crossings: CrossingTable,
+    /// Routed faces with their part, in routing order.
+    items: Vec<(u32, Item)>,
+    /// `items` sorted by part (stably): part `p` is
+    /// `part_items[part_start[p]..part_start[p + 1]]`.
+    part_items: Vec<Item>,
+    part_start: Vec<u32>,
     store_corners: Vec<WCorner>,
     store_loops: Vec<(u32, u32)>,
-    pieces: Vec<PieceRec>,
-    /// Reused buffers.
-    scratch: Scratch,
+    pieces_rec: Vec<PieceRec>,
+    /// The polygon being routed.
+    cur: Poly,
+    stack: PolyStack,
+    /// The result of the last split.
+    pieces: Pieces,
+    split: SplitBufs,
+    caps: CapBufs,
+    build: BuildBufs,
 }
 
 #[derive(Default)]
-struct Scratch {
+struct SplitBufs {
     xs: Vec<Crossing>,
     order: Vec<u32>,
     partner: Vec<u32>,
@@ -222,44 +449,162 @@ struct Scratch {
     online: Vec<(f64, WCorner)>,
     /// Per vertex id: position in the loop being split, or NONE.
     slot: Vec<u32>,
+    cleaned: Vec<WCorner>,
+    pinch: Vec<WCorner>,
 }
 
-impl<'m> Cutter<'m> {
-    fn new(mesh: &'m Mesh, n: DVec3, planes: Vec<f64>) -> Cutter<'m> {
+#[derive(Default)]
+struct CapBufs {
+    /// On-plane directed edges: (undirected key, first-seen rank, +1 if
+    /// stored from the lower id, face).
+    seen: Vec<(u64, u32, i32, u32)>,
+    /// Net count per undirected edge: (first-seen rank, key, count, face).
+    net: Vec<(u32, u64, i32, u32)>,
+    /// Unmatched directed edges (start, end, face).
+    edges: Vec<(u32, u32, u32)>,
+    by_start: Vec<u32>,
+    used: Vec<bool>,
+    /// Closed loops: vertex ids in `loop_verts`, (start, len, face, area).
+    loop_verts: Vec<u32>,
+    loops: Vec<(u32, u32, u32, f64)>,
+    /// Per loop: the cap it is the outer loop of or a hole in, or NONE.
+    owner: Vec<u32>,
+    /// Caps: (outer loop, face, area).
+    caps: Vec<(u32, u32, f64)>,
+}
+
+#[derive(Default)]
+struct BuildBufs {
+    remap: Vec<u32>,
+    touched: Vec<u32>,
+    corners: Vec<u32>,
+    loops: Vec<Loop>,
+    faces: Vec<Face>,
+    sources: Vec<WCorner>,
+    cap_normals: Vec<DVec3>,
+    balance: Vec<(u64, i32)>,
+}
+
+/// Buffers that grew beyond this many elements are freed after a cut, so
+/// that one huge asset does not pin its memory to the thread for good.
+const KEEP: usize = 1 << 16;
+
+fn trim<T>(v: &mut Vec<T>) {
+    if v.capacity() > KEEP {
+        *v = Vec::new();
+    }
+}
+
+impl Bufs {
+    fn trim(&mut self) {
+        trim(&mut self.planes);
+        trim(&mut self.vid);
+        trim(&mut self.rep);
+        trim(&mut self.verts);
+        if self.crossings.slots.len() > KEEP {
+            self.crossings = CrossingTable::default();
+        }
+        trim(&mut self.items);
+        trim(&mut self.part_items);
+        trim(&mut self.part_start);
+        trim(&mut self.store_corners);
+        trim(&mut self.store_loops);
+        trim(&mut self.pieces_rec);
+        trim(&mut self.cur.corners);
+        trim(&mut self.cur.loops);
+        trim(&mut self.stack.corners);
+        trim(&mut self.stack.loops);
+        trim(&mut self.stack.polys);
+        trim(&mut self.pieces.corners);
+        trim(&mut self.pieces.loops);
+        trim(&mut self.pieces.pieces);
+        let s = &mut self.split;
+        trim(&mut s.xs);
+        trim(&mut s.order);
+        trim(&mut s.partner);
+        trim(&mut s.at_edge);
+        trim(&mut s.visited);
+        trim(&mut s.traced);
+        trim(&mut s.online);
+        trim(&mut s.slot);
+        trim(&mut s.cleaned);
+        trim(&mut s.pinch);
+        let c = &mut self.caps;
+        trim(&mut c.seen);
+        trim(&mut c.net);
+        trim(&mut c.edges);
+        trim(&mut c.by_start);
+        trim(&mut c.used);
+        trim(&mut c.loop_verts);
+        trim(&mut c.loops);
+        trim(&mut c.owner);
+        trim(&mut c.caps);
+        let b = &mut self.build;
+        trim(&mut b.remap);
+        trim(&mut b.touched);
+        trim(&mut b.corners);
+        trim(&mut b.loops);
+        trim(&mut b.faces);
+        trim(&mut b.sources);
+        trim(&mut b.cap_normals);
+        trim(&mut b.balance);
+    }
+}
+
+struct Cutter<'m, 'b> {
+    mesh: &'m Mesh,
+    n: DVec3,
+    /// For axis-aligned cuts, the axis (crossing vertices get that coordinate
+    /// set exactly to the plane's, so caps are exactly planar).
+    axis: Option<usize>,
+    tol: f64,
+    /// The plane coordinates of the face being routed (see
+    /// [`Cutter::face_basis`]).
+    basis: (DVec3, DVec3),
+    bufs: &'b mut Bufs,
+}
+
+impl<'m, 'b> Cutter<'m, 'b> {
+    fn new(mesh: &'m Mesh, n: DVec3, offsets: &[f64], bufs: &'b mut Bufs) -> Cutter<'m, 'b> {
+        // Sanitise the offsets: ascending, finite (NaN sorts as "no cut": it
+        // is replaced by its predecessor, or -inf for the first).
+        let planes = &mut bufs.planes;
+        planes.clear();
+        let mut prev = f64::NEG_INFINITY;
+        for &o in offsets {
+            let o = if o.is_nan() { prev } else { o.max(prev) };
+            planes.push(o);
+            prev = o;
+        }
         let tol = mesh_tolerance(mesh).max(
             1e-9 * planes
                 .iter()
                 .filter(|p| p.is_finite())
                 .fold(0.0f64, |m, p| m.max(p.abs())),
         );
-        let weld = weld_points(&mesh.positions, tol);
-        let verts: Vec<DVec3> = weld
-            .representative
-            .iter()
-            .map(|&i| mesh.positions[i as usize])
-            .collect();
+        weld_points_into(&mesh.positions, tol, &mut bufs.vid, &mut bufs.rep);
+        bufs.verts.clear();
+        bufs.verts
+            .extend(bufs.rep.iter().map(|&i| mesh.positions[i as usize]));
+        bufs.crossings.clear();
+        bufs.items.clear();
+        bufs.store_corners.clear();
+        bufs.store_loops.clear();
+        bufs.pieces_rec.clear();
         let axis = [DVec3::X, DVec3::Y, DVec3::Z].iter().position(|&a| a == n);
-        let nparts = planes.len() + 1;
         Cutter {
             mesh,
             n,
             axis,
-            planes,
             tol,
-            vid: weld.id,
-            verts,
-            crossings: fx_map(0),
-            parts: vec![Vec::new(); nparts],
-            store_corners: Vec::new(),
-            store_loops: Vec::new(),
-            pieces: Vec::new(),
-            scratch: Scratch::default(),
+            basis: (DVec3::X, DVec3::Y),
+            bufs,
         }
     }
 
     #[inline]
     fn height(&self, v: u32) -> f64 {
-        let p = self.verts[v as usize];
+        let p = self.bufs.verts[v as usize];
         match self.axis {
             Some(a) => p[a],
             None => self.n.dot(p),
@@ -268,16 +613,32 @@ impl<'m> Cutter<'m> {
 
     #[inline]
     fn dist(&self, v: u32, k: usize) -> f64 {
-        self.height(v) - self.planes[k]
+        self.height(v) - self.bufs.planes[k]
     }
 
+    #[inline]
+    fn on_plane(&self, v: u32, k: usize) -> bool {
+        self.dist(v, k).abs() <= self.tol
+    }
+
+    #[inline]
     fn original_vertex(&self, corner: u32) -> u32 {
-        self.vid[self.mesh.corners[corner as usize] as usize]
+        self.bufs.vid[self.mesh.corners[corner as usize] as usize]
+    }
+
+    /// A vertex in the coordinates `(u, v)` of a plane.
+    #[inline]
+    fn to2d(&self, v: u32, (u, w): (DVec3, DVec3)) -> DVec2 {
+        let p = self.bufs.verts[v as usize];
+        DVec2::new(p.dot(u), p.dot(w))
+    }
+
+    fn nplanes(&self) -> usize {
+        self.bufs.planes.len()
     }
 
     fn run(&mut self) {
         let mesh = self.mesh;
-        let mut poly = Poly::default();
         for face in 0..mesh.faces.len() {
             // Height range of the whole face.
             let mut lo = f64::INFINITY;
@@ -291,24 +652,24 @@ impl<'m> Cutter<'m> {
             }
             if lo.partial_cmp(&hi).is_none_or(|o| o.is_gt()) {
                 // No corners (or non-finite positions): keep it in part 0.
-                self.parts[0].push(Item::Whole(face as u32));
+                self.bufs.items.push((0, Item::Whole(face as u32)));
                 continue;
             }
             // Skip the planes the face lies strictly above.
             let tol = self.tol;
-            let mut k = self.planes.partition_point(|&c| lo - c > tol);
+            let mut k = self.bufs.planes.partition_point(|&c| lo - c > tol);
             let degenerate = mesh.outer_loop(face).len < 3;
             loop {
-                if k == self.planes.len() {
-                    self.parts[k].push(Item::Whole(face as u32));
+                if k == self.nplanes() {
+                    self.bufs.items.push((k as u32, Item::Whole(face as u32)));
                     break;
                 }
-                let c = self.planes[k];
+                let c = self.bufs.planes[k];
                 let has_neg = lo - c < -tol;
                 let has_pos = hi - c > tol;
                 match (has_neg, has_pos) {
                     (true, false) => {
-                        self.parts[k].push(Item::Whole(face as u32));
+                        self.bufs.items.push((k as u32, Item::Whole(face as u32)));
                         break;
                     }
                     (false, true) => k += 1,
@@ -318,15 +679,15 @@ impl<'m> Cutter<'m> {
                         // vertex shapes have no normal and stay below.
                         let up = degenerate || face_normal(mesh, face).dot(self.n) > 0.0;
                         if up {
-                            self.parts[k].push(Item::Whole(face as u32));
+                            self.bufs.items.push((k as u32, Item::Whole(face as u32)));
                             break;
                         }
                         k += 1;
                     }
                     (true, true) => {
-                        self.load_face(face, &mut poly);
+                        self.load_face(face);
                         let normal = face_normal(mesh, face);
-                        self.route(face as u32, normal, &poly, k);
+                        self.route(face as u32, normal, k);
                         break;
                     }
                 }
@@ -334,10 +695,12 @@ impl<'m> Cutter<'m> {
         }
     }
 
-    /// The face as a polygon of corners that remember their original edge.
-    fn load_face(&self, face: usize, poly: &mut Poly) {
-        poly.clear();
+    /// Loads the face into `cur` as a polygon of corners that remember their
+    /// original edge.
+    fn load_face(&mut self, face: usize) {
         let mesh = self.mesh;
+        let mut poly = std::mem::take(&mut self.bufs.cur);
+        poly.clear();
         for &l in mesh.face_loops(face) {
             let start = poly.corners.len() as u32;
             let r = mesh.loop_corners(l);
@@ -352,51 +715,111 @@ impl<'m> Cutter<'m> {
             }
             poly.loops.push((start, l.len));
         }
+        self.bufs.cur = poly;
     }
 
-    /// Routes a polygon (a face or a piece of it) known to reach below plane
-    /// `k` or further: splits it at planes `k..` and stores the pieces.
-    fn route(&mut self, face: u32, normal: DVec3, poly: &Poly, mut k: usize) {
+    /// Routes the polygon in `cur` (a face crossing plane `k`) through the
+    /// planes from `k` on: splits it, stores the pieces below each plane and
+    /// routes the pieces above on, depth first (the order in which the
+    /// pieces reach each part is that of a recursion over the pieces).
+    fn route(&mut self, face: u32, normal: DVec3, k: usize) {
+        debug_assert!(self.bufs.stack.polys.is_empty());
+        self.basis = self.face_basis(normal);
+        self.route_one(face, normal, k);
+        while let Some((first, count, k)) = self.bufs.stack.polys.pop() {
+            let b = &mut self.bufs;
+            b.cur.clear();
+            let base = b.stack.loops[first as usize].0;
+            for &(s, n) in &b.stack.loops[first as usize..(first + count) as usize] {
+                b.cur.loops.push((s - base, n));
+            }
+            b.cur
+                .corners
+                .extend_from_slice(&b.stack.corners[base as usize..]);
+            b.stack.loops.truncate(first as usize);
+            b.stack.corners.truncate(base as usize);
+            self.route_one(face, normal, k as usize);
+        }
+    }
+
+    /// Routes `cur` from plane `k` on until it is stored or split; the
+    /// pieces above a split are pushed on the stack.
+    fn route_one(&mut self, face: u32, normal: DVec3, mut k: usize) {
         loop {
-            if k == self.planes.len() {
-                self.store(face, poly, k);
+            if k == self.nplanes() {
+                self.store_cur(face, k);
                 return;
             }
-            match self.classify(poly, k) {
+            match self.classify(k) {
                 Side::Below => {
-                    self.store(face, poly, k);
+                    self.store_cur(face, k);
                     return;
                 }
                 Side::Above => k += 1,
                 Side::On => {
-                    if poly.corners.len() < 3 || normal.dot(self.n) > 0.0 {
-                        self.store(face, poly, k);
+                    if self.bufs.cur.corners.len() < 3 || normal.dot(self.n) > 0.0 {
+                        self.store_cur(face, k);
                         return;
                     }
                     k += 1;
                 }
                 Side::Both => {
-                    let (below, above) = if poly.loops[0].1 < 3 {
-                        self.split_segment(poly, k)
+                    match self.split_simple(face, normal, k) {
+                        Simple::NotApplicable => {}
+                        Simple::Done { above: true } => {
+                            k += 1;
+                            continue;
+                        }
+                        Simple::Done { above: false } => return,
+                    }
+                    let split = if self.bufs.cur.loops[0].1 < 3 {
+                        self.split_segment(k)
                     } else {
-                        self.split_polygon(poly, normal, k)
+                        self.split_polygon(normal, k)
                     };
-                    for p in &below {
-                        self.store(face, p, k);
+                    match split {
+                        Split::Whole(false) => {
+                            self.store_cur(face, k);
+                            return;
+                        }
+                        Split::Whole(true) => k += 1,
+                        Split::Pieces => {
+                            let pieces = std::mem::take(&mut self.bufs.pieces);
+                            for p in 0..pieces.pieces.len() {
+                                if pieces.pieces[p].0 == 0 {
+                                    self.store_piece(face, &pieces, p, k);
+                                }
+                            }
+                            // Pushed in reverse, so that the first piece
+                            // above is routed first.
+                            for p in (0..pieces.pieces.len()).rev() {
+                                if pieces.pieces[p].0 == 1 {
+                                    self.push_piece(&pieces, p, k + 1);
+                                }
+                            }
+                            self.bufs.pieces = pieces;
+                            return;
+                        }
                     }
-                    for p in &above {
-                        self.route(face, normal, p, k + 1);
-                    }
-                    return;
                 }
             }
         }
     }
 
-    fn classify(&self, poly: &Poly, k: usize) -> Side {
+    /// Coordinates in the plane of a face with unit `normal` (or zero),
+    /// in which pieces are told from holes.
+    fn face_basis(&self, normal: DVec3) -> (DVec3, DVec3) {
+        plane_basis(if normal == DVec3::ZERO {
+            self.n
+        } else {
+            normal
+        })
+    }
+
+    fn classify(&self, k: usize) -> Side {
         let mut neg = false;
         let mut pos = false;
-        for c in &poly.corners {
+        for c in &self.bufs.cur.corners {
             let s = self.dist(c.v, k);
             neg |= s < -self.tol;
             pos |= s > self.tol;
@@ -409,20 +832,50 @@ impl<'m> Cutter<'m> {
         }
     }
 
-    fn store(&mut self, face: u32, poly: &Poly, part: usize) {
-        let first = self.store_loops.len() as u32;
-        for k in 0..poly.loops.len() {
-            let l = poly.loop_slice(k);
-            self.store_loops
-                .push((self.store_corners.len() as u32, l.len() as u32));
-            self.store_corners.extend_from_slice(l);
+    fn store_cur(&mut self, face: u32, part: usize) {
+        let b = &mut self.bufs;
+        let first = b.store_loops.len() as u32;
+        for k in 0..b.cur.loops.len() {
+            let l = b.cur.loop_slice(k);
+            b.store_loops
+                .push((b.store_corners.len() as u32, l.len() as u32));
+            b.store_corners.extend_from_slice(l);
         }
-        self.pieces.push(PieceRec {
+        b.pieces_rec.push(PieceRec {
             face,
             first,
-            count: poly.loops.len() as u32,
+            count: b.cur.loops.len() as u32,
         });
-        self.parts[part].push(Item::Piece(self.pieces.len() as u32 - 1));
+        b.items
+            .push((part as u32, Item::Piece(b.pieces_rec.len() as u32 - 1)));
+    }
+
+    fn store_piece(&mut self, face: u32, pieces: &Pieces, p: usize, part: usize) {
+        let b = &mut self.bufs;
+        let first = b.store_loops.len() as u32;
+        let mut count = 0;
+        for l in pieces.piece_loops(p) {
+            let c = pieces.corners_of(l);
+            b.store_loops
+                .push((b.store_corners.len() as u32, c.len() as u32));
+            b.store_corners.extend_from_slice(c);
+            count += 1;
+        }
+        b.pieces_rec.push(PieceRec { face, first, count });
+        b.items
+            .push((part as u32, Item::Piece(b.pieces_rec.len() as u32 - 1)));
+    }
+
+    fn push_piece(&mut self, pieces: &Pieces, p: usize, k: usize) {
+        let s = &mut self.bufs.stack;
+        let first = s.loops.len() as u32;
+        for l in pieces.piece_loops(p) {
+            let c = pieces.corners_of(l);
+            s.loops.push((s.corners.len() as u32, c.len() as u32));
+            s.corners.extend_from_slice(c);
+        }
+        s.polys
+            .push((first, s.loops.len() as u32 - first, k as u32));
     }
 
     /// The corner where plane `k` crosses the edge from corner `ci` to `cj`
@@ -437,10 +890,10 @@ impl<'m> Cutter<'m> {
         };
         let (sa, sb) = (self.dist(va, k), self.dist(vb, k));
         let t_face = sa / (sa - sb);
-        let key = (va.min(vb), va.max(vb), k as u32);
-        let v = match self.crossings.get(&key) {
-            Some(&v) => v,
-            None => {
+        let key = edge_key(va, vb);
+        let v = match self.bufs.crossings.find(key, k as u32) {
+            Ok(v) => v,
+            Err(slot) => {
                 // Compute from the lower id to the higher so that the point
                 // does not depend on which face asks first.
                 let (p, q, sp, sq) = if va < vb {
@@ -449,14 +902,14 @@ impl<'m> Cutter<'m> {
                     (vb, va, sb, sa)
                 };
                 let t = sp / (sp - sq);
-                let (pp, pq) = (self.verts[p as usize], self.verts[q as usize]);
+                let (pp, pq) = (self.bufs.verts[p as usize], self.bufs.verts[q as usize]);
                 let mut x = pp + (pq - pp) * t;
                 if let Some(a) = self.axis {
-                    x[a] = self.planes[k];
+                    x[a] = self.bufs.planes[k];
                 }
-                self.verts.push(x);
-                let v = self.verts.len() as u32 - 1;
-                self.crossings.insert(key, v);
+                self.bufs.verts.push(x);
+                let v = self.bufs.verts.len() as u32 - 1;
+                self.bufs.crossings.insert_at(slot, key, k as u32, v);
                 v
             }
         };
@@ -476,26 +929,213 @@ impl<'m> Cutter<'m> {
     }
 
     /// Splits an edge shape (a loop of two corners) at plane `k`.
-    fn split_segment(&mut self, poly: &Poly, k: usize) -> (Vec<Poly>, Vec<Poly>) {
-        let (c0, c1) = (poly.corners[0], poly.corners[1]);
+    fn split_segment(&mut self, k: usize) -> Split {
+        let (c0, c1) = (self.bufs.cur.corners[0], self.bufs.cur.corners[1]);
         let x = self.crossing_corner(c0, c1, k);
-        let mut lower = Poly::default();
-        let mut upper = Poly::default();
-        if self.dist(c0.v, k) < 0.0 {
-            lower.push_loop(&[c0, x]);
-            upper.push_loop(&[x, c1]);
+        let (lower, upper) = if self.dist(c0.v, k) < 0.0 {
+            ([c0, x], [x, c1])
         } else {
-            upper.push_loop(&[c0, x]);
-            lower.push_loop(&[x, c1]);
+            ([x, c1], [c0, x])
+        };
+        let p = &mut self.bufs.pieces;
+        p.clear();
+        for (side, l) in [(0, lower), (1, upper)] {
+            let start = p.corners.len();
+            p.corners.extend_from_slice(&l);
+            let l = p.add_loop(start, side);
+            p.add_piece(l);
         }
-        (vec![lower], vec![upper])
+        Split::Pieces
     }
 
-    /// Splits a polygon with vertices strictly on both sides of plane `k`
-    /// into pieces below and above (see the module docs).
-    fn split_polygon(&mut self, poly: &Poly, normal: DVec3, k: usize) -> (Vec<Poly>, Vec<Poly>) {
+    /// Splits the polygon in `cur`, with vertices strictly on both sides of
+    /// plane `k`, into pieces below and above (see the module docs), left in
+    /// `pieces`.
+    /// The common case of a split, done directly: a polygon without holes
+    /// and without repeated vertices, no vertex of which lies on plane `k`,
+    /// crossing it at exactly two edges (every convex face that is cut).
+    /// The piece below is stored, the piece above left in `cur`. The result
+    /// is exactly what [`Cutter::split_polygon`] gives (the same crossing
+    /// vertices created in the same order, the same corners in the same
+    /// order, the same pieces dropped for a negative area); it returns
+    /// `NotApplicable` for anything else, having at most created crossing
+    /// vertices the general path finds again.
+    fn split_simple(&mut self, face: u32, normal: DVec3, k: usize) -> Simple {
+        const MAX: usize = 16;
+        if !fast_paths_enabled() {
+            return Simple::NotApplicable;
+        }
         let tol = self.tol;
-        let mut sc = std::mem::take(&mut self.scratch);
+        let cur = &self.bufs.cur;
+        let n = cur.corners.len();
+        if cur.loops.len() != 1 || !(3..=MAX).contains(&n) {
+            return Simple::NotApplicable;
+        }
+        let mut above = [false; MAX];
+        let mut dist = [0.0; MAX];
+        for (i, c) in cur.corners.iter().enumerate() {
+            let s = self.dist(c.v, k);
+            // On the plane (or NaN): the general path decides.
+            if s.abs() <= tol || s.is_nan() {
+                return Simple::NotApplicable;
+            }
+            above[i] = s > tol;
+            dist[i] = s;
+        }
+        let mut edges = [0usize; 2];
+        let mut m = 0;
+        for e in 0..n {
+            if above[e] != above[if e + 1 == n { 0 } else { e + 1 }] {
+                if m == 2 {
+                    return Simple::NotApplicable;
+                }
+                edges[m] = e;
+                m += 1;
+            }
+        }
+        if m != 2 {
+            return Simple::NotApplicable;
+        }
+        for i in 1..n {
+            let v = cur.corners[i].v;
+            if cur.corners[..i].iter().any(|c| c.v == v) {
+                return Simple::NotApplicable;
+            }
+        }
+        // The crossings, created in edge order as the general path does,
+        // with their position and tie-break along the cut line.
+        let d = normal.cross(self.n);
+        let mut xs = [(
+            WCorner {
+                v: 0,
+                a: 0,
+                b: 0,
+                t: 0.0,
+            },
+            0.0,
+            0.0,
+            false,
+        ); 2];
+        for (x, &e) in xs.iter_mut().zip(&edges) {
+            let j = if e + 1 == n { 0 } else { e + 1 };
+            let (ci, cj) = (self.bufs.cur.corners[e], self.bufs.cur.corners[j]);
+            let corner = self.crossing_corner(ci, cj, k);
+            let (lo, hi, slo, shi) = if above[e] {
+                (cj, ci, dist[j], dist[e])
+            } else {
+                (ci, cj, dist[e], dist[j])
+            };
+            let verts = &self.bufs.verts;
+            let dl = verts[hi.v as usize] - verts[lo.v as usize];
+            *x = (
+                corner,
+                verts[corner.v as usize].dot(d),
+                dl.dot(d) / (shi - slo),
+                above[j],
+            );
+        }
+        if xs[0].0.v == xs[1].0.v {
+            return Simple::NotApplicable;
+        }
+        // The general path pairs the crossings in order along the line (a
+        // stable sort): the first must go up, the second down.
+        let second_first = xs[1]
+            .1
+            .total_cmp(&xs[0].1)
+            .then(xs[1].2.total_cmp(&xs[0].2))
+            .is_lt();
+        let (first, second) = if second_first {
+            (xs[1], xs[0])
+        } else {
+            (xs[0], xs[1])
+        };
+        if !first.3 || second.3 {
+            return Simple::NotApplicable;
+        }
+        // Below: from the crossing going down along the loop to the one
+        // going up; above: the rest.
+        let (xd, ed, xu, eu) = if xs[0].3 {
+            (xs[1].0, edges[1], xs[0].0, edges[0])
+        } else {
+            (xs[0].0, edges[0], xs[1].0, edges[1])
+        };
+        // Pieces with a negative area are dropped, as the general path
+        // does (they would be holes with no piece around them).
+        let basis = self.basis;
+        let mut p2 = [DVec2::ZERO; MAX];
+        for (q, c) in p2.iter_mut().zip(&self.bufs.cur.corners) {
+            *q = self.to2d(c.v, basis);
+        }
+        let (pd, pu) = (self.to2d(xd.v, basis), self.to2d(xu.v, basis));
+        let area = |x0: DVec2, e0: usize, x1: DVec2, e1: usize| {
+            let mut seq = [DVec2::ZERO; MAX + 2];
+            seq[0] = x0;
+            let mut len = 1;
+            let mut e = e0;
+            loop {
+                e = if e + 1 == n { 0 } else { e + 1 };
+                seq[len] = p2[e];
+                len += 1;
+                if e == e1 {
+                    break;
+                }
+            }
+            seq[len] = x1;
+            signed_area_by(len + 1, |i| seq[i])
+        };
+        let mut piece = std::mem::take(&mut self.bufs.split.cleaned);
+        if area(pd, ed, pu, eu) >= 0.0 {
+            trace_piece(&self.bufs.cur.corners, &mut piece, (xd, ed), (xu, eu));
+            let b = &mut self.bufs;
+            b.store_loops
+                .push((b.store_corners.len() as u32, piece.len() as u32));
+            b.store_corners.extend_from_slice(&piece);
+            b.pieces_rec.push(PieceRec {
+                face,
+                first: b.store_loops.len() as u32 - 1,
+                count: 1,
+            });
+            b.items
+                .push((k as u32, Item::Piece(b.pieces_rec.len() as u32 - 1)));
+        }
+        let keep = area(pu, eu, pd, ed) >= 0.0;
+        if keep {
+            trace_piece(&self.bufs.cur.corners, &mut piece, (xu, eu), (xd, ed));
+            let cur = &mut self.bufs.cur;
+            std::mem::swap(&mut cur.corners, &mut piece);
+            cur.loops[0] = (0, cur.corners.len() as u32);
+        }
+        self.bufs.split.cleaned = piece;
+        count_simple_split();
+        Simple::Done { above: keep }
+    }
+
+    fn split_polygon(&mut self, normal: DVec3, k: usize) -> Split {
+        let poly = std::mem::take(&mut self.bufs.cur);
+        let mut sc = std::mem::take(&mut self.bufs.split);
+        let split = self.split_polygon_with(&poly, normal, k, &mut sc);
+        self.bufs.split = sc;
+        if let Split::Whole(_) = split {
+            // Inconsistent input (self-intersecting or badly non-planar
+            // polygon): keep the face whole on the side of its centroid
+            // rather than produce garbage.
+            let c = poly.corners.iter().map(|c| self.dist(c.v, k)).sum::<f64>()
+                / poly.corners.len() as f64;
+            self.bufs.cur = poly;
+            return Split::Whole(c > 0.0 || c.is_nan());
+        }
+        self.bufs.cur = poly;
+        split
+    }
+
+    fn split_polygon_with(
+        &mut self,
+        poly: &Poly,
+        normal: DVec3,
+        k: usize,
+        sc: &mut SplitBufs,
+    ) -> Split {
+        let tol = self.tol;
         sc.xs.clear();
         sc.at_edge.clear();
         sc.at_edge.resize(poly.corners.len(), NONE);
@@ -522,13 +1162,14 @@ impl<'m> Cutter<'m> {
                 };
                 let (lo, hi) = if ai { (cj, ci) } else { (ci, cj) };
                 let (slo, shi) = if ai { (sj, si) } else { (si, sj) };
-                let dl = self.verts[hi.v as usize] - self.verts[lo.v as usize];
+                let verts = &self.bufs.verts;
+                let dl = verts[hi.v as usize] - verts[lo.v as usize];
                 sc.at_edge[i] = sc.xs.len() as u32;
                 sc.xs.push(Crossing {
                     corner,
                     lp: li as u32,
                     edge: e,
-                    lambda: self.verts[corner.v as usize].dot(d),
+                    lambda: verts[corner.v as usize].dot(d),
                     tie: dl.dot(d) / (shi - slo),
                     up: aj,
                 });
@@ -559,25 +1200,10 @@ impl<'m> Cutter<'m> {
             }
         }
         if !valid {
-            // Inconsistent input (self-intersecting or badly non-planar
-            // polygon): keep the face whole on the side of its centroid
-            // rather than produce garbage.
-            self.scratch = sc;
-            let c = poly.corners.iter().map(|c| self.dist(c.v, k)).sum::<f64>()
-                / poly.corners.len() as f64;
-            return if c <= 0.0 {
-                (vec![poly.clone()], vec![])
-            } else {
-                (vec![], vec![poly.clone()])
-            };
+            return Split::Whole(false);
         }
 
-        let (u, v) = plane_basis(if normal == DVec3::ZERO {
-            self.n
-        } else {
-            normal
-        });
-        let to2d = |p: DVec3| DVec2::new(p.dot(u), p.dot(v));
+        let basis = self.basis;
         // The face's vertices on the cut line, by position along it. A jump
         // along the line passes through those lying between its ends: this
         // keeps edges of the line shared between pieces and caps (no
@@ -585,15 +1211,15 @@ impl<'m> Cutter<'m> {
         // other side, where it is then split (see `split_pinches`).
         sc.online.clear();
         for c in &poly.corners {
-            if self.dist(c.v, k).abs() <= tol {
-                sc.online.push((self.verts[c.v as usize].dot(d), *c));
+            if self.on_plane(c.v, k) {
+                sc.online.push((self.bufs.verts[c.v as usize].dot(d), *c));
             }
         }
         sc.online
             .sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.v.cmp(&b.1.v)));
         sc.online.dedup_by_key(|x| x.1.v);
-        let mut result: [Vec<Poly>; 2] = [Vec::new(), Vec::new()];
-        let mut extra_holes: [Vec<Vec<WCorner>>; 2] = [Vec::new(), Vec::new()];
+        let mut res = std::mem::take(&mut self.bufs.pieces);
+        res.clear();
         for side in 0..2 {
             // side 0: below (entered at crossings going down), 1: above.
             let entering_up = side == 1;
@@ -653,24 +1279,28 @@ impl<'m> Cutter<'m> {
                 if guard == 0 {
                     continue;
                 }
-                let traced = std::mem::take(&mut sc.traced);
-                for l in self.split_pinches(&traced, k, &mut sc.slot) {
-                    let pts: Vec<DVec2> =
-                        l.iter().map(|c| to2d(self.verts[c.v as usize])).collect();
-                    if signed_area(&pts) >= 0.0 {
-                        let mut p = Poly::default();
-                        p.push_loop(&l);
-                        result[side].push(p);
-                    } else {
-                        extra_holes[side].push(l);
+                let first_new = res.loops.len();
+                self.split_pinches(
+                    &sc.traced,
+                    k,
+                    side,
+                    &mut sc.slot,
+                    &mut sc.cleaned,
+                    &mut sc.pinch,
+                    &mut res,
+                );
+                for l in first_new..res.loops.len() {
+                    // Counter-clockwise loops are pieces, clockwise ones
+                    // holes of the piece around them.
+                    let c = res.corners_of(l);
+                    if signed_area_by(c.len(), |i| self.to2d(c[i].v, basis)) >= 0.0 {
+                        res.add_piece(l);
                     }
                 }
-                sc.traced = traced;
             }
         }
         // Loops without crossings lie on one side: holes of the piece that
         // contains them (or, for a malformed face, pieces of their own).
-        let mut holes: [Vec<Vec<WCorner>>; 2] = extra_holes;
         for li in 0..poly.loops.len() {
             let l = poly.loop_slice(li);
             let (start, len) = poly.loops[li];
@@ -678,145 +1308,157 @@ impl<'m> Cutter<'m> {
                 continue;
             }
             let side = usize::from(l.iter().any(|c| self.dist(c.v, k) > tol));
-            let Some(cl) = self.clean_loop(l, k) else {
+            let at = res.corners.len();
+            if !self.clean_loop_into(l, k, &mut res.corners) {
                 continue;
-            };
+            }
+            let nl = res.add_loop(at, side);
             if li == 0 {
-                let mut p = Poly::default();
-                p.push_loop(&cl);
-                result[side].push(p);
-            } else {
-                holes[side].push(cl);
+                res.add_piece(nl);
             }
         }
-        for side in 0..2 {
-            let out = &mut result[side];
-            for cl in std::mem::take(&mut holes[side]) {
-                if out.is_empty() {
+        // Holes (clockwise traced loops first, then the loops without
+        // crossings) go to the piece of their side containing them.
+        for side in 0..2u8 {
+            let count = res.pieces.iter().filter(|p| p.0 == side).count();
+            for h in 0..res.loops.len() {
+                let hl = res.loops[h];
+                if hl.side != side || hl.owner != NONE {
+                    continue;
+                }
+                if count == 0 {
                     continue; // a hole without a piece around it: nothing to cut out of
                 }
+                let cl = res.corners_of(h);
                 let probe = cl
                     .iter()
                     .find(|c| self.dist(c.v, k).abs() > tol)
-                    .map(|c| to2d(self.verts[c.v as usize]));
+                    .map(|c| self.to2d(c.v, basis));
+                let mut of_side = (0..res.pieces.len()).filter(|&p| res.pieces[p].0 == side);
+                let first = of_side.clone().next().unwrap_or(0);
                 let target = match probe {
-                    Some(q) if out.len() > 1 => out
-                        .iter()
-                        .position(|p| {
-                            let pts: Vec<DVec2> = p
-                                .loop_slice(0)
-                                .iter()
-                                .map(|c| to2d(self.verts[c.v as usize]))
-                                .collect();
-                            point_in_polygon(q, &pts)
+                    Some(q) if count > 1 => of_side
+                        .find(|&p| {
+                            let o = res.corners_of(res.pieces[p].1 as usize);
+                            point_in_polygon_by(q, o.len(), |i| self.to2d(o[i].v, basis))
                         })
-                        .unwrap_or(0),
-                    _ => 0,
+                        .unwrap_or(first),
+                    _ => first,
                 };
-                out[target].push_loop(&cl);
+                res.loops[h].owner = target as u32;
             }
         }
-        self.scratch = sc;
-        let [below, above] = result;
-        (below, above)
+        self.bufs.pieces = res;
+        Split::Pieces
     }
 
-    /// Removes repeated consecutive vertices; `None` if fewer than three
-    /// remain or all lie on plane `k` (a piece without area).
-    fn clean_loop(&self, l: &[WCorner], k: usize) -> Option<Vec<WCorner>> {
-        let mut out: Vec<WCorner> = Vec::with_capacity(l.len());
+    /// Appends `l` to `out` without repeated consecutive vertices; returns
+    /// false, leaving `out` as it was, if fewer than three remain or all lie
+    /// on plane `k` (a piece without area).
+    fn clean_loop_into(&self, l: &[WCorner], k: usize, out: &mut Vec<WCorner>) -> bool {
+        let base = out.len();
         for &c in l {
-            if out.last().is_some_and(|p| p.v == c.v) {
+            if out.len() > base && out[out.len() - 1].v == c.v {
                 continue;
             }
             out.push(c);
         }
-        while out.len() > 1 && out[0].v == out[out.len() - 1].v {
+        while out.len() - base > 1 && out[base].v == out[out.len() - 1].v {
             out.pop();
         }
-        if out.len() < 3 || out.iter().all(|c| self.dist(c.v, k).abs() <= self.tol) {
-            return None;
+        if out.len() - base < 3 || out[base..].iter().all(|c| self.on_plane(c.v, k)) {
+            out.truncate(base);
+            return false;
         }
-        Some(out)
+        true
     }
 
     /// Splits a traced loop where it visits a vertex twice (a piece touching
     /// itself on the cut line, or a bridge along an edge lying in the line)
-    /// into simple loops, dropping those without area.
-    fn split_pinches(&self, l: &[WCorner], k: usize, slot: &mut Vec<u32>) -> Vec<Vec<WCorner>> {
-        let mut out = Vec::new();
-        let Some(l) = self.clean_loop(l, k) else {
-            return out;
-        };
-        if slot.len() < self.verts.len() {
-            slot.resize(self.verts.len(), NONE);
+    /// into simple loops, dropping those without area; appends them to
+    /// `out` on `side`, unowned.
+    #[allow(clippy::too_many_arguments)]
+    fn split_pinches(
+        &self,
+        l: &[WCorner],
+        k: usize,
+        side: usize,
+        slot: &mut Vec<u32>,
+        cleaned: &mut Vec<WCorner>,
+        stack: &mut Vec<WCorner>,
+        out: &mut Pieces,
+    ) {
+        cleaned.clear();
+        if !self.clean_loop_into(l, k, cleaned) {
+            return;
         }
-        let mut stack: Vec<WCorner> = Vec::with_capacity(l.len());
-        for &c in &l {
+        if slot.len() < self.bufs.verts.len() {
+            slot.resize(self.bufs.verts.len(), NONE);
+        }
+        stack.clear();
+        for &c in cleaned.iter() {
             let p = slot[c.v as usize];
             if p != NONE {
                 // Close the sub-loop from the first visit up to here.
-                let sub: Vec<WCorner> = stack.drain(p as usize + 1..).collect();
-                for s in &sub {
+                let p = p as usize;
+                for s in &stack[p + 1..] {
                     slot[s.v as usize] = NONE;
                 }
-                let mut lp = Vec::with_capacity(sub.len() + 1);
-                lp.push(stack[p as usize]);
-                lp.extend(sub);
-                if let Some(lp) = self.clean_loop(&lp, k) {
-                    out.push(lp);
+                let at = out.corners.len();
+                if self.clean_loop_into(&stack[p..], k, &mut out.corners) {
+                    out.add_loop(at, side);
                 }
+                stack.truncate(p + 1);
                 continue;
             }
             slot[c.v as usize] = stack.len() as u32;
             stack.push(c);
         }
-        for s in &stack {
+        for s in stack.iter() {
             slot[s.v as usize] = NONE;
         }
-        if let Some(lp) = self.clean_loop(&stack, k) {
-            out.push(lp);
+        let at = out.corners.len();
+        if self.clean_loop_into(stack, k, &mut out.corners) {
+            out.add_loop(at, side);
         }
-        out
     }
 
-    /// Loops of the faces of `part`, for cap computation.
-    fn for_each_loop(&self, part: usize, mut f: impl FnMut(u32, &mut dyn Iterator<Item = u32>)) {
-        let mesh = self.mesh;
-        for item in &self.parts[part] {
-            match *item {
-                Item::Whole(face) => {
-                    if mesh.outer_loop(face as usize).len < 3 {
-                        continue;
-                    }
-                    for &l in mesh.face_loops(face as usize) {
-                        let mut it = mesh.loop_corners(l).map(|c| self.original_vertex(c as u32));
-                        f(face, &mut it);
-                    }
-                }
-                Item::Piece(p) => {
-                    let rec = self.pieces[p as usize];
-                    let (_, outer_len) = self.store_loops[rec.first as usize];
-                    if outer_len < 3 {
-                        continue;
-                    }
-                    for li in rec.first..rec.first + rec.count {
-                        let (s, n) = self.store_loops[li as usize];
-                        let mut it = self.store_corners[s as usize..(s + n) as usize]
-                            .iter()
-                            .map(|c| c.v);
-                        f(rec.face, &mut it);
-                    }
-                }
-            }
+    /// Sorts the routed items by part (stably) into `part_items`.
+    fn group_items_by_part(&mut self) {
+        let b = &mut self.bufs;
+        let nparts = b.planes.len() + 1;
+        b.part_start.clear();
+        b.part_start.resize(nparts + 1, 0);
+        for &(p, _) in &b.items {
+            b.part_start[p as usize + 1] += 1;
         }
+        for p in 0..nparts {
+            b.part_start[p + 1] += b.part_start[p];
+        }
+        b.part_items.clear();
+        b.part_items.resize(b.items.len(), Item::Whole(0));
+        // `remap` serves as the fill pointers here.
+        let fill = &mut b.build.remap;
+        fill.clear();
+        fill.extend_from_slice(&b.part_start[..nparts]);
+        for &(p, item) in &b.items {
+            let f = &mut fill[p as usize];
+            b.part_items[*f as usize] = item;
+            *f += 1;
+        }
+    }
+
+    fn part_items(&self, part: usize) -> &[Item] {
+        let b = &self.bufs;
+        &b.part_items[b.part_start[part] as usize..b.part_start[part + 1] as usize]
     }
 
     /// True if every welded edge of the input is used as often in one
     /// direction as in the other (so cut parts can be closed with caps).
-    fn input_is_closed(&self) -> bool {
+    fn input_is_closed(&mut self) -> bool {
         let mesh = self.mesh;
-        let mut balance: FxHashMap<(u32, u32), i32> = fx_map(mesh.corners.len());
+        let mut balance = std::mem::take(&mut self.bufs.build.balance);
+        balance.clear();
         let mut any = false;
         for face in 0..mesh.faces.len() {
             if mesh.outer_loop(face).len < 3 {
@@ -833,187 +1475,302 @@ impl<'m> Cutter<'m> {
                     );
                     if a != b {
                         let d = if a < b { 1 } else { -1 };
-                        *balance.entry((a.min(b), a.max(b))).or_insert(0) += d;
+                        balance.push((edge_key(a, b), d));
                     }
                 }
             }
         }
-        any && balance.values().all(|&b| b == 0)
+        balance.sort_unstable_by_key(|e| e.0);
+        let balanced = balance
+            .chunk_by(|x, y| x.0 == y.0)
+            .all(|g| g.iter().map(|e| e.1).sum::<i32>() == 0);
+        self.bufs.build.balance = balance;
+        any && balanced
     }
 
     /// Cap faces of `part` in plane `k`, facing `outward` (`+n` for the
-    /// plane above the part, `-n` below). Each cap is a list of loops (outer
-    /// first) of vertex ids, with the face whose material it takes.
-    fn caps(&self, part: usize, k: usize, outward: DVec3) -> Vec<(u32, Vec<Vec<u32>>)> {
+    /// plane above the part, `-n` below), left in `caps`: each cap is an
+    /// outer loop (then holes) of vertex ids, with the face whose material
+    /// it takes.
+    fn caps(&self, part: usize, k: usize, outward: DVec3, cb: &mut CapBufs) {
         let tol = self.tol;
-        let on = |v: u32| self.dist(v, k).abs() <= tol;
-        // Net count of directed on-plane edges per undirected edge.
-        let mut net: FxHashMap<(u32, u32), (i32, u32)> = fx_map(0);
-        let mut order: Vec<(u32, u32)> = Vec::new();
-        self.for_each_loop(part, &mut |face, it: &mut dyn Iterator<Item = u32>| {
-            let vs: Vec<u32> = it.collect();
-            let n = vs.len();
-            for i in 0..n {
-                let (a, b) = (vs[i], vs[(i + 1) % n]);
-                if a == b || !on(a) || !on(b) {
-                    continue;
-                }
-                let key = (a.min(b), a.max(b));
-                let e = net.entry(key).or_insert_with(|| {
-                    order.push(key);
-                    (0, face)
-                });
-                e.0 += if a < b { 1 } else { -1 };
+        cb.caps.clear();
+        cb.loops.clear();
+        cb.loop_verts.clear();
+        cb.owner.clear();
+        // Net count of directed on-plane edges per undirected edge, in the
+        // order the edges are first seen.
+        cb.seen.clear();
+        let add = |a: u32, b: u32, face: u32, seen: &mut Vec<(u64, u32, i32, u32)>| {
+            if a == b || !self.on_plane(a, k) || !self.on_plane(b, k) {
+                return;
             }
-        });
+            let rank = seen.len() as u32;
+            seen.push((edge_key(a, b), rank, if a < b { 1 } else { -1 }, face));
+        };
+        let mesh = self.mesh;
+        for item in self.part_items(part) {
+            match *item {
+                Item::Whole(face) => {
+                    if mesh.outer_loop(face as usize).len < 3 {
+                        continue;
+                    }
+                    for &l in mesh.face_loops(face as usize) {
+                        let r = mesh.loop_corners(l);
+                        for c in r.clone() {
+                            let n = if c + 1 == r.end { r.start } else { c + 1 };
+                            let (a, b) = (
+                                self.original_vertex(c as u32),
+                                self.original_vertex(n as u32),
+                            );
+                            add(a, b, face, &mut cb.seen);
+                        }
+                    }
+                }
+                Item::Piece(p) => {
+                    let rec = self.bufs.pieces_rec[p as usize];
+                    let (_, outer_len) = self.bufs.store_loops[rec.first as usize];
+                    if outer_len < 3 {
+                        continue;
+                    }
+                    for li in rec.first..rec.first + rec.count {
+                        let (s, n) = self.bufs.store_loops[li as usize];
+                        let cs = &self.bufs.store_corners[s as usize..(s + n) as usize];
+                        for i in 0..cs.len() {
+                            let j = if i + 1 == cs.len() { 0 } else { i + 1 };
+                            add(cs[i].v, cs[j].v, rec.face, &mut cb.seen);
+                        }
+                    }
+                }
+            }
+        }
+        if cb.seen.is_empty() {
+            return;
+        }
+        cb.seen.sort_unstable_by_key(|e| (e.0, e.1));
+        cb.net.clear();
+        for g in cb.seen.chunk_by(|x, y| x.0 == y.0) {
+            let count: i32 = g.iter().map(|e| e.2).sum();
+            cb.net.push((g[0].1, g[0].0, count, g[0].3));
+        }
+        cb.net.sort_unstable_by_key(|e| e.0);
         // Unmatched edges, reversed: the caps' boundary edges.
-        let mut edges: Vec<(u32, u32, u32)> = Vec::new();
-        for key in &order {
-            let (count, face) = net[key];
-            let (a, b) = *key;
+        cb.edges.clear();
+        for &(_, key, count, face) in &cb.net {
+            let (a, b) = ((key >> 32) as u32, key as u32);
             for _ in 0..count.unsigned_abs() {
                 if count > 0 {
-                    edges.push((b, a, face));
+                    cb.edges.push((b, a, face));
                 } else {
-                    edges.push((a, b, face));
+                    cb.edges.push((a, b, face));
                 }
             }
         }
-        if edges.is_empty() {
-            return Vec::new();
+        if cb.edges.is_empty() {
+            return;
         }
-        let (u, v) = plane_basis(outward);
-        let p2 = |i: u32| {
-            let p = self.verts[i as usize];
-            DVec2::new(p.dot(u), p.dot(v))
-        };
-        // Out-edges per start vertex.
-        let mut by_start: Vec<u32> = (0..edges.len() as u32).collect();
-        by_start.sort_by_key(|&e| edges[e as usize].0);
+        let basis = plane_basis(outward);
+        let p2 = |i: u32| self.to2d(i, basis);
+        let edges = &cb.edges;
+        // Out-edges per start vertex (in edge order for equal starts).
+        cb.by_start.clear();
+        cb.by_start.extend(0..edges.len() as u32);
+        cb.by_start
+            .sort_unstable_by_key(|&e| (edges[e as usize].0, e));
+        let by_start = &cb.by_start;
         let first_out = |vtx: u32| by_start.partition_point(|&e| edges[e as usize].0 < vtx);
-        let mut used = vec![false; edges.len()];
-        let mut loops: Vec<(Vec<u32>, u32, f64)> = Vec::new(); // (vertices, face, signed area)
+        cb.used.clear();
+        cb.used.resize(edges.len(), false);
         for e0 in 0..edges.len() {
-            if used[e0] {
+            if cb.used[e0] {
                 continue;
             }
-            used[e0] = true;
-            let mut verts = vec![edges[e0].0];
+            cb.used[e0] = true;
+            let start = cb.loop_verts.len();
+            cb.loop_verts.push(edges[e0].0);
             let mut cur = e0;
             let mut closed = false;
             for _ in 0..=edges.len() {
                 let (a, w, _) = edges[cur];
-                let back = p2(a) - p2(w);
-                let mut best: Option<(usize, f64)> = None;
-                let mut idx = first_out(w);
-                while idx < by_start.len() && edges[by_start[idx] as usize].0 == w {
-                    let e = by_start[idx] as usize;
-                    idx += 1;
-                    if used[e] && e != e0 {
-                        continue;
-                    }
-                    let dir = p2(edges[e].1) - p2(w);
-                    let mut ang = back.perp_dot(dir).atan2(back.dot(dir));
-                    if ang <= 0.0 {
-                        ang += std::f64::consts::TAU;
-                    }
-                    if best.is_none_or(|(_, b)| ang > b) {
-                        best = Some((e, ang));
-                    }
-                }
-                let Some((e, _)) = best else {
+                let first = first_out(w);
+                let usable = |e: usize| !cb.used[e] || e == e0;
+                let mut outs = by_start[first..]
+                    .iter()
+                    .take_while(|&&e| edges[e as usize].0 == w)
+                    .map(|&e| e as usize)
+                    .filter(|&e| usable(e));
+                let Some(only) = outs.next() else {
                     break; // open chain: the section is not closed here
+                };
+                // At a vertex where several continue, the sharpest turn
+                // (largest angle from the way back) keeps loops simple.
+                let e = if outs.next().is_none() {
+                    only
+                } else {
+                    let back = p2(a) - p2(w);
+                    let mut best: Option<(usize, f64)> = None;
+                    for &e in by_start[first..]
+                        .iter()
+                        .take_while(|&&e| edges[e as usize].0 == w)
+                    {
+                        let e = e as usize;
+                        if !usable(e) {
+                            continue;
+                        }
+                        let dir = p2(edges[e].1) - p2(w);
+                        let mut ang = back.perp_dot(dir).atan2(back.dot(dir));
+                        if ang <= 0.0 {
+                            ang += std::f64::consts::TAU;
+                        }
+                        if best.is_none_or(|(_, b)| ang > b) {
+                            best = Some((e, ang));
+                        }
+                    }
+                    best.map_or(only, |b| b.0)
                 };
                 if e == e0 {
                     closed = true;
                     break;
                 }
-                used[e] = true;
-                verts.push(edges[e].0);
+                cb.used[e] = true;
+                cb.loop_verts.push(edges[e].0);
                 cur = e;
             }
-            if !closed || verts.len() < 3 {
+            let len = cb.loop_verts.len() - start;
+            if !closed || len < 3 {
+                cb.loop_verts.truncate(start);
                 continue;
             }
-            let pts: Vec<DVec2> = verts.iter().map(|&i| p2(i)).collect();
-            let area = signed_area(&pts);
+            let vs = &cb.loop_verts[start..];
+            let area = signed_area_by(len, |i| p2(vs[i]));
             if area.abs() <= tol * tol {
+                cb.loop_verts.truncate(start);
                 continue;
             }
-            loops.push((verts, edges[e0].2, area));
+            cb.loops.push((start as u32, len as u32, edges[e0].2, area));
         }
         // Outer loops (counter-clockwise) become caps; each hole goes to the
         // smallest outer loop containing it.
-        let mut caps: Vec<CapCandidate> = Vec::new();
-        for (verts, face, area) in &loops {
-            if *area > 0.0 {
-                let pts = verts.iter().map(|&i| p2(i)).collect();
-                caps.push(CapCandidate {
-                    face: *face,
-                    loops: vec![verts.clone()],
-                    area: *area,
-                    outline: pts,
-                });
+        cb.owner.resize(cb.loops.len(), NONE);
+        for (li, &(_, _, face, area)) in cb.loops.iter().enumerate() {
+            if area > 0.0 {
+                cb.owner[li] = cb.caps.len() as u32;
+                cb.caps.push((li as u32, face, area));
             }
         }
-        for (verts, _, area) in &loops {
-            if *area > 0.0 {
+        let loop_of = |li: usize| {
+            let (s, n, _, _) = cb.loops[li];
+            &cb.loop_verts[s as usize..(s + n) as usize]
+        };
+        for li in 0..cb.loops.len() {
+            let area = cb.loops[li].3;
+            if area > 0.0 {
                 continue;
             }
-            let probe = hole_probe(verts, &p2, &caps);
+            let verts = loop_of(li);
+            let probe = hole_probe(verts, &p2, cb.caps.iter().map(|c| loop_of(c.0 as usize)));
             let mut best: Option<usize> = None;
-            for (ci, cap) in caps.iter().enumerate() {
-                if cap.area > -area
-                    && point_in_polygon(probe, &cap.outline)
-                    && best.is_none_or(|b| cap.area < caps[b].area)
-                {
-                    best = Some(ci);
+            for (ci, &(outer, _, cap_area)) in cb.caps.iter().enumerate() {
+                if cap_area > -area && best.is_none_or(|b| cap_area < cb.caps[b].2) {
+                    let o = loop_of(outer as usize);
+                    if point_in_polygon_by(probe, o.len(), |i| p2(o[i])) {
+                        best = Some(ci);
+                    }
                 }
             }
             if let Some(b) = best {
-                caps[b].loops.push(verts.clone());
+                cb.owner[li] = b as u32;
             }
         }
-        caps.into_iter().map(|c| (c.face, c.loops)).collect()
     }
 
     /// Builds the output meshes.
-    fn build(&self) -> Vec<Mesh> {
+    /// Where a piece of `face` starts its outer loop `cs`: at the edge that
+    /// runs most nearly like the source face's first edge (ties: the earliest
+    /// in the loop). A facade split into tiles and floors so keeps its first
+    /// edges along the ground, and the pieces' `comp(f)` scopes keep the
+    /// facade's orientation, whichever corner the cut reached first.
+    fn first_corner(&self, cs: &[WCorner], face: u32) -> usize {
         let mesh = self.mesh;
-        let closed = self.planes.is_empty() || self.input_is_closed();
-        let nparts = self.parts.len();
+        let outer = mesh.loop_indices(mesh.outer_loop(face as usize));
+        let reference = (0..outer.len())
+            .map(|i| {
+                mesh.positions[outer[(i + 1) % outer.len()] as usize]
+                    - mesh.positions[outer[i] as usize]
+            })
+            .find(|e| e.length() > self.tol)
+            .map(|e| e.normalize());
+        let Some(reference) = reference else {
+            return 0;
+        };
+        let verts = &self.bufs.verts;
+        let mut best = (f64::NEG_INFINITY, 0);
+        for i in 0..cs.len() {
+            let e = verts[cs[(i + 1) % cs.len()].v as usize] - verts[cs[i].v as usize];
+            let len = e.length();
+            if len <= self.tol {
+                continue;
+            }
+            let along = e.dot(reference) / len;
+            if along > best.0 + 1e-9 {
+                best = (along, i);
+            }
+        }
+        best.1
+    }
+
+    fn build(&mut self) -> Vec<Mesh> {
+        let mesh = self.mesh;
+        let closed = self.bufs.planes.is_empty() || self.input_is_closed();
+        self.group_items_by_part();
+        let nparts = self.nplanes() + 1;
         let mut out = Vec::with_capacity(nparts);
-        let mut remap = vec![NONE; self.verts.len()];
+        let mut bb = std::mem::take(&mut self.bufs.build);
+        let mut cb = std::mem::take(&mut self.bufs.caps);
+        bb.remap.clear();
+        bb.remap.resize(self.bufs.verts.len(), NONE);
         for part in 0..nparts {
-            let mut m = empty_like(mesh);
-            let mut sources: Vec<WCorner> = Vec::new();
-            let mut cap_normals: Vec<DVec3> = Vec::new();
-            let mut touched: Vec<u32> = Vec::new();
-            let mut map = |v: u32, m: &mut Mesh, touched: &mut Vec<u32>| {
-                if remap[v as usize] == NONE {
-                    remap[v as usize] = m.positions.len() as u32;
-                    m.positions.push(self.verts[v as usize]);
+            bb.touched.clear();
+            bb.corners.clear();
+            bb.loops.clear();
+            bb.faces.clear();
+            bb.sources.clear();
+            bb.cap_normals.clear();
+            let BuildBufs {
+                remap,
+                touched,
+                corners,
+                loops,
+                faces,
+                sources,
+                cap_normals,
+                ..
+            } = &mut bb;
+            let mut map = |v: u32| {
+                let r = &mut remap[v as usize];
+                if *r == NONE {
+                    *r = touched.len() as u32;
                     touched.push(v);
                 }
-                remap[v as usize]
+                *r
             };
-            let push_face = |m: &mut Mesh, mat: u32, group: u32, nloops: u32| {
-                m.faces.push(Face {
-                    first_loop: m.loops.len() as u32 - nloops,
+            let push_face = |loops: &Vec<Loop>, faces: &mut Vec<Face>, f: Face, nloops: u32| {
+                faces.push(Face {
+                    first_loop: loops.len() as u32 - nloops,
                     loop_count: nloops,
-                    material: mat,
-                    group,
+                    material: f.material,
+                    group: f.group,
                 });
             };
-            for item in &self.parts[part] {
+            let items = self.part_items(part);
+            for item in items {
                 match *item {
                     Item::Whole(face) => {
                         let f = mesh.faces[face as usize];
                         for &l in mesh.face_loops(face as usize) {
-                            let start = m.corners.len() as u32;
+                            let start = corners.len() as u32;
                             for c in mesh.loop_corners(l) {
-                                let p = map(self.original_vertex(c as u32), &mut m, &mut touched);
-                                m.corners.push(p);
+                                corners.push(map(self.original_vertex(c as u32)));
                                 sources.push(WCorner {
                                     v: 0,
                                     a: c as u32,
@@ -1021,43 +1778,52 @@ impl<'m> Cutter<'m> {
                                     t: 0.0,
                                 });
                             }
-                            m.loops.push(Loop { start, len: l.len });
+                            loops.push(Loop { start, len: l.len });
                         }
-                        push_face(&mut m, f.material, f.group, f.loop_count);
+                        push_face(loops, faces, f, f.loop_count);
                     }
                     Item::Piece(p) => {
-                        let rec = self.pieces[p as usize];
+                        let rec = self.bufs.pieces_rec[p as usize];
                         let f = mesh.faces[rec.face as usize];
                         for li in rec.first..rec.first + rec.count {
-                            let (s, n) = self.store_loops[li as usize];
-                            let start = m.corners.len() as u32;
-                            for c in &self.store_corners[s as usize..(s + n) as usize] {
-                                let p = map(c.v, &mut m, &mut touched);
-                                m.corners.push(p);
+                            let (s, n) = self.bufs.store_loops[li as usize];
+                            let cs = &self.bufs.store_corners[s as usize..(s + n) as usize];
+                            // The outer loop starts where its first edge runs
+                            // like the source face's first edge.
+                            let shift = if li == rec.first {
+                                self.first_corner(cs, rec.face)
+                            } else {
+                                0
+                            };
+                            let start = corners.len() as u32;
+                            for i in 0..cs.len() {
+                                let c = &cs[(i + shift) % cs.len()];
+                                corners.push(map(c.v));
                                 sources.push(*c);
                             }
-                            m.loops.push(Loop { start, len: n });
+                            loops.push(Loop { start, len: n });
                         }
-                        push_face(&mut m, f.material, f.group, rec.count);
+                        push_face(loops, faces, f, rec.count);
                     }
                 }
             }
-            if closed && !self.parts[part].is_empty() {
-                let mut all_caps = Vec::new();
-                if part > 0 {
-                    all_caps.push((self.caps(part, part - 1, -self.n), -self.n));
-                }
-                if part < self.planes.len() {
-                    all_caps.push((self.caps(part, part, self.n), self.n));
-                }
-                for (caps, outward) in all_caps {
-                    for (face, loops) in caps {
+            if closed && !items.is_empty() {
+                for (plane, outward) in [
+                    (part.checked_sub(1), -self.n),
+                    ((part < self.nplanes()).then_some(part), self.n),
+                ] {
+                    let Some(plane) = plane else { continue };
+                    self.caps(part, plane, outward, &mut cb);
+                    for (ci, &(outer, face, _)) in cb.caps.iter().enumerate() {
                         let f = mesh.faces[face as usize];
-                        for l in &loops {
-                            let start = m.corners.len() as u32;
-                            for &v in l {
-                                let p = map(v, &mut m, &mut touched);
-                                m.corners.push(p);
+                        let holes = (0..cb.loops.len())
+                            .filter(|&l| l != outer as usize && cb.owner[l] == ci as u32);
+                        let mut nloops = 0;
+                        for li in std::iter::once(outer as usize).chain(holes) {
+                            let (s, n, _, _) = cb.loops[li];
+                            let start = corners.len() as u32;
+                            for &v in &cb.loop_verts[s as usize..(s + n) as usize] {
+                                corners.push(map(v));
                                 sources.push(WCorner {
                                     v: cap_normals.len() as u32,
                                     a: CAP,
@@ -1065,17 +1831,21 @@ impl<'m> Cutter<'m> {
                                     t: 0.0,
                                 });
                             }
-                            m.loops.push(Loop {
-                                start,
-                                len: l.len() as u32,
-                            });
+                            loops.push(Loop { start, len: n });
+                            nloops += 1;
                         }
                         cap_normals.push(outward);
-                        push_face(&mut m, f.material, f.group, loops.len() as u32);
+                        push_face(loops, faces, f, nloops);
                     }
                 }
             }
-            for v in touched {
+            let verts = &self.bufs.verts;
+            let mut m = empty_like(mesh);
+            m.positions = touched.iter().map(|&v| verts[v as usize]).collect();
+            m.corners = corners.to_vec();
+            m.loops = loops.to_vec();
+            m.faces = faces.to_vec();
+            for &v in touched.iter() {
                 remap[v as usize] = NONE;
             }
             // Per-corner attributes.
@@ -1117,43 +1887,73 @@ impl<'m> Cutter<'m> {
             }
             out.push(m);
         }
+        self.bufs.build = bb;
+        self.bufs.caps = cb;
         out
     }
 }
 
-/// A cap being assembled: an outer loop (then holes) of vertex ids.
-struct CapCandidate {
-    /// The face whose material and group the cap takes.
-    face: u32,
-    loops: Vec<Vec<u32>>,
-    area: f64,
-    /// The outer loop in plane coordinates.
-    outline: Vec<DVec2>,
+/// The loop `corners` from crossing `x0` on edge `e0` along the loop to
+/// crossing `x1` on edge `e1`, into `piece`.
+fn trace_piece(
+    corners: &[WCorner],
+    piece: &mut Vec<WCorner>,
+    (x0, e0): (WCorner, usize),
+    (x1, e1): (WCorner, usize),
+) {
+    let n = corners.len();
+    piece.clear();
+    piece.push(x0);
+    let mut e = e0;
+    loop {
+        e = if e + 1 == n { 0 } else { e + 1 };
+        piece.push(corners[e]);
+        if e == e1 {
+            break;
+        }
+    }
+    piece.push(x1);
 }
 
-fn signed_area(pts: &[DVec2]) -> f64 {
-    let n = pts.len();
+/// An undirected edge as one sortable key (lower id in the high half).
+fn edge_key(a: u32, b: u32) -> u64 {
+    ((a.min(b) as u64) << 32) | a.max(b) as u64
+}
+
+/// Signed area of the polygon of points `pt(0..n)` (counter-clockwise
+/// positive).
+fn signed_area_by(n: usize, pt: impl Fn(usize) -> DVec2) -> f64 {
     let mut a = 0.0;
     for i in 0..n {
-        a += pts[i].perp_dot(pts[(i + 1) % n]);
+        a += pt(i).perp_dot(pt(if i + 1 == n { 0 } else { i + 1 }));
     }
     0.5 * a
 }
 
-/// Even-odd point in polygon test.
+/// Even-odd point in polygon test. The cut itself uses
+/// [`point_in_polygon_by`]; this slice form stays for the other geometry
+/// modules of the crate.
+#[allow(dead_code)]
 pub(crate) fn point_in_polygon(q: DVec2, pts: &[DVec2]) -> bool {
-    let n = pts.len();
+    point_in_polygon_by(q, pts.len(), |i| pts[i])
+}
+
+/// Even-odd test of `q` against the polygon of points `pt(0..n)`.
+fn point_in_polygon_by(q: DVec2, n: usize, pt: impl Fn(usize) -> DVec2) -> bool {
     let mut inside = false;
-    let mut j = n.wrapping_sub(1);
+    if n == 0 {
+        return inside;
+    }
+    let mut b = pt(n - 1);
     for i in 0..n {
-        let (a, b) = (pts[i], pts[j]);
+        let a = pt(i);
         if (a.y > q.y) != (b.y > q.y) {
             let x = a.x + (q.y - a.y) / (b.y - a.y) * (b.x - a.x);
             if q.x < x {
                 inside = !inside;
             }
         }
-        j = i;
+        b = a;
     }
     inside
 }
@@ -1161,13 +1961,15 @@ pub(crate) fn point_in_polygon(q: DVec2, pts: &[DVec2]) -> bool {
 /// A point of a hole loop to test containment with: the midpoint of its
 /// first edge that is not on the boundary of a candidate outer loop
 /// (holes may touch their outer loop at vertices).
-fn hole_probe(verts: &[u32], p2: &impl Fn(u32) -> DVec2, caps: &[CapCandidate]) -> DVec2 {
+fn hole_probe<'a>(
+    verts: &[u32],
+    p2: &impl Fn(u32) -> DVec2,
+    outers: impl Iterator<Item = &'a [u32]> + Clone,
+) -> DVec2 {
     let n = verts.len();
     for i in 0..n {
         let (a, b) = (verts[i], verts[(i + 1) % n]);
-        let shared = caps
-            .iter()
-            .any(|c| c.loops[0].contains(&a) && c.loops[0].contains(&b));
+        let shared = outers.clone().any(|o| o.contains(&a) && o.contains(&b));
         if !shared {
             return (p2(a) + p2(b)) * 0.5;
         }
@@ -1674,6 +2476,124 @@ pub(crate) mod tests {
             prop_assert!(a.is_empty() || closed(&a));
             prop_assert!(b.is_empty() || closed(&b));
             prop_assert!((non_cap_area(&a) + non_cap_area(&b) - mesh_area(&m)).abs() <= 1e-9 * mesh_area(&m));
+        }
+    }
+
+    /// `split_along_axis` by the general path only, and the number of
+    /// splits the fast path did in the normal run.
+    fn split_both_ways(m: &Mesh, axis: usize, cuts: &[f64]) -> (Vec<Mesh>, Vec<Mesh>, usize) {
+        SIMPLE_SPLITS.with(|c| c.set(0));
+        let fast = split_along_axis(m, axis, cuts);
+        let used = SIMPLE_SPLITS.with(|c| c.get());
+        GENERAL_PATH_ONLY.with(|g| g.set(true));
+        let general = split_along_axis(m, axis, cuts);
+        GENERAL_PATH_ONLY.with(|g| g.set(false));
+        (fast, general, used)
+    }
+
+    #[test]
+    fn fast_path_splits_boxes_and_quads_as_the_general_path() {
+        // Floors of a mass: every side face crosses 3 planes, all split by
+        // the fast path; the output is the same, face for face.
+        let mass = prism(&[(0., 0.), (20., 0.), (20., -30.), (0., -30.)], &[], 10.0);
+        let (fast, general, used) = split_both_ways(&mass, 1, &[0.0, 3.0, 6.0, 9.0, 10.0]);
+        assert_eq!(used, 12);
+        assert_eq!(fast, general);
+        assert_eq!(
+            fast.iter().map(|m| m.faces.len()).collect::<Vec<_>>(),
+            vec![0, 6, 6, 6, 6, 0]
+        );
+        // A facade with UVs into tiles, cuts on its borders included.
+        let mut q = Mesh::polygon(&[
+            v(0., 0., 0.),
+            v(20., 0., 0.),
+            v(20., 10., 0.),
+            v(0., 10., 0.),
+        ]);
+        q.uvs[0] = Some(vec![
+            DVec2::new(0., 0.),
+            DVec2::new(1., 0.),
+            DVec2::new(1., 1.),
+            DVec2::new(0., 1.),
+        ]);
+        let cuts: Vec<f64> = (0..=10).map(|i| i as f64 * 2.0).collect();
+        let (fast, general, used) = split_both_ways(&q, 0, &cuts);
+        assert_eq!(used, 9);
+        assert_eq!(fast, general);
+        // Tile 3 spans x in [4, 6]; UVs are interpolated along the edges.
+        let t = &fast[3];
+        assert_eq!((t.faces.len(), t.positions.len()), (1, 4));
+        let uv = t.uvs[0].as_ref().unwrap();
+        for (k, &c) in t.corners.iter().enumerate() {
+            let p = t.positions[c as usize];
+            assert!(p.x == 4.0 || p.x == 6.0);
+            assert!((uv[k] - DVec2::new(p.x / 20.0, p.y / 10.0)).length() < 1e-15);
+        }
+        // A cut through a vertex is left to the general path.
+        let (fast, general, used) = split_both_ways(&q, 0, &[20.0]);
+        assert_eq!((used, fast.len()), (0, 2));
+        assert_eq!(fast, general);
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 300, .. ProptestConfig::default() })]
+
+        /// Random planar convex quads in any orientation, with UVs and
+        /// normals, cut along any axis, some cuts through their vertices.
+        #[test]
+        fn fast_path_equals_general_path_on_quads(
+            o in prop::array::uniform3(-5.0f64..5.0),
+            u in prop::array::uniform3(-3.0f64..3.0),
+            w in prop::array::uniform3(-3.0f64..3.0),
+            stretch in 0.3f64..1.7,
+            shear in -0.4f64..0.4,
+            axis in 0usize..3,
+            fr in prop::collection::vec(-0.2f64..1.2, 1..8),
+            through_vertex in prop::option::of(0usize..4),
+        ) {
+            let (o, u, w) = (DVec3::from(o), DVec3::from(u), DVec3::from(w));
+            prop_assume!(u.cross(w).length() > 0.1);
+            // Convex: a parallelogram with one corner pushed outwards.
+            let pts = [o, o + u, o + u + w * stretch, o + w + u * shear];
+            let mut m = Mesh::polygon(&pts);
+            m.uvs[0] = Some((0..4).map(|i| DVec2::new(i as f64, 0.5 * i as f64)).collect());
+            m.normals = Some(vec![u.cross(w).normalize(); 4]);
+            let lo = pts.iter().map(|p| p[axis]).fold(f64::INFINITY, f64::min);
+            let hi = pts.iter().map(|p| p[axis]).fold(f64::NEG_INFINITY, f64::max);
+            let mut cuts: Vec<f64> = fr.iter().map(|f| lo + f * (hi - lo)).collect();
+            if let Some(k) = through_vertex {
+                cuts.push(pts[k][axis]);
+            }
+            cuts.sort_by(f64::total_cmp);
+            let (fast, general, _) = split_both_ways(&m, axis, &cuts);
+            prop_assert_eq!(fast, general);
+        }
+
+        /// Boxes, axis-aligned or rotated, split along any axis.
+        #[test]
+        fn fast_path_equals_general_path_on_boxes(
+            size in prop::array::uniform3(0.1f64..10.0),
+            at in prop::array::uniform3(-10.0f64..10.0),
+            turn in prop::option::of((0.0f64..3.0, 0.0f64..1.0)),
+            axis in 0usize..3,
+            fr in prop::collection::vec(-0.2f64..1.2, 1..8),
+            snap in any::<bool>(),
+        ) {
+            let mut b = crate::primitive::cube(DVec3::from(size));
+            if let Some((y, x)) = turn {
+                let r = glam::DAffine3::from_rotation_y(y) * glam::DAffine3::from_rotation_x(x);
+                crate::transform::transform(&mut b, &r);
+            }
+            b.map_positions(|p| p + DVec3::from(at));
+            let lo = b.positions.iter().map(|p| p[axis]).fold(f64::INFINITY, f64::min);
+            let hi = b.positions.iter().map(|p| p[axis]).fold(f64::NEG_INFINITY, f64::max);
+            let mut cuts: Vec<f64> = fr.iter().map(|f| {
+                let f = if snap { (f * 4.0).round() / 4.0 } else { *f };
+                lo + f * (hi - lo)
+            }).collect();
+            cuts.sort_by(f64::total_cmp);
+            let (fast, general, _) = split_both_ways(&b, axis, &cuts);
+            prop_assert_eq!(fast, general);
         }
     }
 }

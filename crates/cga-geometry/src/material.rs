@@ -1,6 +1,12 @@
 //! Materials as CGA describes them (`material.*` shape attributes).
 
-use std::sync::Arc;
+use std::sync::{Arc, LazyLock};
+
+/// Shared strings for the defaults: a default material is made for every
+/// new mesh, and `Arc::from("")` would allocate each time.
+static EMPTY: LazyLock<Arc<str>> = LazyLock::new(|| Arc::from(""));
+static SHADER: LazyLock<Arc<str>> = LazyLock::new(|| Arc::from("CityEngineShader"));
+static BLEND: LazyLock<Arc<str>> = LazyLock::new(|| Arc::from("blend"));
 
 /// The ten texture channels, in the order of CGA's texture layers / UV sets:
 /// the channel at index `k` uses UV set `k`.
@@ -32,7 +38,7 @@ pub struct TextureChannel {
 impl Default for TextureChannel {
     fn default() -> Self {
         TextureChannel {
-            path: Arc::from(""),
+            path: EMPTY.clone(),
             su: 1.0,
             sv: 1.0,
             tu: 0.0,
@@ -68,8 +74,8 @@ pub struct Material {
 impl Default for Material {
     fn default() -> Self {
         Material {
-            name: Arc::from(""),
-            shader: Arc::from("CityEngineShader"),
+            name: EMPTY.clone(),
+            shader: SHADER.clone(),
             color: [1.0; 3],
             ambient: [0.0; 3],
             specular: [0.0; 3],
@@ -81,7 +87,7 @@ impl Default for Material {
             metallic: 0.0,
             roughness: 1.0,
             double_sided: true,
-            opacitymap_mode: Arc::from("blend"),
+            opacitymap_mode: BLEND.clone(),
             opacitymap_cutoff: 0.5,
             maps: Default::default(),
         }

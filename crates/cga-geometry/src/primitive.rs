@@ -111,7 +111,7 @@ pub fn cube(size: DVec3) -> Mesh {
     let with = |idx: [u32; 4], n: DVec3| -> Vec<(u32, DVec2, DVec3)> {
         (0..4).map(|k| (idx[k], uv[k], n)).collect()
     };
-    face(&mut m, &with([1, 0, 3, 2], -DVec3::Y));
+    face(&mut m, &with([3, 2, 1, 0], -DVec3::Y));
     face(&mut m, &with([4, 5, 6, 7], DVec3::Y));
     let outward = [DVec3::Z, DVec3::X, -DVec3::Z, -DVec3::X];
     for i in 0..4u32 {

@@ -94,6 +94,39 @@ fn cell_key(p: DVec3, cell: f64) -> [i64; 3] {
 pub fn weld_points(points: &[DVec3], tol: f64) -> Weld {
     let mut id = Vec::with_capacity(points.len());
     let mut representative: Vec<u32> = Vec::new();
+    weld_points_into(points, tol, &mut id, &mut representative);
+    Weld {
+        count: representative.len(),
+        id,
+        representative,
+    }
+}
+
+/// Up to this many points, [`weld_points_into`] first tries a plain scan of
+/// the representatives: cheaper than hashing for the boxes and quads most
+/// shapes are.
+const SMALL_WELD: usize = 40;
+
+/// [`weld_points`] into reused buffers: `id` and `representative` are
+/// cleared and filled as the fields of [`Weld`] are.
+pub(crate) fn weld_points_into(
+    points: &[DVec3],
+    tol: f64,
+    id: &mut Vec<u32>,
+    representative: &mut Vec<u32>,
+) {
+    id.clear();
+    representative.clear();
+    if points.len() <= SMALL_WELD && weld_small(points, tol, id, representative) {
+        return;
+    }
+    weld_grid(points, tol, id, representative);
+}
+
+/// Welding with a hash grid (or, for `tol <= 0`, a hash of the bits).
+fn weld_grid(points: &[DVec3], tol: f64, id: &mut Vec<u32>, representative: &mut Vec<u32>) {
+    id.clear();
+    representative.clear();
     if tol <= 0.0 || !tol.is_finite() {
         let mut seen: FxHashMap<[u64; 3], u32> = fx_map(points.len());
         for (i, p) in points.iter().enumerate() {
@@ -155,11 +188,46 @@ pub fn weld_points(points: &[DVec3], tol: f64) -> Weld {
             id.push(v);
         }
     }
-    Weld {
-        count: representative.len(),
-        id,
-        representative,
+}
+
+/// Welding by scanning all representatives, for few points. It only
+/// decides the plain case, where every point is either bitwise equal (up to
+/// the sign of zero) to one representative and farther than `tol` from all
+/// others, or farther than `tol` from all: there the hash grid finds the
+/// same clusters. Anything closer (points within `tol` but not equal, or
+/// near several representatives) returns false, leaving the grid to decide,
+/// so the result never depends on the path taken.
+fn weld_small(
+    points: &[DVec3],
+    tol: f64,
+    id: &mut Vec<u32>,
+    representative: &mut Vec<u32>,
+) -> bool {
+    let exact = tol <= 0.0 || !tol.is_finite();
+    for (i, &p) in points.iter().enumerate() {
+        let p = p + DVec3::ZERO;
+        let mut found = u32::MAX;
+        for (r, &ri) in representative.iter().enumerate() {
+            let q = points[ri as usize] + DVec3::ZERO;
+            let equal = q.x.to_bits() == p.x.to_bits()
+                && q.y.to_bits() == p.y.to_bits()
+                && q.z.to_bits() == p.z.to_bits();
+            if equal {
+                if found != u32::MAX {
+                    return false;
+                }
+                found = r as u32;
+            } else if !exact && (q - p).abs().max_element() <= tol {
+                return false;
+            }
+        }
+        if found == u32::MAX {
+            found = representative.len() as u32;
+            representative.push(i as u32);
+        }
+        id.push(found);
     }
+    true
 }
 
 /// One use of an edge by a face: the corner the edge starts at (the edge runs
@@ -322,6 +390,42 @@ impl Topology {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// The scan for few points agrees with the grid whenever it
+        /// decides: points on a coarse lattice (so many coincide, up to
+        /// the sign of zero), some moved by less than the tolerance.
+        #[test]
+        fn small_welding_agrees_with_the_grid(
+            pts in prop::collection::vec((prop::array::uniform3(-2i32..3), 0u8..4), 1..40),
+            tol in prop::sample::select(vec![0.0, 1e-9, 1e-3]),
+        ) {
+            let points: Vec<DVec3> = pts
+                .iter()
+                .map(|(c, jitter)| {
+                    let p = DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64) * 0.5;
+                    match jitter {
+                        0 => p + DVec3::X * 0.3 * tol,
+                        1 => -p,
+                        _ => p,
+                    }
+                })
+                .collect();
+            let (mut id, mut rep) = (Vec::new(), Vec::new());
+            let decided = weld_small(&points, tol, &mut id, &mut rep);
+            let (mut gid, mut grep) = (Vec::new(), Vec::new());
+            weld_grid(&points, tol, &mut gid, &mut grep);
+            if decided {
+                prop_assert_eq!(&id, &gid);
+                prop_assert_eq!(&rep, &grep);
+            }
+            // Whichever path it takes, `weld_points` gives the grid's result.
+            let w = weld_points(&points, tol);
+            prop_assert_eq!(w.id, gid);
+            prop_assert_eq!(w.representative, grep);
+        }
+    }
 
     #[test]
     fn welding_exact_and_with_tolerance() {
@@ -345,6 +449,29 @@ mod tests {
         let b = a + DVec3::splat(0.5 * t);
         let c = a + DVec3::new(2.0 * t, 0.0, 0.0);
         assert_eq!(weld_points(&[a, b, c], t).id, vec![0, 0, 1]);
+    }
+
+    #[test]
+    fn few_points_are_welded_by_the_scan() {
+        // The 24 corners of a cube (each position repeated per face, one
+        // with a negative zero) weld to 8 without the grid.
+        let cube = crate::primitive::cube(DVec3::new(1.0, 2.0, 3.0));
+        let mut points: Vec<DVec3> = cube
+            .corners
+            .iter()
+            .map(|&c| cube.positions[c as usize])
+            .collect();
+        assert_eq!(points.len(), 24);
+        let zero_x = points.iter().position(|p| p.x == 0.0).unwrap();
+        points[zero_x].x = -0.0;
+        let (mut id, mut rep) = (Vec::new(), Vec::new());
+        assert!(weld_small(&points, 1e-9, &mut id, &mut rep));
+        assert_eq!(rep.len(), 8);
+        assert_eq!(weld_points(&points, 1e-9).id, id);
+        // A point within the tolerance but not equal is left to the grid.
+        points.push(points[3] + DVec3::X * 1e-12);
+        assert!(!weld_small(&points, 1e-9, &mut id, &mut rep));
+        assert_eq!(weld_points(&points, 1e-9).count, 8);
     }
 
     #[test]

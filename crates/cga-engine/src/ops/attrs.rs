@@ -97,10 +97,6 @@ pub fn exec(
                 shape.set_local_mesh(mesh);
             }
         }
-        Op::Texture => {
-            let m = Arc::make_mut(&mut shape.material);
-            set_field(m, MatField::Map(0), &args[0].value, &args[0])?;
-        }
         Op::Print => cx.out.prints.push(to_text(&args[0].value)),
         Op::Report => {
             let key = match &args[0].value {

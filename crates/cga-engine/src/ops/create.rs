@@ -177,10 +177,7 @@ fn insert(cx: &mut Interp, shape: &mut Shape, call: &OpCall, args: &[Arg]) -> Re
     if let Some(a) = args.get(3) {
         selector(a, &["numericalCleanup", "noCleanup"])?;
     }
-    let asset = match builtin_asset(path) {
-        Some(m) => Ok(Arc::new(m)),
-        None => cx.assets.mesh(call.span.file, path),
-    };
+    let asset = cx.assets.mesh(call.span.file, path);
     match asset {
         Ok(mut mesh) => {
             if up_z {
@@ -199,22 +196,6 @@ fn insert(cx: &mut Interp, shape: &mut Shape, call: &OpCall, args: &[Arg]) -> Re
         }
     }
     Ok(())
-}
-
-/// The built-in geometry assets (`builtin:cube`, ...), as unit shapes.
-fn builtin_asset(path: &str) -> Option<Mesh> {
-    use cga_geometry::primitive as p;
-    let name = path.strip_prefix("builtin:")?;
-    let name = name.strip_suffix(".obj").unwrap_or(name);
-    Some(match name {
-        "cube" => p::builtin_cube(),
-        "quad" => p::quad(1.0, 1.0),
-        "disk" => p::disk(16, 1.0, 1.0),
-        "sphere" => p::sphere(16, 16, DVec3::ONE),
-        "cylinder" => p::cylinder(16, DVec3::ONE),
-        "cone" => p::cone(16, DVec3::ONE),
-        _ => return None,
-    })
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]

@@ -11,6 +11,7 @@ mod roof;
 mod scope_ops;
 pub mod split;
 pub mod split_area;
+pub mod texturing;
 mod transform;
 
 use cga_value::Value;
@@ -87,6 +88,16 @@ pub enum Op {
     Mirror,
     ReduceGeometry,
     Rectify,
+    SetupProjection,
+    ProjectUV,
+    TranslateUV,
+    ScaleUV,
+    RotateUV,
+    NormalizeUV,
+    TileUV,
+    DeleteUV,
+    CopyUV,
+    InsertAlongUV,
 }
 
 /// How an operation's arguments are read by the resolver.
@@ -111,6 +122,8 @@ pub enum ArgMode {
 pub fn arg_mode(name: &str, arity: usize, pos: usize) -> ArgMode {
     use ArgMode::*;
     match (name, arity, pos) {
+        // The uv split's uv set is a number: `split(u, uvSpace, set)`.
+        ("split", 3, 2) => Expr,
         (
             "split" | "splitArea" | "comp" | "center" | "alignScopeToAxes" | "resetMaterial",
             _,
@@ -124,6 +137,7 @@ pub fn arg_mode(name: &str, arity: usize, pos: usize) -> ArgMode {
         ("setPivot", _, 0) => Selector,
         ("i", _, 1..) => Selector,
         ("setupProjection", _, 1) => Selector,
+        ("normalizeUV", _, 1 | 2) => Selector,
         ("offset", 2, 1) => Selector,
         ("envelope", _, 0) => Selector,
         ("setback" | "setbackPerEdge" | "setbackToArea" | "shapeL" | "shapeU" | "shapeO", _, _) => {
@@ -182,6 +196,16 @@ pub fn lookup(name: &str) -> Option<OpInfo> {
         "mirrorScope" => info(Op::MirrorScope, 3, 3),
         "resetGeometry" => info(Op::ResetGeometry, 0, 0),
         "reverseNormals" => info(Op::ReverseNormals, 0, 0),
+        "setupProjection" => info(Op::SetupProjection, 4, 7),
+        "projectUV" => info(Op::ProjectUV, 1, 1),
+        "translateUV" => info(Op::TranslateUV, 3, 3),
+        "scaleUV" => info(Op::ScaleUV, 3, 3),
+        "rotateUV" => info(Op::RotateUV, 2, 2),
+        "normalizeUV" => info(Op::NormalizeUV, 3, 3),
+        "tileUV" => info(Op::TileUV, 3, 3),
+        "deleteUV" => info(Op::DeleteUV, 1, 1),
+        "copyUV" => info(Op::CopyUV, 2, 2),
+        "insertAlongUV" => info(Op::InsertAlongUV, 3, 5),
         "split" => Some(OpInfo {
             op: Op::Split,
             min_args: 1,
@@ -341,13 +365,20 @@ pub fn exec(
         | Op::PrimitiveCone
         | Op::Insert
         | Op::ReverseNormals => create::exec(cx, st, call, args),
-        Op::Color
-        | Op::Set(_)
-        | Op::SetMaterial
-        | Op::ResetMaterial
-        | Op::Texture
-        | Op::Print
-        | Op::Report => attrs::exec(cx, st, call, args),
+        Op::Color | Op::Set(_) | Op::SetMaterial | Op::ResetMaterial | Op::Print | Op::Report => {
+            attrs::exec(cx, st, call, args)
+        }
+        Op::SetupProjection
+        | Op::ProjectUV
+        | Op::TranslateUV
+        | Op::ScaleUV
+        | Op::RotateUV
+        | Op::NormalizeUV
+        | Op::TileUV
+        | Op::DeleteUV
+        | Op::CopyUV
+        | Op::InsertAlongUV
+        | Op::Texture => texturing::exec(cx, st, call, args),
         Op::AlignScopeToAxes
         | Op::AlignScopeToGeometry
         | Op::SetPivot

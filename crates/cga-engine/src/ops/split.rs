@@ -7,6 +7,9 @@
 //! `cga_geometry::split_along_axis`), and runs each part's operations on a
 //! new shape whose scope is the part's (`noAdjust`) or the bounding box of
 //! its geometry in the parent's orientation (`adjust`, the default).
+//!
+//! `split(u|v, uvSpace|unitSpace, uvSet) { ... }` splits in texture space
+//! instead (see [`uv_split`]).
 
 use std::sync::Arc;
 
@@ -36,11 +39,7 @@ pub fn exec(
     };
     let axis_name = selector(&args[0], &["x", "y", "z", "u", "v"])?;
     if matches!(axis_name, "u" | "v") {
-        cx.warn_once(call.span, || {
-            "the uv split (`split(u|v, ...)`) is not supported yet; the shape is left unchanged"
-                .to_string()
-        });
-        return Ok(());
+        return uv_split(cx, st, call, args, frame, block, axis_name == "v");
     }
     let axis = match axis_name {
         "x" => 0,
@@ -190,4 +189,104 @@ pub(crate) fn place_part(
     if adjust && !empty {
         child.fit_scope(axes);
     }
+}
+
+/// `split(u|v, uvSpace|unitSpace, set) { ... }`: the parts are laid out as
+/// in the xyz split, between the smallest and the largest value of the
+/// coordinate in UV set `set`, and the geometry is cut along the lines where
+/// the coordinate takes the part boundaries
+/// ([`texturing::cut_along_uv`](super::texturing::cut_along_uv)).
+///
+/// In `uvSpace` sizes are texture coordinates. In `unitSpace` they are
+/// scene units on the surface: the coordinate's range is converted with the
+/// surface's average length per unit of the coordinate (area-weighted over
+/// the faces, `geometry.du(set, unitSpace)` divided by `geometry.du(set,
+/// uvSpace)`), exact for projected and other affine parameterisations.
+///
+/// Each part's scope is the bounding box of its geometry in the parent's
+/// orientation. A shape without texture coordinates in `set` stays as it
+/// is, with a warning.
+fn uv_split(
+    cx: &mut Interp,
+    st: &mut ShapeState,
+    call: &OpCall,
+    args: &[Arg],
+    frame: &[Value],
+    block: &RBlock<RBody>,
+    along_v: bool,
+) -> Result<(), RtError> {
+    let (Some(space), Some(set)) = (args.get(1), args.get(2)) else {
+        return Err(RtError::new(
+            "the uv split needs a space and a uv set: `split(u|v, uvSpace|unitSpace, uvSet) { ... }`",
+            call.span,
+        ));
+    };
+    let unit_space = selector(space, &["uvSpace", "unitSpace"])? == "unitSpace";
+    let set = super::texturing::uv_set(set)?;
+    let axis = usize::from(along_v);
+    let mesh = st.shape.geometry.local().clone();
+    let bounds = cga_geometry::measure::uv_bounds(&mesh, set);
+    let scale = if unit_space {
+        cga_geometry::measure::uv_unit_scale(&mesh, set).map(|s| s[axis])
+    } else {
+        Some(1.0)
+    };
+    let (Some((lo, hi)), Some(scale)) = (bounds, scale.filter(|s| *s > 0.0 && s.is_finite()))
+    else {
+        cx.warn_once(call.span, || {
+            format!("split: the shape has no usable texture coordinates in uv set {set}; it is left unchanged")
+        });
+        return Ok(());
+    };
+    let (start, end) = (lo[axis], hi[axis]);
+
+    let mut pattern = SplitPattern::new(block.repeat);
+    let mut bodies: Vec<&RBody> = Vec::new();
+    add_parts(cx, frame, &st.shape, block, &mut pattern, &mut bodies)?;
+    let placed: Vec<Placed> = crate::split_layout::layout(&pattern, (end - start) * scale)
+        .map_err(|e| RtError::new(format!("split: {e:?}"), call.span))?
+        .into_iter()
+        .filter(|p| p.end - p.start >= MIN_PART_SIZE)
+        .collect();
+    st.has_successor = true;
+    if placed.is_empty() {
+        return Ok(());
+    }
+
+    let coord = |d: f64| start + d / scale;
+    let mut cuts: Vec<f64> = placed
+        .iter()
+        .flat_map(|p| [coord(p.start), coord(p.end)])
+        .collect();
+    cuts.sort_by(f64::total_cmp);
+    cuts.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * (1.0 + a.abs()));
+    let slabs = super::texturing::cut_along_uv(&mesh, set, axis, &cuts);
+    // Slab i lies between cuts[i-1] and cuts[i].
+    let slab_index = |c: f64| cuts.partition_point(|&x| x < c - 1e-12 * (1.0 + c.abs()));
+    let axes = st.shape.scope.frame.axes;
+    let total = placed.len() as f64;
+    for part in &placed {
+        let first = slab_index(coord(part.start)) + 1;
+        let last = slab_index(coord(part.end));
+        let mut piece = Mesh::new();
+        for slab in slabs.iter().take(last + 1).skip(first) {
+            if piece.faces.is_empty() {
+                piece = slab.clone();
+            } else {
+                cga_geometry::transform::merge(&mut piece, slab);
+            }
+        }
+        let mut child = cx.child(&st.shape, call.span)?;
+        let empty = piece.faces.is_empty();
+        child.set_local_mesh(piece);
+        if !empty {
+            child.fit_scope(axes);
+        }
+        child.split_index = part.index as f64;
+        child.split_total = total;
+        let mut cst = ShapeState::new(child);
+        cx.exec_body(bodies[part.part], frame, &mut cst)?;
+        cx.finish(cst);
+    }
+    Ok(())
 }

@@ -16,6 +16,7 @@
 //! | [`envelope`] | `envelope` |
 //! | [`footprint`] | `footprint`, polygon union and difference (`i_overlay`) |
 //! | [`inner_rect`] | `innerRectangle` |
+//! | [`perimeter`] | `splitAndSetbackPerimeter` |
 //! | [`primitive`] | `primitive*` and `builtin:cube` |
 //! | [`normals`] | `setNormals`, `softenNormals` |
 //! | [`obj`] | OBJ + MTL assets |
@@ -38,6 +39,7 @@ pub mod measure;
 pub mod mesh;
 pub mod normals;
 pub mod obj;
+pub mod perimeter;
 pub mod primitive;
 pub mod roof;
 pub mod roof_edges;

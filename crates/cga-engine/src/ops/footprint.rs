@@ -31,10 +31,12 @@ use cga_value::Value;
 use super::comp::FaceEdgeSelection;
 use super::transform::selector;
 use super::Op;
-use crate::derive::{Arg, Interp, RtError, ShapeState};
+use crate::derive::{Arg, Interp, RtError, ShapeState, SizeKind};
 use crate::expr::{OpCall, RBlock, RBody, RExpr, RExprKind, RPart};
 use crate::selectors::{quadrant_of, Frames, Quadrant};
 use crate::shape::Shape;
+use crate::split_layout::{Placed, Size, SplitPattern};
+use cga_geometry::perimeter;
 
 pub fn exec(
     cx: &mut Interp,
@@ -799,15 +801,215 @@ fn footprint(st: &mut ShapeState) -> Result<(), RtError> {
 
 // ----- splitAndSetbackPerimeter -----
 
+/// Evaluates the sizes of a perimeter block into `pattern` (as `split`
+/// does); `parts[k]` is entry `k`'s depth expression and operations.
+fn perimeter_parts<'b>(
+    cx: &mut Interp,
+    frame: &[Value],
+    shape: &Shape,
+    block: &'b RBlock<RBody>,
+    pattern: &mut SplitPattern,
+    parts: &mut Vec<(Option<&'b RExpr>, &'b RBody)>,
+) -> Result<(), RtError> {
+    for part in &block.parts {
+        match part {
+            RPart::Entry {
+                head, depth, body, ..
+            } => {
+                let arg = cx.eval_arg(head, frame, shape)?;
+                let x = arg.num()?;
+                pattern.push(match arg.kind {
+                    SizeKind::Absolute => Size::Absolute(x),
+                    SizeKind::Relative => Size::Relative(x),
+                    SizeKind::Floating => Size::Floating(x),
+                });
+                parts.push((depth.as_ref(), body));
+            }
+            RPart::Group(g) => {
+                pattern.open();
+                perimeter_parts(cx, frame, shape, g, pattern, parts)?;
+                pattern
+                    .close(g.repeat)
+                    .map_err(|e| RtError::new(format!("splitAndSetbackPerimeter: {e:?}"), g.span))?;
+            }
+            RPart::Unlabeled { span, .. } => {
+                return Err(RtError::new(
+                    "a splitAndSetbackPerimeter part needs a length and a depth: `length : depth : operations`",
+                    *span,
+                ))
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `splitAndSetbackPerimeter(offset [, firstEdgeIndex, selectedEdgesMask])
+/// { length : depth : operations | ... } { remainder : operations }`: the
+/// chain of selected face edges (from `firstEdgeIndex`, in face-edge order,
+/// wrapping around) is split like `split` splits a scope axis, starting at
+/// `offset` (relative: of the chain's length) and wrapping around the
+/// chain's end; every section is set back by its depth (evaluated per
+/// section, with `split.index` set) and becomes a shape; the rest of the
+/// faces is the remainder.
 fn perimeter(
     cx: &mut Interp,
-    _st: &mut ShapeState,
+    st: &mut ShapeState,
     call: &OpCall,
-    _args: &[Arg],
-    _frame: &[Value],
+    args: &[Arg],
+    frame: &[Value],
 ) -> Result<(), RtError> {
-    cx.warn_once(call.span, || {
-        "splitAndSetbackPerimeter is not supported yet; the shape is left unchanged".to_string()
-    });
+    let Some(block) = &call.block else {
+        return Err(RtError::new(
+            "`splitAndSetbackPerimeter` needs a `{ length : depth : operations | ... }` block",
+            call.span,
+        ));
+    };
+    if args.len() == 2 {
+        return Err(RtError::new(
+            "`splitAndSetbackPerimeter` takes the split offset, or the offset, the first edge index and the edge mask",
+            call.span,
+        ));
+    }
+    let mesh = st.shape.geometry.local().clone();
+    let n = face_edge_count(&mesh);
+    st.has_successor = true;
+    let lengths: Vec<f64> = {
+        let mut v = Vec::with_capacity(n);
+        for f in 0..mesh.faces.len() {
+            for &l in mesh.face_loops(f) {
+                let p: Vec<DVec3> = mesh.loop_points(l).collect();
+                for i in 0..p.len() {
+                    v.push((p[(i + 1) % p.len()] - p[i]).length());
+                }
+            }
+        }
+        v
+    };
+    let first = match args.get(1) {
+        Some(a) if n > 0 => {
+            let x = a.num()?.floor();
+            x.rem_euclid(n as f64) as usize % n
+        }
+        _ => 0,
+    };
+    let mask: Vec<bool> = match args.get(2) {
+        Some(a) => match &a.value {
+            Value::BoolArray(m) => (0..n)
+                .map(|k| m.data.get(k).copied().unwrap_or(false))
+                .collect(),
+            Value::Bool(b) => vec![*b; n],
+            other => {
+                return Err(RtError::new(
+                    format!(
+                        "the edge mask must be a bool array, found {}",
+                        crate::values::type_name(other)
+                    ),
+                    a.span,
+                ))
+            }
+        },
+        None => vec![true; n],
+    };
+    let chain: Vec<usize> = (0..n)
+        .map(|i| (first + i) % n)
+        .filter(|&k| mask[k])
+        .collect();
+    let total: f64 = chain.iter().map(|&k| lengths[k]).sum();
+    let offset = args[0].size(total)?;
+    let mut pattern = SplitPattern::new(block.repeat);
+    let mut parts = Vec::new();
+    perimeter_parts(cx, frame, &st.shape, block, &mut pattern, &mut parts)?;
+    let placed: Vec<Placed> = if total > 0.0 {
+        crate::split_layout::layout(&pattern, total)
+            .map_err(|e| RtError::new(format!("splitAndSetbackPerimeter: {e:?}"), call.span))?
+            .into_iter()
+            .filter(|p| p.size >= super::split::MIN_PART_SIZE)
+            .collect()
+    } else {
+        Vec::new()
+    };
+    // The shapes first (their random streams in order), then the depths.
+    let count = placed.len() as f64;
+    let mut children = Vec::with_capacity(placed.len());
+    let mut sections = Vec::new();
+    let mut section_of = Vec::new();
+    for (i, p) in placed.iter().enumerate() {
+        let mut child = cx.child(&st.shape, call.span)?;
+        child.split_index = p.index as f64;
+        child.split_total = count;
+        let depth = match parts[p.part].0 {
+            Some(e) => {
+                let a = cx.eval_arg(e, frame, &child)?;
+                a.num()?
+            }
+            None => 0.0,
+        };
+        children.push(child);
+        // Sections wrap around the chain's end.
+        let start = (offset + p.start).rem_euclid(total);
+        let end = start + p.size;
+        if end <= total + 1e-9 {
+            sections.push(perimeter::Section {
+                start,
+                end: end.min(total),
+                depth,
+            });
+            section_of.push(i);
+        } else {
+            sections.push(perimeter::Section {
+                start,
+                end: total,
+                depth,
+            });
+            section_of.push(i);
+            sections.push(perimeter::Section {
+                start: 0.0,
+                end: end - total,
+                depth,
+            });
+            section_of.push(i);
+        }
+    }
+    let result = perimeter::split_and_setback_perimeter(&mesh, &chain, &sections);
+    let mut meshes: Vec<Mesh> = vec![Mesh::new(); placed.len()];
+    for (s, m) in result.sections.iter().enumerate() {
+        let i = section_of[s];
+        if meshes[i].faces.is_empty() {
+            meshes[i] = m.clone();
+        } else {
+            cga_geometry::transform::merge(&mut meshes[i], m);
+        }
+    }
+    for ((p, mut child), m) in placed.iter().zip(children).zip(meshes) {
+        if m.faces.is_empty() {
+            continue;
+        }
+        place(&mut child, m);
+        let mut cst = ShapeState::new(child);
+        cx.exec_body(parts[p.part].1, frame, &mut cst)?;
+        cx.finish(cst);
+    }
+    if let Some(rb) = &call.remainder_block {
+        let entries = entries(Some(rb), "splitAndSetbackPerimeter", call.span)?;
+        for e in &entries {
+            if keyword(e.head) != Some("remainder") {
+                return Err(RtError::new(
+                    "the second block of `splitAndSetbackPerimeter` is `{ remainder : operations }`",
+                    e.head.span,
+                ));
+            }
+            let faces: Vec<usize> = (0..result.remainder.faces.len()).collect();
+            spawn(
+                cx,
+                st,
+                frame,
+                &result.remainder,
+                &faces,
+                BlockOp::Equals,
+                e.body,
+                e.span,
+            )?;
+        }
+    }
     Ok(())
 }

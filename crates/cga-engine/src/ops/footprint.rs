@@ -613,6 +613,14 @@ fn inner_rectangle(
             }
         }
     }
+    // A face that is a rectangle leaves no remainder (a face without area).
+    let tiny = 1e-9 * measure::mesh_area(&mesh).max(1.0);
+    let keep: Vec<usize> = (0..rems.faces.len())
+        .filter(|&f| measure::face_area(&rems, f) > tiny)
+        .collect();
+    if keep.len() < rems.faces.len() {
+        rems = sub_mesh(&rems, &keep);
+    }
     if failed > 0 {
         cx.warn_once(call.span, || {
             format!("innerRectangle: {failed} face(s) have no inner rectangle (no area); they are kept as remainder")

@@ -162,7 +162,7 @@ fn face_sections(
     // The region each section sweeps on this face, alone.
     let mut regions: Vec<(usize, Shapes)> = Vec::new();
     for (si, sec) in sections.iter().enumerate() {
-        if !(sec.depth > 0.0) || !sec.depth.is_finite() {
+        if sec.depth.is_nan() || sec.depth <= 0.0 || !sec.depth.is_finite() {
             continue;
         }
         let d: Vec<f64> = pieces

@@ -117,7 +117,7 @@ pub fn classify_roof_edges(
             eave_vertex[vb as usize] = true;
         }
     }
-    for e in 0..ne {
+    for (e, kind) in kinds.iter_mut().enumerate() {
         let uses = topo.edge_uses(e);
         if uses.len() != 2
             || uses[0].face == uses[1].face
@@ -144,7 +144,7 @@ pub fn classify_roof_edges(
             }
         }
         let [va, vb] = topo.edges[e].v;
-        kinds[e] = if best.1 > tol {
+        *kind = if best.1 > tol {
             RoofEdgeKind::Valley
         } else if eave_vertex[va as usize] || eave_vertex[vb as usize] {
             RoofEdgeKind::Hip

@@ -1,6 +1,6 @@
 //! Operations that rework the current geometry in place: `convexify`,
-//! `deleteHoles`, `cleanupGeometry`, `setNormals`, `softenNormals`,
-//! `mirror`, `reduceGeometry` and `rectify`. None of them creates shapes;
+//! `deleteHoles`, `cleanupGeometry`, `reverseNormals`, `setNormals`,
+//! `softenNormals`, `mirror`, `reduceGeometry` and `rectify`. None of them creates shapes;
 //! the scope stays where it is (its size is refitted by `convexify` only if
 //! nothing changes it: splitting a face keeps its bounding box).
 
@@ -37,6 +37,11 @@ pub fn exec(
             if mesh.loops.len() > mesh.faces.len() {
                 shape.set_local_mesh(delete_holes(&mesh));
             }
+        }
+        Op::ReverseNormals => {
+            let mut mesh = (**shape.geometry.local()).clone();
+            reverse_keeping_first_edge(&mut mesh);
+            shape.set_local_mesh(mesh);
         }
         Op::SetNormals => {
             let mode = selector(&args[0], &["hard", "conform", "soft", "auto"])?;
@@ -172,4 +177,36 @@ fn delete_holes(mesh: &Mesh) -> Mesh {
         out.faces.push(face);
     }
     out
+}
+
+/// `reverseNormals`: every loop runs the other way and keeps its first edge
+/// (op_reverseNormals.md: "the First Edge is retained"): `c0 c1 .. cn-1`
+/// becomes `c1 c0 cn-1 .. c2`, per-corner attributes along; normals are
+/// negated.
+fn reverse_keeping_first_edge(mesh: &mut Mesh) {
+    fn reorder<T: Copy>(v: &mut [T]) {
+        // c0 c1 .. cn-1 -> c1 c0 cn-1 .. c2: reverse all, then rotate so
+        // that c1 comes first.
+        v.reverse();
+        let n = v.len();
+        v.rotate_left(n - 2);
+    }
+    for l in mesh.loops.clone() {
+        let r = mesh.loop_corners(l);
+        if r.len() < 3 {
+            continue;
+        }
+        reorder(&mut mesh.corners[r.clone()]);
+        for uv in mesh.uvs.iter_mut().flatten() {
+            reorder(&mut uv[r.clone()]);
+        }
+        if let Some(n) = &mut mesh.normals {
+            reorder(&mut n[r.clone()]);
+        }
+    }
+    if let Some(n) = &mut mesh.normals {
+        for v in n {
+            *v = -*v;
+        }
+    }
 }

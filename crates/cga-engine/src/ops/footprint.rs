@@ -762,18 +762,17 @@ fn taper(st: &mut ShapeState, args: &[Arg]) -> Result<(), RtError> {
     out.positions.push(apex);
     // The base reversed, starting at its second corner (as extrude's bottom).
     let base: Vec<u32> = (0..k).map(|i| (k + 1 - i) % k).collect();
-    let (base_face, side_face): (Vec<u32>, fn(u32, u32, u32) -> [u32; 3]) = if h >= 0.0 {
-        (base, |a, b, t| [a, b, t])
-    } else {
-        ((0..k).collect(), |a, b, t| [b, a, t])
-    };
+    // Downwards the pyramid hangs below the face: base and sides turn.
+    let up = h >= 0.0;
+    let base_face: Vec<u32> = if up { base } else { (0..k).collect() };
     out.add_face(&[&base_face], material);
     for i in 0..k {
         let j = (i + 1) % k;
         if outer[i as usize] == outer[j as usize] {
             continue;
         }
-        out.add_face(&[&side_face(i, j, k)], material);
+        let side = if up { [i, j, k] } else { [j, i, k] };
+        out.add_face(&[&side], material);
     }
     super::roof::set_mesh_y_up(&mut st.shape, out, Some(n));
     if h < 0.0 {

@@ -363,8 +363,7 @@ pub fn exec(
         | Op::PrimitiveSphere
         | Op::PrimitiveCylinder
         | Op::PrimitiveCone
-        | Op::Insert
-        | Op::ReverseNormals => create::exec(cx, st, call, args),
+        | Op::Insert => create::exec(cx, st, call, args),
         Op::Color | Op::Set(_) | Op::SetMaterial | Op::ResetMaterial | Op::Print | Op::Report => {
             attrs::exec(cx, st, call, args)
         }
@@ -402,6 +401,7 @@ pub fn exec(
         | Op::Taper
         | Op::Footprint => footprint::exec(cx, st, call, args, frame),
         Op::Convexify
+        | Op::ReverseNormals
         | Op::DeleteHoles
         | Op::CleanupGeometry
         | Op::SetNormals

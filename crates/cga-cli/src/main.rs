@@ -228,10 +228,27 @@ fn read_lots(specs: &[String]) -> Result<Vec<Lot>, Failure> {
             .map(|e| e.to_ascii_lowercase());
         let more = match ext.as_deref() {
             Some("obj") => lot::from_obj(path),
-            Some("geojson" | "json") => lot::from_geojson(path),
+            Some(ext @ ("geojson" | "json" | "fgb")) => {
+                let read = if ext == "fgb" {
+                    lot::from_flatgeobuf(path)
+                } else {
+                    lot::from_geojson_georeferenced(path)
+                };
+                read.map(|(lots, origin)| {
+                    if let Some(o) = origin {
+                        eprintln!(
+                            "note: {} is in longitude/latitude; lots are in metres east (x) and north (-z) of lon {:.7}, lat {:.7}",
+                            path.display(),
+                            o.lon,
+                            o.lat
+                        );
+                    }
+                    lots
+                })
+            }
             _ => {
                 return Err(Failure::Usage(format!(
-                    "unknown lot `{spec}`: expected rect:W,D, an .obj or a .geojson file"
+                    "unknown lot `{spec}`: expected rect:W,D, grid:COLSxROWS, an .obj, a .geojson or a .fgb (FlatGeobuf) file"
                 )))
             }
         };

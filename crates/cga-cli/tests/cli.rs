@@ -355,3 +355,81 @@ fn obj_lots_keep_their_texture_coordinates() {
         assert!((w - 3.0 * 60.0 / 69.0).abs() < 1e-6, "{w}");
     }
 }
+
+#[test]
+fn geographic_geojson_is_projected_to_metres() {
+    // A block in Zurich given in longitude/latitude: 0.0004 deg of longitude
+    // by 0.0002 deg of latitude at 47.37 N is about 30.1 m by 22.2 m.
+    let dir = temp_dir("geographic");
+    let rules = rule_file(&dir, "g.cga", "Lot --> print(geometry.area)\n");
+    let gj = dir.join("zurich.geojson");
+    std::fs::write(
+        &gj,
+        r#"{"type":"FeatureCollection","features":[{"type":"Feature","properties":{},"geometry":{"type":"Polygon",
+           "coordinates":[[[8.5400,47.3700],[8.5404,47.3700],[8.5404,47.3702],[8.5400,47.3702],[8.5400,47.3700]]]}}]}"#,
+    )
+    .unwrap();
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--lot",
+        gj.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("longitude/latitude"),
+        "{}",
+        stderr(&out)
+    );
+    let area: f64 = stdout(&out).trim().parse().unwrap();
+    let k = std::f64::consts::PI / 180.0 * 6_371_008.8;
+    let expected = (0.0004 * k * (47.3701f64.to_radians()).cos()) * (0.0002 * k);
+    assert!(
+        (area - expected).abs() < 0.01 * expected,
+        "{area} vs {expected}"
+    );
+    assert!((area - 30.1 * 22.2).abs() < 5.0, "{area}");
+}
+
+#[test]
+fn flatgeobuf_lots_with_attributes() {
+    use flatgeobuf::{ColumnType, FgbWriter, FgbWriterOptions, GeometryType};
+    use geozero::{ColumnValue, PropertyProcessor};
+    let dir = temp_dir("fgb");
+    let path = dir.join("lots.fgb");
+    let options = FgbWriterOptions {
+        write_index: false,
+        ..Default::default()
+    };
+    let mut fgb = FgbWriter::create_with_options("lots", GeometryType::Polygon, options).unwrap();
+    fgb.add_column("height", ColumnType::Double, |_, _| {});
+    for (x, h) in [(0.0, 12.0), (30.0, 7.5)] {
+        let geometry = format!(
+            r#"{{"type":"Polygon","coordinates":[[[{x},0],[{},0],[{},10],[{x},10],[{x},0]]]}}"#,
+            x + 20.0,
+            x + 20.0
+        );
+        fgb.add_feature_geom(geozero::geojson::GeoJson(&geometry), |feature| {
+            feature
+                .property(0, "height", &ColumnValue::Double(h))
+                .unwrap();
+        })
+        .unwrap();
+    }
+    let mut file = std::io::BufWriter::new(std::fs::File::create(&path).unwrap());
+    fgb.write(&mut file).unwrap();
+    drop(file);
+    let rules = rule_file(
+        &dir,
+        "f.cga",
+        "attr height = 1\nLot --> extrude(height) print(geometry.volume)\n",
+    );
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--lot",
+        path.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(stdout(&out), "2400\n1500\n");
+}

@@ -7,6 +7,7 @@ mod eval;
 pub mod expr;
 pub mod file_fns;
 pub mod generate;
+pub mod geo;
 pub mod lot;
 pub mod material_attr;
 pub mod ops;

@@ -543,3 +543,20 @@ fn degenerate_footprints() {
         }
     }
 }
+
+/// Texture coordinates projected before an offset, a setback or a
+/// convexify stay where the projection put them (the new polygons take
+/// them from the face they were cut from).
+#[test]
+fn texture_coordinates_survive() {
+    let src = "Lot --> setupProjection(0, scope.xz, '1, '1) projectUV(0) OP print(geometry.uMin(0)) print(geometry.uMax(0)) print(geometry.vMin(0)) print(geometry.vMax(0)) X.\n";
+    let g = gen(&src.replace("OP", "offset(-3, inside)")).ok();
+    let p: Vec<f64> = g.prints().iter().map(|x| x.parse().unwrap()).collect();
+    assert_all_near(&p, &[0.15, 0.85, 0.1, 0.9], 1e-9);
+    let g = gen("Lot --> setupProjection(0, scope.xz, '1, '1) projectUV(0) setback(5) { front : NIL | remainder : Rest }\n\
+                 Rest --> print(geometry.uMin(0)) print(geometry.uMax(0)) print(geometry.vMin(0)) print(geometry.vMax(0)) X.\n")
+        .ok();
+    let p: Vec<f64> = g.prints().iter().map(|x| x.parse().unwrap()).collect();
+    // The remainder lies 5 m behind the front: v up to 25 / 30.
+    assert_all_near(&p, &[0.0, 1.0, 0.0, 25.0 / 30.0], 1e-9);
+}

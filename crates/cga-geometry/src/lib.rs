@@ -7,6 +7,7 @@
 //! | [`mesh`], [`material`] | the data |
 //! | [`measure`] | normals, areas, volume, bounds, the `geometry.*` measures |
 //! | [`topology`] | welding, unique edges with their faces (`comp(e)` order), closedness |
+//! | [`uv_carry`] | texture coordinates kept through offsets, setbacks, `convexify` |
 //! | [`triangulate`] | faces to triangles for export |
 //! | [`cleanup`] | `cleanupGeometry`, `reduceGeometry`, `rectify` |
 //! | [`convexify`] | `convexify` |
@@ -48,6 +49,7 @@ pub mod skeleton;
 pub mod topology;
 pub mod transform;
 pub mod triangulate;
+pub mod uv_carry;
 
 pub use area_split::{split_by_areas, AreaProfile, Flatness};
 pub use cut::{cut_by_plane, split_along_axis, split_by_parallel_planes};

@@ -29,7 +29,9 @@ pub fn exec(
             };
             let mesh = shape.geometry.local().clone();
             if !mesh.faces.is_empty() {
-                shape.set_local_mesh(cga_geometry::convexify::convexify(&mesh, max));
+                let mut out = cga_geometry::convexify::convexify(&mesh, max);
+                cga_geometry::uv_carry::carry_uvs(&mesh, &mut out);
+                shape.set_local_mesh(out);
             }
         }
         Op::DeleteHoles => {

@@ -120,13 +120,23 @@ pub(crate) fn keyword(head: &RExpr) -> Option<&str> {
     }
 }
 
-/// A mesh of some faces of `src`, with its materials.
+/// A mesh of some faces of `src`, with its materials and per-corner
+/// attributes.
 pub(crate) fn sub_mesh(src: &Mesh, faces: &[usize]) -> Mesh {
     let mut out = Mesh::new();
     out.materials = src.materials.clone();
     out.groups = src.groups.clone();
+    for (k, set) in src.uvs.iter().enumerate() {
+        if set.is_some() {
+            out.uvs[k] = Some(Vec::new());
+        }
+    }
+    if src.normals.is_some() {
+        out.normals = Some(Vec::new());
+    }
     for &f in faces {
         let mut ids: Vec<Vec<u32>> = Vec::new();
+        let first = out.corners.len();
         for &l in src.face_loops(f) {
             let s = out.positions.len() as u32;
             out.positions.extend(src.loop_points(l));
@@ -135,6 +145,21 @@ pub(crate) fn sub_mesh(src: &Mesh, faces: &[usize]) -> Mesh {
         let refs: Vec<&[u32]> = ids.iter().map(|x| x.as_slice()).collect();
         let nf = out.add_face(&refs, src.faces[f].material);
         out.faces[nf].group = src.faces[f].group;
+        let corners = src
+            .face_loops(f)
+            .iter()
+            .flat_map(|&l| src.loop_corners(l))
+            .enumerate();
+        for (i, c) in corners {
+            for (k, set) in out.uvs.iter_mut().enumerate() {
+                if let (Some(dst), Some(s)) = (set.as_mut(), src.uvs[k].as_ref()) {
+                    dst[first + i] = s[c];
+                }
+            }
+            if let (Some(dst), Some(s)) = (out.normals.as_mut(), src.normals.as_ref()) {
+                dst[first + i] = s[c];
+            }
+        }
     }
     out
 }
@@ -304,7 +329,9 @@ fn offset(
     let faces: Vec<usize> = (0..o.kinds.len())
         .filter(|&f| kinds.contains(&o.kinds[f]))
         .collect();
-    let mut out = sub_mesh(&o.mesh, &faces);
+    let mut res = o.mesh;
+    cga_geometry::uv_carry::carry_uvs(&mesh, &mut res);
+    let mut out = sub_mesh(&res, &faces);
     if keep != "border" {
         // A face the skeleton failed on is kept whole, as its own inside.
         let failed: Vec<usize> = o.failed.iter().map(|(f, _)| *f).collect();
@@ -409,6 +436,7 @@ fn emit_setback(
 ) -> Result<(), RtError> {
     let starts = face_edge_starts(mesh);
     let mut all = o.mesh.clone();
+    cga_geometry::uv_carry::carry_uvs(mesh, &mut all);
     let failed: Vec<usize> = o.failed.iter().map(|(f, _)| *f).collect();
     let mut remainder = o.faces_of(OffsetFace::Inside);
     remainder.extend(append_faces(&mut all, mesh, &failed));
@@ -483,8 +511,11 @@ fn shape_luo(
         .collect();
     let o = cga_geometry::setback(&mesh, &d);
     warn_failed(cx, call.span, name, &o.failed);
-    let shape_mesh = cga_geometry::merge_strips(&o);
-    let mut rem = sub_mesh(&o.mesh, &o.faces_of(OffsetFace::Inside));
+    let mut shape_mesh = cga_geometry::merge_strips(&o);
+    cga_geometry::uv_carry::carry_uvs(&mesh, &mut shape_mesh);
+    let mut with_uvs = o.mesh.clone();
+    cga_geometry::uv_carry::carry_uvs(&mesh, &mut with_uvs);
+    let mut rem = sub_mesh(&with_uvs, &o.faces_of(OffsetFace::Inside));
     let failed: Vec<usize> = o.failed.iter().map(|(f, _)| *f).collect();
     append_faces(&mut rem, &mesh, &failed);
     st.has_successor = true;
@@ -621,6 +652,8 @@ fn inner_rectangle(
     if keep.len() < rems.faces.len() {
         rems = sub_mesh(&rems, &keep);
     }
+    cga_geometry::uv_carry::carry_uvs(&mesh, &mut shapes);
+    cga_geometry::uv_carry::carry_uvs(&mesh, &mut rems);
     if failed > 0 {
         cx.warn_once(call.span, || {
             format!("innerRectangle: {failed} face(s) have no inner rectangle (no area); they are kept as remainder")
@@ -650,6 +683,7 @@ fn inner_rect(st: &mut ShapeState) -> Result<(), RtError> {
             cga_geometry::transform::merge(&mut out, &s);
         }
     }
+    cga_geometry::uv_carry::carry_uvs(&mesh, &mut out);
     place(&mut st.shape, out);
     Ok(())
 }
@@ -977,7 +1011,14 @@ fn perimeter(
             section_of.push(i);
         }
     }
-    let result = perimeter::split_and_setback_perimeter(&mesh, &chain, &sections);
+    let mut result = perimeter::split_and_setback_perimeter(&mesh, &chain, &sections);
+    for m in result
+        .sections
+        .iter_mut()
+        .chain(std::iter::once(&mut result.remainder))
+    {
+        cga_geometry::uv_carry::carry_uvs(&mesh, m);
+    }
     let mut meshes: Vec<Mesh> = vec![Mesh::new(); placed.len()];
     for (s, m) in result.sections.iter().enumerate() {
         let i = section_of[s];

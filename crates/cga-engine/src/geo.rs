@@ -84,9 +84,9 @@ fn for_each_position(gj: &mut geojson::GeoJson, f: &mut impl FnMut(&mut Vec<f64>
         use geojson::Value::*;
         match &mut g.value {
             Point(p) => f(p),
-            MultiPoint(ps) | LineString(ps) => ps.iter_mut().for_each(|p| f(p)),
-            MultiLineString(ls) | Polygon(ls) => ls.iter_mut().flatten().for_each(|p| f(p)),
-            MultiPolygon(pss) => pss.iter_mut().flatten().flatten().for_each(|p| f(p)),
+            MultiPoint(ps) | LineString(ps) => ps.iter_mut().for_each(&mut *f),
+            MultiLineString(ls) | Polygon(ls) => ls.iter_mut().flatten().for_each(&mut *f),
+            MultiPolygon(pss) => pss.iter_mut().flatten().flatten().for_each(&mut *f),
             GeometryCollection(gs) => gs.iter_mut().for_each(|g| geometry(g, f)),
         }
     }

@@ -95,7 +95,8 @@ pub fn degenerate(lot: &Lot) -> Option<String> {
     let size = cga_geometry::measure::bounds(m)
         .map(|(lo, hi)| (hi - lo).length())
         .unwrap_or(0.0);
-    if !(area > 1e-12 * size.max(1.0).powi(2)) {
+    // NaN areas (from NaN coordinates) count as no area too.
+    if area.is_nan() || area <= 1e-12 * size.max(1.0).powi(2) {
         return Some(
             "it has no area (fewer than three distinct corners, or collinear ones)".into(),
         );

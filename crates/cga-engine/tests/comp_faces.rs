@@ -82,7 +82,11 @@ Tile --> comp(f) { 0 : print("tile " + scope.sx + " " + scope.sy + " " + scope.e
     let tiles = r.numbers("tile");
     assert_eq!(tiles.len(), 12);
     for (i, t) in tiles.iter().enumerate() {
-        assert_close(&[t.clone()], &[&[5.0, 3.0, 3.0 * (i / 4) as f64]], 1e-9);
+        assert_close(
+            std::slice::from_ref(t),
+            &[&[5.0, 3.0, 3.0 * (i / 4) as f64]],
+            1e-9,
+        );
     }
 }
 

@@ -55,6 +55,14 @@ pub struct Summary {
 }
 
 pub fn summarize(obj: &Path) -> Summary {
+    summarize_rounded(obj, None)
+}
+
+/// [`summarize`] with vertex coordinates rounded to `decimals` first, as
+/// CityEngine's OBJ writer rounds them (3 decimals): comparing with its
+/// goldens, both models are then measured from the same rounded points.
+pub fn summarize_rounded(obj: &Path, decimals: Option<i32>) -> Summary {
+    let scale = decimals.map(|d| 10f64.powi(d));
     let dir = obj.parent().unwrap();
     let text = std::fs::read_to_string(obj).expect("the OBJ file exists");
     let mut mats: BTreeMap<String, ([f64; 3], String)> = BTreeMap::new();
@@ -97,10 +105,13 @@ pub fn summarize(obj: &Path) -> Summary {
                 }
             }
             Some("v") => {
-                let v = [0, 1, 2].map(|k| p[k + 1].parse::<f64>().unwrap());
-                for k in 0..3 {
-                    s.min[k] = s.min[k].min(v[k]);
-                    s.max[k] = s.max[k].max(v[k]);
+                let v = [0, 1, 2].map(|k| {
+                    let x = p[k + 1].parse::<f64>().unwrap();
+                    scale.map_or(x, |f| (x * f).round() / f)
+                });
+                for (k, x) in v.iter().enumerate() {
+                    s.min[k] = s.min[k].min(*x);
+                    s.max[k] = s.max[k].max(*x);
                 }
                 verts.push(v);
             }

@@ -560,3 +560,27 @@ fn texture_coordinates_survive() {
     // The remainder lies 5 m behind the front: v up to 25 / 30.
     assert_all_near(&p, &[0.0, 1.0, 0.0, 25.0 / 30.0], 1e-9);
 }
+
+/// op_setback's selectors: an index wraps around (-1 is the last edge), a
+/// logical expression combines keywords, a condition is evaluated on each
+/// face edge as a shape (as `comp` evaluates conditions: the component in
+/// the current scope's orientation, so `scope.sz` is an edge's extent
+/// along z); an edge goes to the first entry that selects it; `remainder`
+/// is the same wherever it stands.
+#[test]
+fn setback_selectors() {
+    let src = "Lot --> setback(2) { remainder : print(\"R \" + geometry.area) R. | -1 : print(\"L \" + geometry.area) L. | front || back : print(\"FB \" + geometry.area) FB. | scope.sz > 25 : print(\"S \" + geometry.area) S. }\n";
+    let g = gen(src).ok();
+    // Edge 3 (left, 30 m), front and back (20 m), then the right side.
+    assert_all_near(&areas(&g, "R"), &[16.0 * 26.0], 1e-9);
+    // The left strip: 30 long, its ends mitred with front and back.
+    assert_all_near(&areas(&g, "L"), &[(30.0 + 26.0) / 2.0 * 2.0], 1e-9);
+    assert_all_near(
+        &sorted(areas(&g, "FB")),
+        &[(20.0 + 16.0) / 2.0 * 2.0, (20.0 + 16.0) / 2.0 * 2.0],
+        1e-9,
+    );
+    assert_all_near(&areas(&g, "S"), &[(30.0 + 26.0) / 2.0 * 2.0], 1e-9);
+    // The order of creation follows the entries, remainder first here.
+    assert!(g.prints()[0].starts_with("R "));
+}

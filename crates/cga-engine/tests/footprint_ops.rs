@@ -355,8 +355,8 @@ fn perimeter_offset_and_mask() {
 
 /// op_innerRectangle, "Inner Rectangles of Lot Shapes": on the L the
 /// largest scope-aligned rectangle is a 12 x 5 wing; the remainder is the
-/// rest of the L (`:` one shape per polygon). A rectangular lot is its own
-/// inner rectangle and leaves no remainder.
+/// rest of the L (`:` one shape per polygon; a U leaves two). A
+/// rectangular lot is its own inner rectangle and leaves no remainder.
 #[test]
 fn inner_rectangle() {
     let src = "Lot --> innerRectangle(A) { shape : print(\"S \" + geometry.area) S. | remainder : print(\"R \" + geometry.area) R. }\n";
@@ -366,7 +366,29 @@ fn inner_rectangle() {
         assert_all_near(&areas(&g, "S"), &[60.0], 1e-9);
         assert_all_near(&areas(&g, "R"), &[35.0], 1e-9);
         assert!(measure::is_rectangular(&g.meshes()[0], 1e-9));
+        // The rest of the L is the other wing's 5 x 7 rectangle.
+        assert!(measure::is_rectangular(&g.meshes()[1], 1e-9));
     }
+    let u = Opts::polygon(&pts(&[
+        (0.0, 0.0),
+        (15.0, 0.0),
+        (15.0, -12.0),
+        (10.0, -12.0),
+        (10.0, -5.0),
+        (5.0, -5.0),
+        (5.0, -12.0),
+        (0.0, -12.0),
+    ]));
+    let g = gen_with(&src.replace('A', "scope"), &u).ok();
+    assert_all_near(&areas(&g, "S"), &[75.0], 1e-9);
+    assert_all_near(&areas(&g, "R"), &[35.0, 35.0], 1e-9);
+    let g = gen_with(
+        &src.replace('A', "scope")
+            .replace("remainder :", "remainder ="),
+        &u,
+    )
+    .ok();
+    assert_all_near(&areas(&g, "R"), &[70.0], 1e-9);
     let g = gen(&src.replace('A', "scope")).ok();
     assert_all_near(&areas(&g, "S"), &[600.0], 1e-9);
     assert!(areas(&g, "R").is_empty());

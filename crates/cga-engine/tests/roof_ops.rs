@@ -140,6 +140,17 @@ fn hip_on_an_l() {
         1e-9,
     );
     assert!(measure::is_closed(roof_mesh(&g)));
+    // byHeight: the highest point (the ridge) at the height given, whatever
+    // the footprint; the roof's scope is that high.
+    for op in [
+        "roofHip(byHeight, 4)",
+        "roofGable(byHeight, 4)",
+        "roofHip(byHeight, 4, 0, true)",
+    ] {
+        let g = gen_with(&roof_rules(op), &Opts::polygon(&l_lot())).ok();
+        assert_near(mesh_bounds(roof_mesh(&g)).1.y, 14.0, 1e-9);
+        assert_near(scope_line(&g.prints()[1]).s.y, 4.0, 1e-9);
+    }
 }
 
 /// The heights of the ridge vertices (above the eaves) of a roof mesh.

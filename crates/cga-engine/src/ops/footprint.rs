@@ -533,15 +533,56 @@ fn shape_luo(
 
 // ----- innerRectangle, innerRect -----
 
-/// The largest inner rectangle of face `f` and the face with that rectangle
-/// cut out as a hole. `scope` alignment: sides parallel to the two scope
-/// axes spanning the plane the face is most parallel to, the rectangle seen
-/// along the third (on a slanted face a parallelogram, a rectangle seen
-/// from that axis); `edge` alignment: parallel to an edge of the face.
+/// The largest inner rectangle of face `f` and the polygons of the face
+/// around it. `scope` alignment: see [`scope_rectangle`]; `edge`
+/// alignment: parallel to an edge of the face (an edge longer than a
+/// quarter of the longest edge of its loop).
 fn face_inner_rectangle(mesh: &Mesh, f: usize, scope_aligned: bool) -> Option<(Mesh, Mesh)> {
-    if !scope_aligned {
-        return cga_geometry::inner_rectangle(mesh, f, None);
+    let shape = if scope_aligned {
+        scope_rectangle(mesh, f)?
+    } else {
+        cga_geometry::inner_rectangle(mesh, f, None)?.0
+    };
+    let corners: Vec<DVec3> = shape.loop_points(shape.outer_loop(0)).collect();
+    Some((shape, face_minus(mesh, f, &corners)))
+}
+
+/// Face `f` without the polygon `hole` (in its plane): the polygons left,
+/// each a face (op_innerRectangle: "each polygon is put into a new shape").
+fn face_minus(mesh: &Mesh, f: usize, hole: &[DVec3]) -> Mesh {
+    let n = measure::face_normal(mesh, f);
+    let (u, v) = cga_geometry::triangulate::plane_basis(n);
+    let o = mesh.positions[mesh.corners[mesh.outer_loop(f).start as usize] as usize];
+    let to2 = |p: DVec3| DVec2::new((p - o).dot(u), (p - o).dot(v));
+    let face: Vec<Vec<DVec2>> = mesh
+        .face_loops(f)
+        .iter()
+        .map(|&l| mesh.loop_points(l).map(to2).collect())
+        .collect();
+    let cut: Vec<DVec2> = hole.iter().map(|&p| to2(p)).collect();
+    let rest = cga_geometry::footprint::difference(&face, &[cut]);
+    let mut out = Mesh::new();
+    out.materials = mesh.materials.clone();
+    let material = mesh.faces[f].material;
+    for shape in rest {
+        let mut ids: Vec<Vec<u32>> = Vec::new();
+        for l in &shape {
+            let s = out.positions.len() as u32;
+            out.positions
+                .extend(l.iter().map(|q| o + u * q.x + v * q.y));
+            ids.push((s..s + l.len() as u32).collect());
+        }
+        let refs: Vec<&[u32]> = ids.iter().map(|x| x.as_slice()).collect();
+        out.add_face(&refs, material);
     }
+    out
+}
+
+/// The largest rectangle of face `f` with sides parallel to the two scope
+/// axes spanning the plane the face is most parallel to, seen along the
+/// third (on a slanted face a parallelogram, a rectangle seen from that
+/// axis).
+fn scope_rectangle(mesh: &Mesh, f: usize) -> Option<Mesh> {
     let n = measure::face_normal(mesh, f);
     if n == DVec3::ZERO {
         return None;
@@ -592,21 +633,7 @@ fn face_inner_rectangle(mesh: &Mesh, f: usize, scope_aligned: bool) -> Option<(M
     let mut shape = Mesh::polygon(&corners);
     shape.materials = mesh.materials.clone();
     shape.faces[0].material = material;
-    let mut rem = Mesh::new();
-    rem.materials = mesh.materials.clone();
-    let mut ids: Vec<Vec<u32>> = Vec::new();
-    for &l in mesh.face_loops(f) {
-        let s = rem.positions.len() as u32;
-        rem.positions.extend(mesh.loop_points(l));
-        ids.push((s..s + l.len).collect());
-    }
-    let s = rem.positions.len() as u32;
-    rem.positions
-        .extend([corners[0], corners[3], corners[2], corners[1]]);
-    ids.push((s..s + 4).collect());
-    let refs: Vec<&[u32]> = ids.iter().map(|x| x.as_slice()).collect();
-    rem.add_face(&refs, material);
-    Some((shape, rem))
+    Some(shape)
 }
 
 fn inner_rectangle(

@@ -1051,7 +1051,7 @@ impl Resolver<'_> {
         }
     }
 
-    /// The block of an operation; `comp`: the heads are comp selectors.
+    /// The block of an operation, its heads resolved as `heads` says.
     fn op_block(&mut self, cx: &Cx, b: &ast::Block<Body>, heads: Heads) -> RBlock<RBody> {
         RBlock {
             parts: b

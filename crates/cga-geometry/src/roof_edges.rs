@@ -11,7 +11,7 @@
 //!
 //! - *eave*: an edge of exactly one roof face whose other faces (if any) are
 //!   bases, with both ends at the lowest level of that roof face (so it is
-//!   horizontal). It runs as the roof face runs: counter-clockwise around
+//!   horizontal; within half a degree, for assets that are not exact). It runs as the roof face runs: counter-clockwise around
 //!   the footprint seen from above.
 //! - between exactly two roof faces: *valley* if they form a concavity,
 //!   else *hip* if it touches an eave, else *ridge*.
@@ -109,7 +109,11 @@ pub fn classify_roof_edges(
         let u = roof_use.expect("one roof use");
         let f = u.face as usize;
         let [a, b] = topo.edges[e].p;
-        if (height(a) - low[f]).abs() <= tol && (height(b) - low[f]).abs() <= tol {
+        // At the lowest level, horizontal within half a degree (assets are
+        // not always exact).
+        let len = (mesh.positions[b as usize] - mesh.positions[a as usize]).length();
+        let slack = tol + len * 0.5f64.to_radians().sin();
+        if (height(a) - low[f]).abs() <= slack && (height(b) - low[f]).abs() <= slack {
             kinds[e] = RoofEdgeKind::Eave;
             eave_use[e] = Some(u);
             let [va, vb] = topo.edges[e].v;

@@ -4,9 +4,12 @@
 //! and `footprint`.
 //!
 //! The geometry lives in `cga_geometry` (`setback`, `inner_rect`,
-//! `envelope`, `perimeter`); this module reads the arguments, selects the
-//! edges and makes the shapes. Polygons are handled in the current shape's
-//! scope-local coordinates, which are metric.
+//! `envelope`, `perimeter`, `footprint`); this module reads the arguments,
+//! selects the edges (with `comp(fe)`'s selectors, see
+//! `ops::comp::FaceEdgeSelection`) and makes the shapes. Polygons are
+//! handled in the current shape's scope-local coordinates, which are
+//! metric; texture coordinates are carried over from the faces they were
+//! cut from (`cga_geometry::uv_carry`).
 //!
 //! Shapes created here (setback strips and remainders, L/U/O shapes, inner
 //! rectangles, perimeter sections) keep the current shape's pivot and scope

@@ -131,6 +131,8 @@ pub struct OpCall {
     pub op: Op,
     pub args: Vec<RExpr>,
     pub block: Option<RBlock<RBody>>,
+    /// The second block of `splitAndSetbackPerimeter(..) { .. } { remainder : .. }`.
+    pub remainder_block: Option<RBlock<RBody>>,
     pub span: Span,
 }
 

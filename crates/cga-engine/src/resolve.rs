@@ -1051,25 +1051,29 @@ impl Resolver<'_> {
         }
     }
 
-    /// The block of an operation; `comp`: the heads are comp selectors.
-    fn op_block(&mut self, cx: &Cx, b: &ast::Block<Body>, comp: bool) -> RBlock<RBody> {
+    /// The block of an operation, its heads resolved as `heads` says.
+    fn op_block(&mut self, cx: &Cx, b: &ast::Block<Body>, heads: Heads) -> RBlock<RBody> {
         RBlock {
             parts: b
                 .parts
                 .iter()
                 .map(|p| match p {
                     BlockPart::Entry(e) => RPart::Entry {
-                        head: if comp {
-                            self.comp_head(cx, &e.head)
-                        } else {
-                            self.head(cx, &e.head)
+                        head: match (heads, &e.head.kind) {
+                            // The setback selector `remainder` is not an
+                            // edge selector: a plain keyword.
+                            (Heads::Setback, ExprKind::Name(n)) if n.name == "remainder" => {
+                                self.head(cx, &e.head)
+                            }
+                            (Heads::Comp | Heads::Setback, _) => self.comp_head(cx, &e.head),
+                            (Heads::Plain, _) => self.head(cx, &e.head),
                         },
                         depth: e.depth.as_ref().map(|d| self.expr(cx, d)),
                         op: e.op,
                         body: self.body(cx, &e.body),
                         span: e.span,
                     },
-                    BlockPart::Group(g) => RPart::Group(self.op_block(cx, g, comp)),
+                    BlockPart::Group(g) => RPart::Group(self.op_block(cx, g, heads)),
                     BlockPart::Unlabeled { body, span } => RPart::Unlabeled {
                         body: self.body(cx, body),
                         span: *span,
@@ -1131,18 +1135,35 @@ impl Resolver<'_> {
                 );
                 return RStmt::Nil;
             }
-            let args = self.op_args(cx, name, call.args.as_deref().unwrap_or(&[]));
-            let block = call
-                .block
-                .as_ref()
-                .map(|b| self.op_block(cx, b, name == "comp"));
+            let mut args = self.op_args(cx, name, call.args.as_deref().unwrap_or(&[]));
+            if name == "setbackPerEdge" {
+                // A shortcut for `setback(comp(fe) { all : distance })`
+                // (op_setbackPerEdge.md): the distance is evaluated on
+                // every face edge component, not on the current shape.
+                let d = args.remove(0);
+                args.insert(0, per_face_edge(d));
+            }
+            let heads = match name {
+                "comp" => Heads::Comp,
+                "setback" | "setbackPerEdge" | "setbackToArea" => Heads::Setback,
+                _ => Heads::Plain,
+            };
+            let block = call.block.as_ref().map(|b| self.op_block(cx, b, heads));
             if block.is_some() && !info.block {
                 self.error(format!("`{name}` takes no `{{ ... }}` block"), span);
+            }
+            let remainder_block = call
+                .remainder_block
+                .as_ref()
+                .map(|b| self.op_block(cx, b, Heads::Plain));
+            if remainder_block.is_some() && info.op != Op::SplitAndSetbackPerimeter {
+                self.error(format!("`{name}` takes one `{{ ... }}` block"), span);
             }
             return RStmt::Op(OpCall {
                 op: info.op,
                 args,
                 block,
+                remainder_block,
                 span,
             });
         }
@@ -1150,7 +1171,7 @@ impl Resolver<'_> {
             // Resolve what is inside anyway, so that its errors are reported.
             let _ = self.op_args(cx, name, call.args.as_deref().unwrap_or(&[]));
             if let Some(b) = &call.block {
-                let _ = self.op_block(cx, b, false);
+                let _ = self.op_block(cx, b, Heads::Plain);
             }
             return RStmt::Unsupported {
                 name: name.to_string(),
@@ -1252,6 +1273,7 @@ impl Resolver<'_> {
             op: Op::Set(t),
             args: vec![value],
             block: None,
+            remainder_block: None,
             span,
         })
     }
@@ -1290,6 +1312,48 @@ impl Resolver<'_> {
             }
         }
         out
+    }
+}
+
+/// How the heads of an operation's block are resolved: comp selectors
+/// (`comp`), comp selectors and the keyword `remainder` (the setback
+/// operations), or split sizes and plain keywords (everything else).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Heads {
+    Comp,
+    Setback,
+    Plain,
+}
+
+/// `comp(fe) { all : e }`: the value of `e` on every face edge.
+fn per_face_edge(e: RExpr) -> RExpr {
+    let span = e.span;
+    let head = RExpr {
+        kind: RExprKind::CompHead {
+            text: Arc::from("all"),
+            expr: Box::new(RExpr {
+                kind: RExprKind::CompSelector(crate::selectors::Selector::All, Vec::new()),
+                span,
+            }),
+        },
+        span,
+    };
+    RExpr {
+        kind: RExprKind::CompFn {
+            args: vec![RExpr::constant(Value::Str(Arc::from("fe")), span)],
+            block: RBlock {
+                parts: vec![RPart::Entry {
+                    head,
+                    depth: None,
+                    op: cga_syntax::ast::BlockOp::Colon,
+                    body: e,
+                    span,
+                }],
+                repeat: false,
+                span,
+            },
+        },
+        span,
     }
 }
 

@@ -391,7 +391,6 @@ fn reset_geometry_keeps_attributes() {
 /// op_resetGeometry, "Recursive setbacks": each setback is applied to the
 /// initial shape again.
 #[test]
-#[ignore = "setback is not implemented yet"]
 fn reset_geometry_recursive_setbacks() {
     let src = "const maxGFA      = 5000\nconst floorHeight = 10\n\
                Example -->\n    color(\"#FFAA00\")\n    SetBackRec(0, 0)\n\
@@ -399,8 +398,20 @@ fn reset_geometry_recursive_setbacks() {
                Floor(sumGFA, iFloor) -->\n    CreateFloor(sumGFA, iFloor)\n    SetBackRec(sumGFA, iFloor + 1)\n\
                CreateFloor(sumGFA, iFloor) -->\n    set(material.opacity,\n        case sumGFA > maxGFA : 0.1 else : 1)\n    t(0, iFloor*floorHeight, 0)\n    extrude(floorHeight)\n";
     let g = gen_with(src, &Opts::rect(60.0, 40.0).start("Example")).ok();
-    // floors shrink by 3 m per side and level until nothing is left
-    assert!(g.meshes().len() >= 5);
+    // Floors shrink by 3 m per side and level until nothing is left: 60 x
+    // 40, 54 x 34, ..., 24 x 4, then a setback of 21 m leaves no remainder.
+    assert_eq!(g.meshes().len(), 7);
+    let mut sum = 0.0;
+    for (k, m) in g.meshes().iter().enumerate() {
+        let (w, d) = (60.0 - 6.0 * k as f64, 40.0 - 6.0 * k as f64);
+        let (lo, hi) = mesh_bounds(m);
+        assert_vec_near(hi - lo, [w, 10.0, d], 1e-9);
+        assert_near(lo.y, 10.0 * k as f64, 1e-9);
+        sum += w * d;
+        // The floors above the maximal floor area are transparent.
+        let opacity = m.materials[m.faces[0].material as usize].opacity;
+        assert_near(opacity, if sum > 5000.0 { 0.1 } else { 1.0 }, 1e-12);
+    }
 }
 
 // ---------------------------------------------------------------------------

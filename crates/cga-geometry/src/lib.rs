@@ -7,33 +7,49 @@
 //! | [`mesh`], [`material`] | the data |
 //! | [`measure`] | normals, areas, volume, bounds, the `geometry.*` measures |
 //! | [`topology`] | welding, unique edges with their faces (`comp(e)` order), closedness |
+//! | [`uv_carry`] | texture coordinates kept through offsets, setbacks, `convexify` |
 //! | [`triangulate`] | faces to triangles for export |
+//! | [`cleanup`] | `cleanupGeometry`, `reduceGeometry`, `rectify` |
+//! | [`convexify`] | `convexify` |
 //! | [`cut`] | plane cuts with caps: `split`, trim planes |
 //! | [`area_split`] | the area left of a moving plane and its inverse: `splitArea` |
 //! | [`extrude`] | `extrude` |
+//! | [`envelope`] | `envelope` |
+//! | [`footprint`] | `footprint`, polygon union and difference (`i_overlay`) |
 //! | [`inner_rect`] | `innerRectangle` |
+//! | [`perimeter`] | `splitAndSetbackPerimeter` |
 //! | [`primitive`] | `primitive*` and `builtin:cube` |
+//! | [`normals`] | `setNormals`, `softenNormals` |
 //! | [`obj`] | OBJ + MTL assets |
 //! | [`transform`] | affine transforms, reversing, merging |
 //! | [`roof`] | `roofHip`, `roofGable`, `roofPyramid`, `roofShed`, `roofRidge` |
+//! | [`roof_edges`] | `comp(e)`'s roof edge classes of any mesh |
 //! | [`setback`] | `offset`, `setback`, `setbackToArea`, `shapeL/U/O` |
 //! | [`skeleton`] | weighted straight skeletons and wavefront offsets |
 
 pub mod area_split;
+pub mod cleanup;
+pub mod convexify;
 pub mod cut;
+pub mod envelope;
 pub mod extrude;
+pub mod footprint;
 pub mod inner_rect;
 pub mod material;
 pub mod measure;
 pub mod mesh;
+pub mod normals;
 pub mod obj;
+pub mod perimeter;
 pub mod primitive;
 pub mod roof;
+pub mod roof_edges;
 pub mod setback;
 pub mod skeleton;
 pub mod topology;
 pub mod transform;
 pub mod triangulate;
+pub mod uv_carry;
 
 pub use area_split::{split_by_areas, AreaProfile, Flatness};
 pub use cut::{cut_by_plane, split_along_axis, split_by_parallel_planes};

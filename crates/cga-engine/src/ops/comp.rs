@@ -144,6 +144,8 @@ pub(crate) struct Components {
     vertex_normal: Vec<DVec3>,
     vertex_border: Vec<bool>,
     roof: Option<Vec<Option<RoofEdge>>>,
+    /// Per edge, for eaves: the roof face's use (see `roof_classes`).
+    eave_use: Vec<Option<cga_geometry::topology::EdgeUse>>,
     frames: Frames,
     parent: ParentFrames,
     builder: MeshBuilder,
@@ -171,6 +173,7 @@ impl Components {
             vertex_normal: Vec::new(),
             vertex_border: Vec::new(),
             roof: None,
+            eave_use: Vec::new(),
             frames: Frames::for_scope(shape.scope.frame.axes, object_axes),
             parent: ParentFrames {
                 scope: shape.scope,
@@ -410,63 +413,51 @@ impl Components {
     }
 
     /// Roof edge classes of all unique edges (op_comp.md, "Roof Edges"),
-    /// from the geometry alone: eaves are horizontal border edges at the
-    /// lowest level of the mesh; valleys are inside edges whose faces form a
-    /// concavity; hips are the other inside edges touching an eave; ridges
-    /// the remaining inside edges. "Up" is the world's up direction.
+    /// from the geometry alone (`cga_geometry::roof_edges`, which agrees with
+    /// the classes `cga_geometry::roof` gives the roofs it builds): faces
+    /// facing up are roof faces, faces facing down bases; eaves are the
+    /// lowest horizontal edges of one roof face (and bases), valleys the
+    /// concave edges between two roof faces, hips the others touching an
+    /// eave, ridges the rest. "Up" is the world's up direction.
     fn roof_classes(&mut self) -> &[Option<RoofEdge>] {
         if self.roof.is_none() {
+            use cga_geometry::roof::RoofEdgeKind as K;
             self.topology();
             let topo = self.topo.as_ref().expect("just computed");
-            let mesh = &*self.mesh;
             let up = self.parent.scope.frame.axes.transpose() * DVec3::Y;
-            let height = |p: u32| mesh.positions[p as usize].dot(up);
-            let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-            for &p in &mesh.corners {
-                lo = lo.min(height(p));
-                hi = hi.max(height(p));
-            }
-            let tol = 1e-6 * (hi - lo).abs().max(1.0);
-            let n = topo.edges.len();
-            let mut class = vec![None; n];
-            let mut eave_vertex = vec![false; topo.weld.count];
-            for (e, edge) in topo.edges.iter().enumerate() {
-                if !self.edge_border[e] {
-                    continue;
-                }
-                let (ha, hb) = (height(edge.p[0]), height(edge.p[1]));
-                let len = (mesh.positions[edge.p[1] as usize] - mesh.positions[edge.p[0] as usize])
-                    .length();
-                // Horizontal within 0.5 degrees, at the bottom.
-                let horizontal = (hb - ha).abs() <= len * 0.5f64.to_radians().sin() + tol;
-                if horizontal && ha - lo <= tol && hb - lo <= tol {
-                    class[e] = Some(RoofEdge::Eave);
-                    eave_vertex[edge.v[0] as usize] = true;
-                    eave_vertex[edge.v[1] as usize] = true;
-                }
-            }
-            for (e, edge) in topo.edges.iter().enumerate() {
-                if self.edge_border[e] {
-                    continue;
-                }
-                let uses = topo.edge_uses(e);
-                let Some(other) = uses.iter().find(|u| u.face != uses[0].face) else {
-                    continue;
-                };
-                let f = uses[0].face as usize;
-                let nf = self.face_normals[f];
-                let m_other = self.inward(other.face as usize, other.corner as usize);
-                class[e] = Some(if m_other.dot(nf) > 1e-9 {
-                    RoofEdge::Valley
-                } else if eave_vertex[edge.v[0] as usize] || eave_vertex[edge.v[1] as usize] {
-                    RoofEdge::Hip
-                } else {
-                    RoofEdge::Ridge
-                });
-            }
+            let c = cga_geometry::roof_edges::classify_roof_edges(
+                &self.mesh,
+                topo,
+                &self.face_normals,
+                up,
+            );
+            let class = c
+                .kinds
+                .iter()
+                .map(|k| match k {
+                    K::Eave => Some(RoofEdge::Eave),
+                    K::Hip => Some(RoofEdge::Hip),
+                    K::Valley => Some(RoofEdge::Valley),
+                    K::Ridge => Some(RoofEdge::Ridge),
+                    K::Other => None,
+                })
+                .collect();
+            self.eave_use = c.eave_use;
             self.roof = Some(class);
         }
         self.roof.as_deref().expect("just computed")
+    }
+
+    /// The use an edge component takes its direction from: an eave's roof
+    /// face (eaves run counter-clockwise around the footprint), else the
+    /// first face using the edge.
+    fn edge_use(&self, e: usize) -> cga_geometry::topology::EdgeUse {
+        let topo = self.topo.as_ref().expect("edges need the topology");
+        self.eave_use
+            .get(e)
+            .copied()
+            .flatten()
+            .unwrap_or(topo.edge_uses(e)[0])
     }
 
     /// The unit direction in face `f`'s plane, perpendicular to the edge
@@ -511,9 +502,13 @@ impl Components {
                 face_frame(&pts, self.face_normals[face as usize], None)
             }
             Item::Edge(e) => {
-                let topo = self.topo.as_ref().expect("edges need the topology");
-                let edge = topo.edges[e as usize];
-                let (mut a, mut b) = (pos(edge.p[0]), pos(edge.p[1]));
+                // The direction of the edge's first use (or an eave's roof face).
+                let u = self.edge_use(e as usize);
+                let c = u.corner as usize;
+                let (mut a, mut b) = (
+                    pos(mesh.corners[c]),
+                    pos(mesh.corners[next_corner(mesh, c)]),
+                );
                 if upward {
                     let up = self.parent.scope.frame.axes.transpose() * DVec3::Y;
                     if b.dot(up) < a.dot(up) {
@@ -691,13 +686,9 @@ impl Components {
                     .add_hole(&mesh, out, face as usize, lp as usize)
             }
             Item::Edge(e) => {
-                let topo = self.topo.as_ref().expect("edges need the topology");
-                let first = topo.edge_uses(e as usize)[0];
+                let first = self.edge_use(e as usize);
                 let c = first.corner as usize;
                 let mut corners = [c, next_corner(&mesh, c)];
-                if first.reversed {
-                    corners.swap(0, 1);
-                }
                 if upward {
                     let up = self.parent.scope.frame.axes.transpose() * DVec3::Y;
                     let h = |c: usize| mesh.positions[mesh.corners[c] as usize].dot(up);
@@ -1513,6 +1504,56 @@ pub fn exec(
         }
     }
     Ok(())
+}
+
+// ----- face-edge selection for the setback operations -----
+
+/// The face edges of a shape (in face-edge order: every edge of every loop
+/// of every face) selected by comp heads with `comp(fe)`'s semantics: the
+/// edge selectors of `setback`, `setbackPerEdge` and `setbackToArea` (their
+/// orientation keywords classify the edge's outward normal in the face
+/// plane, as the face-edge components of `comp(fe)` are oriented). An edge
+/// taken by a head is not offered to later heads. Index heads wrap around
+/// (op_setback.md: "too large and negative indices are modulo wrapped").
+pub(crate) struct FaceEdgeSelection {
+    comps: Components,
+    taken: Vec<bool>,
+}
+
+impl FaceEdgeSelection {
+    pub(crate) fn new(cx: &Interp, shape: &mut Shape) -> FaceEdgeSelection {
+        let mesh = shape.geometry.local().clone();
+        let comps = Components::new(mesh, Kind::FaceEdges, shape, cx.initial.pivot.axes);
+        let taken = vec![false; comps.len()];
+        FaceEdgeSelection { comps, taken }
+    }
+
+    /// The face edges (ascending, not yet taken) the comp head `head`
+    /// selects on `parent`; marks them taken.
+    pub(crate) fn select(
+        &mut self,
+        cx: &mut Interp,
+        frame: &[Value],
+        parent: &Shape,
+        head: &RExpr,
+    ) -> Result<Vec<u32>, RtError> {
+        let (_, expr) = split_head(head);
+        let n = self.taken.len();
+        if n > 0 && !contains_selector(expr) {
+            if let Value::Float(x) = cx.eval(expr, frame, parent)? {
+                if !x.is_finite() {
+                    return Ok(Vec::new());
+                }
+                let k = (x.floor().rem_euclid(n as f64) as usize).min(n - 1);
+                if self.taken[k] {
+                    return Ok(Vec::new());
+                }
+                self.taken[k] = true;
+                return Ok(vec![k as u32]);
+            }
+        }
+        select(cx, frame, parent, &mut self.comps, expr, &mut self.taken)
+    }
 }
 
 // ----- the function -----

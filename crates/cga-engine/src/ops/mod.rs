@@ -3,8 +3,11 @@
 //! Each family of operations lives in its own module.
 
 mod attrs;
+mod cleanup;
 pub mod comp;
 mod create;
+mod footprint;
+mod roof;
 mod scope_ops;
 pub mod split;
 pub mod split_area;
@@ -59,6 +62,32 @@ pub enum Op {
     SplitArea,
     Comp,
     Trim,
+    RoofHip,
+    RoofGable,
+    RoofPyramid,
+    RoofShed,
+    RoofRidge,
+    Offset,
+    Setback,
+    SetbackPerEdge,
+    SetbackToArea,
+    ShapeL,
+    ShapeU,
+    ShapeO,
+    SplitAndSetbackPerimeter,
+    InnerRectangle,
+    InnerRect,
+    Envelope,
+    Taper,
+    Footprint,
+    Convexify,
+    DeleteHoles,
+    CleanupGeometry,
+    SetNormals,
+    SoftenNormals,
+    Mirror,
+    ReduceGeometry,
+    Rectify,
     SetupProjection,
     ProjectUV,
     TranslateUV,
@@ -131,6 +160,14 @@ pub fn lookup(name: &str) -> Option<OpInfo> {
             block: false,
         })
     };
+    let with_block = |op, min_args, max_args| {
+        Some(OpInfo {
+            op,
+            min_args,
+            max_args,
+            block: true,
+        })
+    };
     match name {
         "extrude" => info(Op::Extrude, 1, 2),
         "t" => info(Op::T, 3, 3),
@@ -188,6 +225,32 @@ pub fn lookup(name: &str) -> Option<OpInfo> {
             block: true,
         }),
         "trim" => info(Op::Trim, 0, 0),
+        "roofHip" => info(Op::RoofHip, 1, 4),
+        "roofGable" => info(Op::RoofGable, 1, 5),
+        "roofPyramid" => info(Op::RoofPyramid, 1, 2),
+        "roofShed" => info(Op::RoofShed, 1, 3),
+        "roofRidge" => info(Op::RoofRidge, 1, 2),
+        "offset" => info(Op::Offset, 1, 2),
+        "setback" => with_block(Op::Setback, 1, 2),
+        "setbackPerEdge" => with_block(Op::SetbackPerEdge, 1, 2),
+        "setbackToArea" => with_block(Op::SetbackToArea, 1, 4),
+        "shapeL" => with_block(Op::ShapeL, 2, 2),
+        "shapeU" => with_block(Op::ShapeU, 3, 3),
+        "shapeO" => with_block(Op::ShapeO, 4, 4),
+        "splitAndSetbackPerimeter" => with_block(Op::SplitAndSetbackPerimeter, 1, 3),
+        "innerRectangle" => with_block(Op::InnerRectangle, 1, 1),
+        "innerRect" => info(Op::InnerRect, 0, 0),
+        "envelope" => info(Op::Envelope, 4, 10),
+        "taper" => info(Op::Taper, 1, 1),
+        "footprint" => info(Op::Footprint, 0, 0),
+        "convexify" => info(Op::Convexify, 0, 1),
+        "deleteHoles" => info(Op::DeleteHoles, 0, 0),
+        "cleanupGeometry" => info(Op::CleanupGeometry, 2, 2),
+        "setNormals" => info(Op::SetNormals, 1, 1),
+        "softenNormals" => info(Op::SoftenNormals, 1, 1),
+        "mirror" => info(Op::Mirror, 3, 3),
+        "reduceGeometry" => info(Op::ReduceGeometry, 1, 1),
+        "rectify" => info(Op::Rectify, 1, 1),
         _ => None,
     }
 }
@@ -300,8 +363,7 @@ pub fn exec(
         | Op::PrimitiveSphere
         | Op::PrimitiveCylinder
         | Op::PrimitiveCone
-        | Op::Insert
-        | Op::ReverseNormals => create::exec(cx, st, call, args),
+        | Op::Insert => create::exec(cx, st, call, args),
         Op::Color | Op::Set(_) | Op::SetMaterial | Op::ResetMaterial | Op::Print | Op::Report => {
             attrs::exec(cx, st, call, args)
         }
@@ -322,5 +384,30 @@ pub fn exec(
         | Op::RotateScope
         | Op::MirrorScope
         | Op::ResetGeometry => scope_ops::exec(cx, st, call, args),
+        Op::RoofHip | Op::RoofGable | Op::RoofPyramid | Op::RoofShed | Op::RoofRidge => {
+            roof::exec(cx, st, call, args)
+        }
+        Op::Offset
+        | Op::Setback
+        | Op::SetbackPerEdge
+        | Op::SetbackToArea
+        | Op::ShapeL
+        | Op::ShapeU
+        | Op::ShapeO
+        | Op::SplitAndSetbackPerimeter
+        | Op::InnerRectangle
+        | Op::InnerRect
+        | Op::Envelope
+        | Op::Taper
+        | Op::Footprint => footprint::exec(cx, st, call, args, frame),
+        Op::Convexify
+        | Op::ReverseNormals
+        | Op::DeleteHoles
+        | Op::CleanupGeometry
+        | Op::SetNormals
+        | Op::SoftenNormals
+        | Op::Mirror
+        | Op::ReduceGeometry
+        | Op::Rectify => cleanup::exec(cx, st, call, args),
     }
 }

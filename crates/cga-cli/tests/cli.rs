@@ -433,3 +433,29 @@ fn flatgeobuf_lots_with_attributes() {
     assert!(out.status.success(), "{}", stderr(&out));
     assert_eq!(stdout(&out), "2400\n1500\n");
 }
+
+#[test]
+fn assets_are_found_from_a_relative_rule_path() {
+    // A project: rules/ and assets/ side by side, run from inside rules/.
+    let dir = temp_dir("relative");
+    std::fs::create_dir_all(dir.join("rules")).unwrap();
+    std::fs::create_dir_all(dir.join("assets/parts")).unwrap();
+    std::fs::write(
+        dir.join("assets/parts/tri.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("rules/r.cga"),
+        "Lot --> i(\"parts/tri.obj\") print(geometry.nFaces)\n",
+    )
+    .unwrap();
+    let out = cga()
+        .current_dir(dir.join("rules"))
+        .args(["generate", "r.cga"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
+    assert_eq!(stdout(&out), "1\n");
+}

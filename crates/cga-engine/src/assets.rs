@@ -25,7 +25,18 @@ pub struct Assets {
 impl Assets {
     pub fn new(sources: &SourceMap) -> Assets {
         Assets {
-            files: sources.files().map(|(_, f)| f.path.clone()).collect(),
+            // Absolute paths: searching the ancestors of `rules/a.cga` given
+            // relative to the working directory must reach the project root.
+            files: sources
+                .files()
+                .map(|(_, f)| {
+                    f.path.canonicalize().unwrap_or_else(|_| {
+                        std::env::current_dir()
+                            .map(|d| d.join(&f.path))
+                            .unwrap_or_else(|_| f.path.clone())
+                    })
+                })
+                .collect(),
             meshes: Mutex::new(HashMap::new()),
             texts: Mutex::new(HashMap::new()),
         }

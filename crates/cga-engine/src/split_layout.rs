@@ -54,19 +54,18 @@
 //! Repeats (`{ ... }*`, and the whole split when it ends in `*`). Each repeat at the top level of the
 //! split (possibly inside non-repeated groups) is a *slot* whose content is repeated `n` times:
 //!
-//! 1. **Repeats of fixed sizes only are evaluated first** ("The repetitive absolute split will be
-//!    evaluated first independently on whichever side of the split the repetition is denoted"):
-//!    they take as many whole repetitions as fit into `L` minus the fixed parts outside repeats,
-//!    before floating parts get anything (`{ 2 : Green }* | ~1 : Blue` on 10: five Greens, no Blue).
-//!    So `~1 : Green | { 2 : Blue }* | ~1 : Green` centres as many Blues as fit (on 10.6: five,
-//!    and Greens of 0.3; on 10: five and no Green), which is what rules such as Candler's pipe
-//!    holders `~3 : NIL | { 0.3 : Holder | 4 : NIL }* | 0.3 : Holder | ~3 : NIL` are written for.
-//!    (Choosing that count by least stretching of the Greens instead would give four Blues and
-//!    Greens of 1 on 10, contradicting the quoted rule.)
+//! 1. **Repeats of fixed sizes only** first take as many whole repetitions as fit into `L` minus
+//!    the fixed parts outside repeats ("The repetitive absolute split will be evaluated first").
 //!    Several such repeats take turns, one repetition each, while one still fits (round robin), so
-//!    `1 | { 2 : G }* | { 1 : Y }* | 1` on 10 gives G G G Y Y between the borders. This is the
-//!    natural reading of "as many times as possible" for parallel repeats; the pages give no numbers
-//!    for it.
+//!    `1 | { 2 : G }* | { 1 : Y }* | 1` on 10 gives G G G Y Y between the borders (the pages give
+//!    no numbers for parallel repeats). If the split has floating parts, the repeats then give
+//!    repetitions back, one at a time from the one with the most, while that makes the floating
+//!    parts less stretched (`|s - 1|`, rule 2); a tie keeps the repetition. So `{ 2 : Green }* |
+//!    ~1 : Blue` on 10 is five Greens and no Blue ("the floating splits do not get any space"),
+//!    while `~1 : Green | { 2 : Blue }* | ~1 : Green` on 10 is four Blues between Greens of 1,
+//!    and Candler's pipe holders `~3 : NIL | { 0.3 : Holder | 4 : NIL }* | 0.3 : Holder | ~3 :
+//!    NIL` get the count that keeps the margins nearest 3: with it the Candler pipes match
+//!    CityEngine's output on both reference lots (taking every repetition that fits does not).
 //! 2. **Repeats containing floating sizes** then get counts `n_j` that make the common floating
 //!    scale `s = (L - fixed) / (sum of floating weights)` *least stretched*, i.e. minimise `|s - 1|`
 //!    ("the number of repetitions and floating dimensions are adapted to the best solution (best
@@ -514,10 +513,20 @@ impl SplitLayouter {
         let mut rest = length - fixed_outside;
         let mut budget = Budget::new(parts_outside);
         let next_turn = self.assign_fixed_repeats(&mut rest, tol, &mut budget)?;
+        // 1b. With floating parts in the split, fixed-only repeats give back repetitions
+        //     while that makes the floating parts less stretched.
+        if floating_outside > 0.0 || self.slots.iter().any(|s| s.is_floating()) {
+            self.balance_fixed_repeats(&mut rest, floating_outside, tol, &mut budget)?;
+        }
 
         // 2. Repeats with floating parts: least stretching of the common floating scale.
-        let floating =
-            self.assign_floating_repeats(&mut rest, floating_outside, tol, &mut budget)?;
+        let floating = assign_floating_repeats(
+            &mut self.slots,
+            &mut rest,
+            floating_outside,
+            tol,
+            &mut budget,
+        )?;
 
         // 3. Nothing floats and space is left: the next fixed-only repeat fills it, cut.
         let scale = if floating > 0.0 && rest > tol {
@@ -644,69 +653,134 @@ impl SplitLayouter {
             .unwrap_or(j)
     }
 
-    /// Rule 2: repetition counts of the floating repeats minimising `|s - 1|`. Takes their fixed
-    /// sizes out of `rest` and returns the total floating weight of the split.
-    fn assign_floating_repeats(
+    /// Rule 1b: when the split has floating parts, a fixed-only repeat does not take every
+    /// repetition that fits: repetitions are given back, one at a time from the repeat with the
+    /// most, while that lowers the floating parts' stretch `|s - 1|` (found with rule 2 applied
+    /// to each candidate). Ties keep the repetitions, so `{ 2 : Green }* | ~1 : Blue` on 10 is
+    /// five Greens and no Blue, as the split pages state, while `~1 : Green | { 2 : Blue }* |
+    /// ~1 : Green` on 10 is four Blues between Greens of 1, and the candler rule's pipe holders
+    /// `~3 : NIL | { 0.3 : Holder | 4 : NIL }* | 0.3 : Holder | ~3 : NIL` get the count that keeps
+    /// the margins nearest 3 (the count CityEngine generates: its areas match).
+    fn balance_fixed_repeats(
         &mut self,
         rest: &mut f64,
         floating_outside: f64,
         tol: f64,
         budget: &mut Budget,
-    ) -> Result<f64, LayoutError> {
-        let mut cycle_fixed = 0.0;
-        let mut cycle_floating = 0.0;
-        let mut cycle_parts = 0usize;
-        for slot in self.slots.iter().filter(|s| s.is_floating()) {
-            cycle_fixed += slot.fixed;
-            cycle_floating += slot.floating;
-            cycle_parts += slot.parts;
-        }
-        let mut floating = floating_outside;
-        if cycle_floating == 0.0 {
-            return Ok(floating);
-        }
-        // Every step of the round robin lowers s, so while s stays >= 1 each step improves: whole
-        // rounds up to s = 1 (solving (rest - n F) / (W + n G) = 1) are taken at once, exactly as
-        // the one-step-at-a-time search would take them.
-        let mut rounds = ((*rest - floating) / (cycle_fixed + cycle_floating)).floor();
-        if cycle_fixed > 0.0 {
-            rounds = rounds.min(((*rest + tol) / cycle_fixed).floor());
-        }
-        let rounds = rounds.max(0.0);
-        budget.add(rounds * cycle_parts as f64)?;
-        let rounds = rounds as u64;
-        for slot in self.slots.iter_mut().filter(|s| s.is_floating()) {
-            slot.count = rounds;
-        }
-        *rest -= rounds as f64 * cycle_fixed;
-        floating += rounds as f64 * cycle_floating;
-
-        // Then single steps, repeat after repeat, while one makes the split less stretched.
-        let mut current = stretch(*rest, floating, tol);
-        loop {
-            let mut progress = false;
-            for slot in self.slots.iter_mut().filter(|s| s.is_floating()) {
-                let next_rest = *rest - slot.fixed;
-                if next_rest < -tol {
-                    continue; // its fixed parts no longer fit
-                }
-                let next_floating = floating + slot.floating;
-                let next_stretch = stretch(next_rest, next_floating, tol);
-                if next_stretch < current - STRETCH_EPSILON {
-                    budget.add(slot.parts as f64)?;
-                    slot.count += 1;
-                    *rest = next_rest;
-                    floating = next_floating;
-                    current = next_stretch;
-                    progress = true;
-                }
+    ) -> Result<(), LayoutError> {
+        let trial = |slots: &[Slot], rest: f64| -> f64 {
+            let mut slots = slots.to_vec();
+            let mut rest = rest;
+            let mut scratch = Budget::new(0);
+            match assign_floating_repeats(
+                &mut slots,
+                &mut rest,
+                floating_outside,
+                tol,
+                &mut scratch,
+            ) {
+                Ok(floating) => stretch(rest, floating, tol),
+                Err(_) => f64::INFINITY,
             }
-            if !progress {
+        };
+        let mut slots = self.slots.clone();
+        let mut r = *rest;
+        let mut best = (trial(&slots, r), slots.clone(), r);
+        let mut previous = best.0;
+        // Each give-back raises the floating scale; past its best the stretch only grows.
+        for _ in 0..MAX_PARTS {
+            let Some(j) = (0..slots.len())
+                .filter(|&j| slots[j].is_fixed_only() && slots[j].count > 0)
+                .max_by_key(|&j| (slots[j].count, j))
+            else {
+                break;
+            };
+            slots[j].count -= 1;
+            r += slots[j].fixed;
+            let st = trial(&slots, r);
+            if st < best.0 - STRETCH_EPSILON {
+                best = (st, slots.clone(), r);
+            } else if st > previous + STRETCH_EPSILON {
                 break;
             }
+            previous = st;
         }
-        Ok(floating)
+        let (_, chosen, chosen_rest) = best;
+        let given_back: usize = self
+            .slots
+            .iter()
+            .zip(&chosen)
+            .map(|(a, b)| (a.count - b.count) as usize * a.parts)
+            .sum();
+        budget.add(-(given_back as f64))?;
+        self.slots = chosen;
+        *rest = chosen_rest;
+        Ok(())
     }
+}
+
+/// Rule 2: repetition counts of the floating repeats minimising `|s - 1|`. Takes their fixed
+/// sizes out of `rest` and returns the total floating weight of the split.
+fn assign_floating_repeats(
+    slots: &mut [Slot],
+    rest: &mut f64,
+    floating_outside: f64,
+    tol: f64,
+    budget: &mut Budget,
+) -> Result<f64, LayoutError> {
+    let mut cycle_fixed = 0.0;
+    let mut cycle_floating = 0.0;
+    let mut cycle_parts = 0usize;
+    for slot in slots.iter().filter(|s| s.is_floating()) {
+        cycle_fixed += slot.fixed;
+        cycle_floating += slot.floating;
+        cycle_parts += slot.parts;
+    }
+    let mut floating = floating_outside;
+    if cycle_floating == 0.0 {
+        return Ok(floating);
+    }
+    // Every step of the round robin lowers s, so while s stays >= 1 each step improves: whole
+    // rounds up to s = 1 (solving (rest - n F) / (W + n G) = 1) are taken at once, exactly as
+    // the one-step-at-a-time search would take them.
+    let mut rounds = ((*rest - floating) / (cycle_fixed + cycle_floating)).floor();
+    if cycle_fixed > 0.0 {
+        rounds = rounds.min(((*rest + tol) / cycle_fixed).floor());
+    }
+    let rounds = rounds.max(0.0);
+    budget.add(rounds * cycle_parts as f64)?;
+    let rounds = rounds as u64;
+    for slot in slots.iter_mut().filter(|s| s.is_floating()) {
+        slot.count = rounds;
+    }
+    *rest -= rounds as f64 * cycle_fixed;
+    floating += rounds as f64 * cycle_floating;
+
+    // Then single steps, repeat after repeat, while one makes the split less stretched.
+    let mut current = stretch(*rest, floating, tol);
+    loop {
+        let mut progress = false;
+        for slot in slots.iter_mut().filter(|s| s.is_floating()) {
+            let next_rest = *rest - slot.fixed;
+            if next_rest < -tol {
+                continue; // its fixed parts no longer fit
+            }
+            let next_floating = floating + slot.floating;
+            let next_stretch = stretch(next_rest, next_floating, tol);
+            if next_stretch < current - STRETCH_EPSILON {
+                budget.add(slot.parts as f64)?;
+                slot.count += 1;
+                *rest = next_rest;
+                floating = next_floating;
+                current = next_stretch;
+                progress = true;
+            }
+        }
+        if !progress {
+            break;
+        }
+    }
+    Ok(floating)
 }
 
 /// `|s - 1|` for the floating scale `s = rest / floating`; a split where nothing floats is

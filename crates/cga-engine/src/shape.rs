@@ -96,14 +96,31 @@ impl Geometry {
     }
 
     /// The mesh in scope-local coordinates, transforming it if needed (once:
-    /// the result replaces the stored mesh).
+    /// the result replaces the stored mesh). A mesh no other shape shares is
+    /// transformed where it is, without a copy.
     pub fn local(&mut self) -> &Arc<Mesh> {
+        self.bake();
+        &self.mesh
+    }
+
+    /// The mesh in scope-local coordinates for editing: copied first only if
+    /// another shape shares it (an operation that changes UVs or winding of
+    /// a freshly cut piece edits it in place).
+    pub fn local_mut(&mut self) -> &mut Mesh {
+        self.bake();
+        Arc::make_mut(&mut self.mesh)
+    }
+
+    /// Applies the pending map to the vertices.
+    fn bake(&mut self) {
         if let Some(t) = self.to_scope.take() {
             if t != DAffine3::IDENTITY {
-                self.mesh = Arc::new(transformed(&self.mesh, &t));
+                match Arc::get_mut(&mut self.mesh) {
+                    Some(m) => transform_in_place(m, &t),
+                    None => self.mesh = Arc::new(transformed(&self.mesh, &t)),
+                }
             }
         }
-        &self.mesh
     }
 
     /// The stored mesh and its map, without transforming anything.
@@ -121,11 +138,16 @@ impl Geometry {
 /// facing outwards.
 pub fn transformed(mesh: &Mesh, t: &DAffine3) -> Mesh {
     let mut m = mesh.clone();
-    cga_geometry::transform::transform(&mut m, t);
-    if t.matrix3.determinant() < 0.0 {
-        cga_geometry::transform::reverse_faces(&mut m);
-    }
+    transform_in_place(&mut m, t);
     m
+}
+
+/// [`transformed`] without the copy.
+pub fn transform_in_place(mesh: &mut Mesh, t: &DAffine3) {
+    cga_geometry::transform::transform(mesh, t);
+    if t.matrix3.determinant() < 0.0 {
+        cga_geometry::transform::reverse_faces(mesh);
+    }
 }
 
 /// Trim state of a shape: the switches `trim.horizontal` and
@@ -293,14 +315,36 @@ impl Shape {
 
     /// The geometry in object coordinates (for output and world queries).
     pub fn object_mesh(&self) -> Mesh {
-        let (mesh, to_scope) = self.geometry.raw();
+        transformed(self.geometry.raw().0, &self.object_transform())
+    }
+
+    /// The map from the stored mesh's coordinates to object coordinates
+    /// (what [`object_mesh`](Shape::object_mesh) applies).
+    pub fn object_transform(&self) -> DAffine3 {
         let frame = self.scope.frame.affine();
-        let t = match to_scope {
+        match self.geometry.raw().1 {
             Some(m) => frame * *m,
             None => frame,
-        };
-        transformed(mesh, &t)
+        }
     }
+
+    /// [`object_mesh`](Shape::object_mesh), taking the mesh out of the shape
+    /// (no copy when no other shape shares it); the shape is left without
+    /// geometry, for an operation that replaces it.
+    pub fn take_object_mesh(&mut self) -> Mesh {
+        let t = self.object_transform();
+        let g = std::mem::replace(&mut self.geometry, Geometry::new(empty_mesh()));
+        let mut m = Arc::try_unwrap(g.mesh).unwrap_or_else(|shared| (*shared).clone());
+        transform_in_place(&mut m, &t);
+        m
+    }
+}
+
+/// A shared empty mesh (a placeholder that costs no allocation).
+fn empty_mesh() -> Arc<Mesh> {
+    static EMPTY: std::sync::LazyLock<Arc<Mesh>> =
+        std::sync::LazyLock::new(|| Arc::new(Mesh::new()));
+    EMPTY.clone()
 }
 
 /// Bounding box of the positions a mesh's faces use.

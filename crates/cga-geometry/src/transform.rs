@@ -29,8 +29,8 @@ pub fn transform(mesh: &mut Mesh, m: &DAffine3) {
 /// first (`c0 cn-1 .. c1`), with its per-corner attributes; per-corner
 /// normals are negated.
 pub fn reverse_faces(mesh: &mut Mesh) {
-    for l in mesh.loops.clone() {
-        let r = mesh.loop_corners(l);
+    for i in 0..mesh.loops.len() {
+        let r = mesh.loop_corners(mesh.loops[i]);
         if r.len() < 3 {
             continue;
         }

@@ -90,11 +90,9 @@ pub fn exec(
                 shape.material = Arc::new(MaterialOverrides::default());
             }
             if target != "shape" {
-                let mut mesh = (**shape.geometry.local()).clone();
-                for m in &mut mesh.materials {
+                for m in &mut shape.geometry.local_mut().materials {
                     *m = cga_geometry::Material::default();
                 }
-                shape.set_local_mesh(mesh);
             }
         }
         Op::Print => cx.out.prints.push(to_text(&args[0].value)),

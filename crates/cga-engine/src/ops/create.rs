@@ -28,9 +28,7 @@ pub fn exec(
         | Op::PrimitiveCone => primitive(shape, call.op, args),
         Op::Insert => insert(cx, shape, call, args),
         Op::ReverseNormals => {
-            let mut mesh = (**shape.geometry.local()).clone();
-            cga_geometry::transform::reverse_faces(&mut mesh);
-            shape.set_local_mesh(mesh);
+            cga_geometry::transform::reverse_faces(shape.geometry.local_mut());
             Ok(())
         }
         _ => unreachable!("not a geometry creation operation"),
@@ -302,10 +300,10 @@ fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {
         _ => unreachable!("arity checked by the resolver"),
     };
     // Extrude in object coordinates, where "world up" is +y.
-    let mesh = shape.object_mesh();
-    if mesh.faces.is_empty() {
+    if shape.geometry.is_empty() {
         return Ok(());
     }
+    let mesh = shape.take_object_mesh();
     let how = match kind {
         "world.up" => Extrusion::Direction(DVec3::Y),
         "world.up.flatTop" => Extrusion::DirectionFlatTop(DVec3::Y),
@@ -330,7 +328,9 @@ fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {
         .unwrap_or_else(|| y.any_orthonormal_vector());
     let axes = DMat3::from_cols(x, y, x.cross(y));
     let to_scope = shape.scope.frame.affine().inverse();
-    shape.set_local_mesh(crate::shape::transformed(&out, &to_scope));
+    let mut out = out;
+    crate::shape::transform_in_place(&mut out, &to_scope);
+    shape.set_local_mesh(out);
     shape.fit_scope(axes);
     if dist < 0.0 {
         // A negative extrusion keeps the base at the scope origin with sy < 0.

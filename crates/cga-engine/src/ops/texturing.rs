@@ -116,9 +116,7 @@ pub fn exec(
         Op::DeleteUV => {
             let set = uv_set(&args[0])?;
             if shape.geometry.raw().0.uvs[set].is_some() {
-                let mut m = (**shape.geometry.local()).clone();
-                m.uvs[set] = None;
-                shape.set_local_mesh(m);
+                shape.geometry.local_mut().uvs[set] = None;
             }
             Ok(())
         }
@@ -127,9 +125,8 @@ pub fn exec(
             let to = uv_set(&args[1])?;
             let mesh = shape.geometry.raw().0;
             if from != to && mesh.uvs[from] != mesh.uvs[to] {
-                let mut m = (**shape.geometry.local()).clone();
+                let m = shape.geometry.local_mut();
                 m.uvs[to] = m.uvs[from].clone();
-                shape.set_local_mesh(m);
             }
             Ok(())
         }
@@ -309,14 +306,23 @@ pub fn project_uv(shape: &mut Shape, set: usize, p: &Projection) {
         return;
     }
     let frame = shape.scope.frame;
-    let mut m = (**shape.geometry.local()).clone();
-    let at: Vec<DVec2> = m
-        .positions
-        .iter()
-        .map(|&q| p.uv(frame.to_object(q)))
-        .collect();
-    m.uvs[set] = Some(m.corners.iter().map(|&c| at[c as usize]).collect());
-    shape.set_local_mesh(m);
+    // In place: the geometry is usually this shape's own (a piece just cut),
+    // and the UV array of a set being re-projected is reused.
+    let m = shape.geometry.local_mut();
+    PROJECTED.with(|at| {
+        let mut at = at.borrow_mut();
+        at.clear();
+        at.extend(m.positions.iter().map(|&q| p.uv(frame.to_object(q))));
+        let mut uvs = m.uvs[set].take().unwrap_or_default();
+        uvs.clear();
+        uvs.extend(m.corners.iter().map(|&c| at[c as usize]));
+        m.uvs[set] = Some(uvs);
+    });
+}
+
+thread_local! {
+    /// The texture coordinates of each position, reused by `project_uv`.
+    static PROJECTED: std::cell::RefCell<Vec<DVec2>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// Runs `f` on UV set `set` of the shape's geometry (scope-local), if the
@@ -325,12 +331,11 @@ fn edit_uvs(shape: &mut Shape, set: usize, f: impl FnOnce(&Mesh, &mut Vec<DVec2>
     if shape.geometry.raw().0.uvs[set].is_none() {
         return;
     }
-    let mut m = (**shape.geometry.local()).clone();
+    let m = shape.geometry.local_mut();
     if let Some(mut uvs) = m.uvs[set].take() {
-        f(&m, &mut uvs);
+        f(m, &mut uvs);
         m.uvs[set] = Some(uvs);
     }
-    shape.set_local_mesh(m);
 }
 
 #[derive(Clone, Copy, PartialEq)]
@@ -396,13 +401,14 @@ fn tile_uv(cx: &mut Interp, shape: &mut Shape, call: &OpCall, args: &[Arg]) -> R
     if shape.geometry.raw().0.uvs[set].is_none() {
         return Ok(());
     }
-    let mesh = shape.geometry.local().clone();
-    let Some((lo, hi)) = uv_bounds(&mesh, set) else {
+    // Borrowed, not shared: `edit_uvs` below then edits the mesh in place.
+    let mesh = shape.geometry.local();
+    let Some((lo, hi)) = uv_bounds(mesh, set) else {
         return Ok(());
     };
     let range = hi - lo;
     // Scene units per unit of u and of v (None: no usable parameterisation).
-    let unit = uv_unit_scale(&mesh, set);
+    let unit = uv_unit_scale(mesh, set);
     let mut factor = DVec2::ONE;
     for (k, arg) in args[1..3].iter().enumerate() {
         let x = arg.num()?;

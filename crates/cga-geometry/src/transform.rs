@@ -203,9 +203,9 @@ mod tests {
             color: [1.0, 0.0, 0.0],
             ..Material::default()
         };
-        b.materials = vec![Material::default(), red.clone()];
+        b.materials = vec![Material::default(), red.clone()].into();
         b.faces[1].material = 1;
-        b.groups = vec![String::new(), "roof".into()];
+        b.groups = vec![String::new(), "roof".into()].into();
         b.faces[1].group = 1;
         b.uvs[2] = Some(vec![DVec2::ONE; b.corners.len()]);
         merge(&mut a, &b);

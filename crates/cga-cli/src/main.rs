@@ -311,6 +311,9 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
             max_depth: args.max_depth,
             max_shapes: args.max_shapes,
         },
+        // The writer places each leaf's shared mesh while writing: no leaf
+        // is copied into object coordinates first.
+        leaves: true,
         ..GenerateOptions::default()
     };
     for a in &args.attrs {
@@ -411,11 +414,15 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
             }
             reports.add(&out.reports);
             shapes += out.shapes;
-            leaves += out.meshes.len();
+            leaves += out.meshes.len() + out.leaves.len();
             if let Some(w) = writer.as_mut() {
+                let export_failed = |e| Failure::Usage(format!("export failed: {e}"));
                 for m in &out.meshes {
-                    w.add_mesh(m)
-                        .map_err(|e| Failure::Usage(format!("export failed: {e}")))?;
+                    w.add_mesh(m).map_err(export_failed)?;
+                }
+                for leaf in &out.leaves {
+                    w.add_placed(&leaf.mesh, Some(&leaf.transform), &leaf.materials)
+                        .map_err(export_failed)?;
                 }
             }
             progress.inc(1);

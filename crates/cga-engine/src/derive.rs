@@ -9,8 +9,10 @@
 //! sequence goes on with the current shape (`extrude(15) r(..) X. r(..) X.`).
 
 use std::collections::HashSet;
+use std::sync::Arc;
 
-use cga_geometry::Mesh;
+use cga_geometry::mesh::SharedVec;
+use cga_geometry::{DAffine3, Material, Mesh};
 use cga_syntax::{Diagnostic, Span};
 use cga_value::Value;
 
@@ -157,11 +159,41 @@ impl ShapeState {
     }
 }
 
+/// A leaf shape's geometry as the derivation left it: the shape's mesh
+/// (shared with the shape, never copied), the map that places it in
+/// object coordinates, and the final materials of its slots. Baking it
+/// ([`Leaf::to_mesh`]) gives the mesh [`LotOutput::meshes`] would hold;
+/// exporters can place it while writing instead
+/// (`cga_export::ModelWriter::add_placed`).
+#[derive(Clone, Debug)]
+pub struct Leaf {
+    pub mesh: Arc<Mesh>,
+    /// From the mesh's coordinates to object coordinates. A map that
+    /// mirrors (negative determinant) also reverses the faces.
+    pub transform: DAffine3,
+    /// The materials of the mesh's slots: its own with the shape's material
+    /// attributes applied and texture paths resolved to files.
+    pub materials: SharedVec<Material>,
+}
+
+impl Leaf {
+    /// The geometry in object coordinates with its final materials.
+    pub fn to_mesh(&self) -> Mesh {
+        let mut m = crate::shape::transformed(&self.mesh, &self.transform);
+        m.materials = self.materials.clone();
+        m
+    }
+}
+
 /// What the derivation of one initial shape produced.
 #[derive(Default)]
 pub struct LotOutput {
-    /// Leaf geometry in object coordinates, with final materials.
+    /// Leaf geometry in object coordinates, with final materials (empty when
+    /// the leaves were asked for as [`LotOutput::leaves`]).
     pub meshes: Vec<Mesh>,
+    /// Leaf geometry unbaked, when asked for (`GenerateOptions::leaves`),
+    /// in derivation order.
+    pub leaves: Vec<Leaf>,
     pub prints: Vec<String>,
     pub reports: Vec<(String, Value)>,
     pub warnings: Vec<Diagnostic>,
@@ -199,7 +231,31 @@ pub struct Interp<'a> {
     /// The rule file of the rule being applied: texture paths of the shapes
     /// it emits are resolved from there.
     pub(crate) current_file: cga_syntax::FileId,
+    /// Emit leaves unbaked into `out.leaves` instead of `out.meshes`.
+    pub keep_leaves: bool,
+    /// The final materials of recently emitted leaves (see `leaf_materials`).
+    emitted: EmitCache,
 }
+
+/// The last few (material attributes, geometry materials, rule file) →
+/// final materials of emitted leaves. Sibling leaves (the walls of a
+/// facade) set equal attributes on pieces of one mesh, so most leaves reuse
+/// a result: no materials are built, and the shared list lets the exporter
+/// recognise it by address.
+#[derive(Default)]
+struct EmitCache {
+    entries: Vec<EmitEntry>,
+    next: usize,
+}
+
+struct EmitEntry {
+    overrides: Arc<crate::material_attr::MaterialOverrides>,
+    base: SharedVec<Material>,
+    file: cga_syntax::FileId,
+    result: SharedVec<Material>,
+}
+
+const EMIT_CACHE_SIZE: usize = 8;
 
 impl<'a> Interp<'a> {
     pub fn new(
@@ -229,6 +285,8 @@ impl<'a> Interp<'a> {
             warned: HashSet::new(),
             textures: Default::default(),
             current_file: cga_syntax::FileId(0),
+            keep_leaves: false,
+            emitted: EmitCache::default(),
         }
     }
 
@@ -326,16 +384,57 @@ impl<'a> Interp<'a> {
         if shape.geometry.is_empty() {
             return;
         }
-        let mut mesh = shape.object_mesh();
-        if !shape.material.is_empty() {
-            for m in &mut mesh.materials {
-                *m = shape.material.apply(m);
+        let (mesh, _) = shape.geometry.raw();
+        let materials = self.leaf_materials(shape, &mesh.materials);
+        if self.keep_leaves {
+            self.out.leaves.push(Leaf {
+                mesh: mesh.clone(),
+                transform: shape.object_transform(),
+                materials,
+            });
+        } else {
+            let mut mesh = shape.object_mesh();
+            mesh.materials = materials;
+            self.out.meshes.push(mesh);
+        }
+    }
+
+    /// The final materials of a leaf whose geometry has the slots `base`:
+    /// the shape's material attributes applied, texture paths as written
+    /// replaced by the files they name.
+    fn leaf_materials(&mut self, shape: &Shape, base: &SharedVec<Material>) -> SharedVec<Material> {
+        let file = self.current_file;
+        let overrides = &shape.material;
+        let hit = self.emitted.entries.iter().find(|e| {
+            e.file == file
+                && SharedVec::ptr_eq(&e.base, base)
+                && (Arc::ptr_eq(&e.overrides, overrides) || *e.overrides == **overrides)
+        });
+        if let Some(e) = hit {
+            return e.result.clone();
+        }
+        let mut result = base.clone();
+        if !overrides.is_empty() {
+            for m in &mut result {
+                *m = overrides.apply(m);
             }
         }
-        // Texture paths as written become the files they name.
         self.textures
-            .resolve_mesh(self.assets, self.current_file, &mut mesh);
-        self.out.meshes.push(mesh);
+            .resolve_materials(self.assets, file, &mut result);
+        let entry = EmitEntry {
+            overrides: overrides.clone(),
+            base: base.clone(),
+            file,
+            result: result.clone(),
+        };
+        let cache = &mut self.emitted;
+        if cache.entries.len() < EMIT_CACHE_SIZE {
+            cache.entries.push(entry);
+        } else {
+            cache.entries[cache.next] = entry;
+            cache.next = (cache.next + 1) % EMIT_CACHE_SIZE;
+        }
+        result
     }
 
     pub fn exec_body(

@@ -18,6 +18,11 @@ pub struct GenerateOptions {
     pub attrs: Vec<(AttrId, Value)>,
     pub seed: u64,
     pub limits: Limits,
+    /// Hand leaf geometry out unbaked (`LotOutput::leaves`: each leaf's
+    /// mesh shared with its shape, with the map that places it) instead of
+    /// as meshes in object coordinates (`LotOutput::meshes`). Exporters
+    /// place the leaves while writing, which saves a copy of every leaf.
+    pub leaves: bool,
 }
 
 /// Derives one lot with `rule`. The output holds everything generated,
@@ -50,6 +55,7 @@ pub fn generate_lot(
         start_rule: program.rules[rule as usize].name.clone(),
     };
     let mut interp = Interp::new(program, assets, options.limits, info, shape, &[]);
+    interp.keep_leaves = options.leaves;
     let mut error = None;
     // Lot attributes (GeoJSON properties) first, command-line values win.
     let lot_attrs = lot

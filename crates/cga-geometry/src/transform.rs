@@ -1,6 +1,6 @@
 //! Moving meshes between frames, reversing faces, and merging meshes.
 
-use glam::{DAffine3, DVec2, DVec3};
+use glam::{DAffine3, DMat3, DVec2, DVec3};
 
 use crate::mesh::{Face, Mesh};
 
@@ -13,15 +13,21 @@ pub fn transform(mesh: &mut Mesh, m: &DAffine3) {
         *p = m.transform_point3(*p);
     }
     if let Some(normals) = &mut mesh.normals {
-        let lin = m.matrix3;
-        let nm = if lin.determinant().abs() > 0.0 {
-            lin.inverse().transpose()
-        } else {
-            lin
-        };
+        let nm = normal_matrix(m);
         for n in normals {
             *n = (nm * *n).normalize_or_zero();
         }
+    }
+}
+
+/// The matrix [`transform`] maps normals with (before renormalising): the
+/// inverse transpose of `m`'s linear part, or that part itself if singular.
+pub fn normal_matrix(m: &DAffine3) -> DMat3 {
+    let lin = m.matrix3;
+    if lin.determinant().abs() > 0.0 {
+        lin.inverse().transpose()
+    } else {
+        lin
     }
 }
 

@@ -519,10 +519,24 @@ impl TextureFiles {
     /// Replaces the texture paths of `mesh`'s materials by the files they
     /// name, searched from rule file `from` (see the module docs).
     pub fn resolve_mesh(&mut self, assets: &Assets, from: FileId, mesh: &mut Mesh) {
-        for m in &mut mesh.materials {
-            for ch in &mut m.maps {
-                if let Some(found) = self.resolve(assets, from, &ch.path) {
-                    ch.path = found;
+        self.resolve_materials(assets, from, &mut mesh.materials);
+    }
+
+    /// [`resolve_mesh`](TextureFiles::resolve_mesh) for a list of materials;
+    /// a shared list is copied only if a path changes.
+    pub fn resolve_materials(
+        &mut self,
+        assets: &Assets,
+        from: FileId,
+        materials: &mut cga_geometry::mesh::SharedVec<cga_geometry::Material>,
+    ) {
+        for i in 0..materials.len() {
+            for k in 0..materials[i].maps.len() {
+                let path = &materials[i].maps[k].path;
+                if let Some(found) = self.resolve(assets, from, path) {
+                    if found != *path {
+                        materials.make_mut()[i].maps[k].path = found;
+                    }
                 }
             }
         }

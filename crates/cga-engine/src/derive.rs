@@ -233,6 +233,11 @@ pub struct Interp<'a> {
     pub(crate) current_file: cga_syntax::FileId,
     /// Emit leaves unbaked into `out.leaves` instead of `out.meshes`.
     pub keep_leaves: bool,
+    /// Empty argument lists and rule frames to reuse: every operation and
+    /// rule call needs one, and allocating each is a measurable part of a
+    /// derivation.
+    arg_pool: Vec<Vec<Arg>>,
+    frame_pool: Vec<Vec<Value>>,
     /// The final materials of recently emitted leaves (see `leaf_materials`).
     emitted: EmitCache,
 }
@@ -287,6 +292,8 @@ impl<'a> Interp<'a> {
             current_file: cga_syntax::FileId(0),
             keep_leaves: false,
             emitted: EmitCache::default(),
+            arg_pool: Vec::new(),
+            frame_pool: Vec::new(),
         }
     }
 
@@ -345,6 +352,8 @@ impl<'a> Interp<'a> {
         self.depth -= 1;
         let r = r.map(|()| self.finish(st));
         self.current_file = caller_file;
+        frame.clear();
+        self.frame_pool.push(frame);
         r
     }
 
@@ -511,14 +520,26 @@ impl<'a> Interp<'a> {
     ) -> Result<(), RtError> {
         match s {
             RStmt::Op(call) => {
-                let mut args = Vec::with_capacity(call.args.len());
+                // Argument lists come from a pool (operations nest: a split
+                // runs its parts' operations while its own arguments live).
+                let mut args = self.arg_pool.pop().unwrap_or_default();
                 for a in &call.args {
-                    args.push(self.eval_arg(a, frame, &st.shape)?);
+                    match self.eval_arg(a, frame, &st.shape) {
+                        Ok(v) => args.push(v),
+                        Err(e) => {
+                            args.clear();
+                            self.arg_pool.push(args);
+                            return Err(e);
+                        }
+                    }
                 }
-                ops::exec(self, st, call, &args, frame)
+                let r = ops::exec(self, st, call, &args, frame);
+                args.clear();
+                self.arg_pool.push(args);
+                r
             }
             RStmt::Rule(rc) => {
-                let mut args = Vec::with_capacity(rc.args.len());
+                let mut args = self.frame_pool.pop().unwrap_or_default();
                 for a in &rc.args {
                     args.push(self.eval(a, frame, &st.shape)?);
                 }

@@ -37,11 +37,11 @@
 
 pub mod insert_along_uv;
 
-use std::collections::HashMap;
 use std::io::Read;
 use std::sync::Arc;
 
 use cga_geometry::measure::{uv_bounds, uv_unit_scale};
+use cga_geometry::topology::FxHashMap;
 use cga_geometry::{DMat3, DVec2, DVec3, Face, Loop, Mesh, UV_SETS};
 use cga_syntax::FileId;
 use cga_value::Value;
@@ -461,7 +461,7 @@ fn texture(cx: &mut Interp, shape: &mut Shape, call: &OpCall, arg: &Arg) -> Resu
     };
     let alpha = cx.textures.has_alpha(cx.assets, call.span.file, &path);
     let m = Arc::make_mut(&mut shape.material);
-    let opacity = if alpha { path.clone() } else { Arc::from("") };
+    let opacity = if alpha { path.clone() } else { empty_str() };
     for (field, v) in [(MatField::Map(0), path), (MatField::Map(4), opacity)] {
         m.set(field, &Value::Str(v))
             .map_err(|e| RtError::new(e, arg.span))?;
@@ -469,12 +469,18 @@ fn texture(cx: &mut Interp, shape: &mut Shape, call: &OpCall, arg: &Arg) -> Resu
     Ok(())
 }
 
+/// A shared empty string (`Arc::from("")` would allocate every time).
+fn empty_str() -> Arc<str> {
+    static EMPTY: std::sync::LazyLock<Arc<str>> = std::sync::LazyLock::new(|| Arc::from(""));
+    EMPTY.clone()
+}
+
 /// Texture files named by rules: where they are and whether they have an
 /// alpha channel, found once per path and rule file (per initial shape).
 #[derive(Default)]
 pub struct TextureFiles {
-    found: HashMap<(u32, Arc<str>), Option<Arc<str>>>,
-    alpha: HashMap<Arc<str>, bool>,
+    found: FxHashMap<(u32, Arc<str>), Option<Arc<str>>>,
+    alpha: FxHashMap<Arc<str>, bool>,
 }
 
 impl TextureFiles {
@@ -487,16 +493,7 @@ impl TextureFiles {
         if let Some(r) = self.found.get(&(from.0, path.clone())) {
             return r.clone();
         }
-        // Textures of inserted assets come as paths next to the asset file,
-        // which may be relative to the working folder.
-        let file = assets.resolve(from, path).or_else(|| {
-            let p = std::path::Path::new(&**path);
-            p.is_file().then(|| p.to_path_buf())
-        });
-        let r = file.map(|f| {
-            let f = f.canonicalize().unwrap_or(f);
-            Arc::from(f.to_string_lossy().as_ref())
-        });
+        let r = assets.texture_file(from, path);
         self.found.insert((from.0, path.clone()), r.clone());
         r
     }

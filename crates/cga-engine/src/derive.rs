@@ -368,10 +368,15 @@ impl<'a> Interp<'a> {
     /// parent's scope remembered for `center`.
     pub fn child(&mut self, parent: &Shape, span: Span) -> Result<Shape, RtError> {
         self.count_shape(span)?;
+        Ok(self.successor(parent))
+    }
+
+    /// [`child`](Interp::child) without counting it.
+    fn successor(&self, parent: &Shape) -> Shape {
         let mut c = parent.clone();
         c.parent_scope = parent.scope;
         c.rng.set(parent.child_rng(parent.next_random().to_bits()));
-        Ok(c)
+        c
     }
 
     pub fn count_shape(&mut self, span: Span) -> Result<(), RtError> {
@@ -454,11 +459,11 @@ impl<'a> Interp<'a> {
     ) -> Result<(), RtError> {
         match body {
             RBody::Ops(stmts) => {
-                for s in stmts {
+                for (i, s) in stmts.iter().enumerate() {
                     if st.deleted {
                         break;
                     }
-                    self.exec_stmt(s, frame, st)?;
+                    self.exec_stmt(s, frame, st, i + 1 == stmts.len())?;
                 }
                 Ok(())
             }
@@ -512,11 +517,16 @@ impl<'a> Interp<'a> {
         Ok(None)
     }
 
+    /// Runs one statement. `last`: nothing runs on `st` after it but
+    /// `finish` (every caller of `exec_body` finishes the state right
+    /// after), so a rule called last takes the shape's geometry instead of
+    /// sharing it, and can edit it without a copy.
     fn exec_stmt(
         &mut self,
         s: &RStmt,
         frame: &[Value],
         st: &mut ShapeState,
+        last: bool,
     ) -> Result<(), RtError> {
         match s {
             RStmt::Op(call) => {
@@ -543,7 +553,18 @@ impl<'a> Interp<'a> {
                 for a in &rc.args {
                     args.push(self.eval(a, frame, &st.shape)?);
                 }
-                let mut child = self.child(&st.shape, rc.span)?;
+                let mut child = if last && !rc.dynamic {
+                    // The successor is the shape's last use (a dynamic
+                    // import still evaluates its overrides on the shape).
+                    self.count_shape(rc.span)?;
+                    let geometry =
+                        std::mem::replace(&mut st.shape.geometry, crate::shape::Geometry::empty());
+                    let mut c = self.successor(&st.shape);
+                    c.geometry = geometry;
+                    c
+                } else {
+                    self.child(&st.shape, rc.span)?
+                };
                 if rc.dynamic {
                     self.reinitialize_import(rc, frame, &st.shape, &mut child)?;
                 }

@@ -87,6 +87,11 @@ impl Geometry {
         }
     }
 
+    /// No geometry (a shared empty mesh: no allocation).
+    pub fn empty() -> Geometry {
+        Geometry::new(empty_mesh())
+    }
+
     /// Applies `m` (scope-local → scope-local) after the current map.
     pub fn transform(&mut self, m: DAffine3) {
         self.to_scope = Some(match self.to_scope {
@@ -333,7 +338,7 @@ impl Shape {
     /// geometry, for an operation that replaces it.
     pub fn take_object_mesh(&mut self) -> Mesh {
         let t = self.object_transform();
-        let g = std::mem::replace(&mut self.geometry, Geometry::new(empty_mesh()));
+        let g = std::mem::replace(&mut self.geometry, Geometry::empty());
         let mut m = Arc::try_unwrap(g.mesh).unwrap_or_else(|shared| (*shared).clone());
         transform_in_place(&mut m, &t);
         m

@@ -12,7 +12,7 @@ use std::collections::HashSet;
 use std::sync::Arc;
 
 use cga_geometry::mesh::SharedVec;
-use cga_geometry::{DAffine3, Material, Mesh};
+use cga_geometry::{DAffine3, DVec2, DVec3, Material, Mesh};
 use cga_syntax::{Diagnostic, Span};
 use cga_value::Value;
 
@@ -238,6 +238,7 @@ pub struct Interp<'a> {
     /// derivation.
     arg_pool: Vec<Vec<Arg>>,
     frame_pool: Vec<Vec<Value>>,
+    pub(crate) memo: MeshMemo,
     /// The final materials of recently emitted leaves (see `leaf_materials`).
     emitted: EmitCache,
 }
@@ -261,6 +262,86 @@ struct EmitEntry {
 }
 
 const EMIT_CACHE_SIZE: usize = 8;
+
+/// Facts about shared meshes (inserted assets), computed once per lot
+/// instead of once per insertion: the asset's bounding box, and the texture
+/// measures `tileUV` needs of it placed by a given map. Entries hold their
+/// mesh, so an address names the same mesh as long as it is here.
+#[derive(Default)]
+pub(crate) struct MeshMemo {
+    bounds: Vec<(Arc<Mesh>, Option<(DVec3, DVec3)>)>,
+    uv: Vec<UvMemo>,
+    next_bounds: usize,
+    next_uv: usize,
+}
+
+/// `uv_bounds` and `uv_unit_scale` of UV set `set` of `mesh` placed by `to_scope`.
+pub(crate) type UvMeasures = (Option<(DVec2, DVec2)>, Option<DVec2>);
+
+struct UvMemo {
+    mesh: Arc<Mesh>,
+    to_scope: Option<DAffine3>,
+    set: usize,
+    measures: UvMeasures,
+}
+
+const MEMO_SIZE: usize = 16;
+
+impl MeshMemo {
+    /// The bounding box of the positions `mesh`'s faces use.
+    pub(crate) fn bounds(&mut self, mesh: &Arc<Mesh>) -> Option<(DVec3, DVec3)> {
+        if Arc::strong_count(mesh) == 1 {
+            // Nobody else has it: it will not come again.
+            return crate::shape::local_bounds(mesh);
+        }
+        if let Some((_, b)) = self.bounds.iter().find(|(m, _)| Arc::ptr_eq(m, mesh)) {
+            return *b;
+        }
+        let b = crate::shape::local_bounds(mesh);
+        remember(&mut self.bounds, &mut self.next_bounds, (mesh.clone(), b));
+        b
+    }
+
+    /// The UV measures of a shared `mesh` placed by `to_scope`, if known.
+    pub(crate) fn uv(
+        &self,
+        mesh: &Arc<Mesh>,
+        to_scope: Option<&DAffine3>,
+        set: usize,
+    ) -> Option<UvMeasures> {
+        self.uv
+            .iter()
+            .find(|e| Arc::ptr_eq(&e.mesh, mesh) && e.to_scope.as_ref() == to_scope && e.set == set)
+            .map(|e| e.measures)
+    }
+
+    pub(crate) fn remember_uv(
+        &mut self,
+        mesh: Arc<Mesh>,
+        to_scope: Option<DAffine3>,
+        set: usize,
+        measures: UvMeasures,
+    ) {
+        let entry = UvMemo {
+            mesh,
+            to_scope,
+            set,
+            measures,
+        };
+        remember(&mut self.uv, &mut self.next_uv, entry);
+    }
+}
+
+/// Adds `entry` to a memo of at most `MEMO_SIZE` entries, replacing the
+/// oldest when full.
+fn remember<T>(list: &mut Vec<T>, next: &mut usize, entry: T) {
+    if list.len() < MEMO_SIZE {
+        list.push(entry);
+    } else {
+        list[*next] = entry;
+        *next = (*next + 1) % MEMO_SIZE;
+    }
+}
 
 impl<'a> Interp<'a> {
     pub fn new(
@@ -294,6 +375,7 @@ impl<'a> Interp<'a> {
             emitted: EmitCache::default(),
             arg_pool: Vec::new(),
             frame_pool: Vec::new(),
+            memo: MeshMemo::default(),
         }
     }
 

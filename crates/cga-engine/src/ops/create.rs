@@ -184,7 +184,8 @@ fn insert(cx: &mut Interp, shape: &mut Shape, call: &OpCall, args: &[Arg]) -> Re
                 cga_geometry::transform::transform(&mut m, &rot);
                 mesh = Arc::new(m);
             }
-            insert_fitted(shape, mesh, mode);
+            let bounds = cx.memo.bounds(&mesh);
+            insert_fitted_in(shape, mesh, bounds, mode);
         }
         Err(message) => {
             // A missing asset must not lose the model: warn and go on.
@@ -211,7 +212,18 @@ pub enum InsertMode {
 /// Places `asset` (in its own coordinates) into the scope as CGA's insert
 /// does, including the rules for scope sizes that are zero.
 pub fn insert_fitted(shape: &mut Shape, asset: Arc<Mesh>, mode: InsertMode) {
-    let Some((lo, hi)) = local_bounds(&asset) else {
+    let bounds = local_bounds(&asset);
+    insert_fitted_in(shape, asset, bounds, mode)
+}
+
+/// [`insert_fitted`] with the asset's bounds (`local_bounds`) known.
+fn insert_fitted_in(
+    shape: &mut Shape,
+    asset: Arc<Mesh>,
+    bounds: Option<(DVec3, DVec3)>,
+    mode: InsertMode,
+) {
+    let Some((lo, hi)) = bounds else {
         shape.set_local_mesh(Mesh::new());
         return;
     };

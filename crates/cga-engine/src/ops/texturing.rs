@@ -401,14 +401,35 @@ fn tile_uv(cx: &mut Interp, shape: &mut Shape, call: &OpCall, args: &[Arg]) -> R
     if shape.geometry.raw().0.uvs[set].is_none() {
         return Ok(());
     }
-    // Borrowed, not shared: `edit_uvs` below then edits the mesh in place.
-    let mesh = shape.geometry.local();
-    let Some((lo, hi)) = uv_bounds(mesh, set) else {
+    // An inserted asset placed like one before (the windows of a facade)
+    // has the same measures: they are remembered.
+    let (raw, to_scope) = shape.geometry.raw();
+    let shared = Arc::strong_count(raw) > 1;
+    let known = if shared {
+        cx.memo.uv(raw, to_scope, set)
+    } else {
+        None
+    };
+    let (bounds, unit) = match known {
+        Some(m) => m,
+        None => {
+            let key = shared.then(|| (raw.clone(), to_scope.copied()));
+            // Borrowed, not shared: `edit_uvs` below then edits an unshared
+            // mesh in place.
+            let mesh = shape.geometry.local();
+            // Scene units per unit of u and of v (None: no usable
+            // parameterisation).
+            let m = (uv_bounds(mesh, set), uv_unit_scale(mesh, set));
+            if let Some((raw, to_scope)) = key {
+                cx.memo.remember_uv(raw, to_scope, set, m);
+            }
+            m
+        }
+    };
+    let Some((lo, hi)) = bounds else {
         return Ok(());
     };
     let range = hi - lo;
-    // Scene units per unit of u and of v (None: no usable parameterisation).
-    let unit = uv_unit_scale(mesh, set);
     let mut factor = DVec2::ONE;
     for (k, arg) in args[1..3].iter().enumerate() {
         let x = arg.num()?;

@@ -366,11 +366,6 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
             .map(|n| n.get())
             .unwrap_or(1)
     });
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(jobs.max(1))
-        .stack_size(DERIVATION_STACK)
-        .build()
-        .map_err(|e| Failure::Usage(format!("cannot start worker threads: {e}")))?;
     let progress = progress_bar(lots.len());
 
     let mut failed_lots = 0usize;
@@ -378,56 +373,49 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
     let mut shapes = 0usize;
     let mut leaves = 0usize;
     let mut seen_warnings = std::collections::HashSet::new();
-    // Lots are derived in parallel a batch at a time; their results are
-    // written in lot order, so the output does not depend on the thread count
-    // and memory holds one batch of results, not the whole city.
-    let batch = (jobs * 8).max(1);
-    for (b, chunk) in lots.chunks(batch).enumerate() {
-        let results: Vec<_> = pool.install(|| {
-            use rayon::prelude::*;
-            chunk
-                .par_iter()
-                .enumerate()
-                .map(|(j, lot)| generate_lot(&program, &assets, rule, lot, b * batch + j, &options))
-                .collect()
-        });
-        for (lot, (out, error)) in chunk.iter().zip(results) {
-            {
-                use std::io::Write;
-                let mut stdout = std::io::stdout().lock();
-                for line in &out.prints {
-                    let _ = writeln!(stdout, "{line}");
-                }
+    // Takes the results of the lots in lot order: prints, diagnostics,
+    // reports, and the geometry into the writer.
+    let mut take = |lot: &Lot, out: cga_engine::LotOutput, error: Option<cga_engine::RtError>| {
+        {
+            use std::io::Write;
+            let mut stdout = std::io::stdout().lock();
+            for line in &out.prints {
+                let _ = writeln!(stdout, "{line}");
             }
-            for w in &out.warnings {
-                if seen_warnings.insert((w.message.clone(), w.span)) {
-                    progress.suspend(|| report_diagnostics(std::slice::from_ref(w), &sources));
-                }
-            }
-            if let Some(e) = error {
-                let mut d = e.to_diagnostic();
-                if lots.len() > 1 {
-                    d = d.with_note(format!("in lot `{}`", lot.name));
-                }
-                progress.suspend(|| report_diagnostics(&[d], &sources));
-                failed_lots += 1;
-            }
-            reports.add(&out.reports);
-            shapes += out.shapes;
-            leaves += out.meshes.len() + out.leaves.len();
-            if let Some(w) = writer.as_mut() {
-                let export_failed = |e| Failure::Usage(format!("export failed: {e}"));
-                for m in &out.meshes {
-                    w.add_mesh(m).map_err(export_failed)?;
-                }
-                for leaf in &out.leaves {
-                    w.add_placed(&leaf.mesh, Some(&leaf.transform), &leaf.materials)
-                        .map_err(export_failed)?;
-                }
-            }
-            progress.inc(1);
         }
-    }
+        for w in &out.warnings {
+            if seen_warnings.insert((w.message.clone(), w.span)) {
+                progress.suspend(|| report_diagnostics(std::slice::from_ref(w), &sources));
+            }
+        }
+        if let Some(e) = error {
+            let mut d = e.to_diagnostic();
+            if lots.len() > 1 {
+                d = d.with_note(format!("in lot `{}`", lot.name));
+            }
+            progress.suspend(|| report_diagnostics(&[d], &sources));
+            failed_lots += 1;
+        }
+        reports.add(&out.reports);
+        shapes += out.shapes;
+        leaves += out.meshes.len() + out.leaves.len();
+        if let Some(w) = writer.as_mut() {
+            let export_failed = |e| Failure::Usage(format!("export failed: {e}"));
+            for m in &out.meshes {
+                w.add_mesh(m).map_err(export_failed)?;
+            }
+            for leaf in &out.leaves {
+                w.add_placed(&leaf.mesh, Some(&leaf.transform), &leaf.materials)
+                    .map_err(export_failed)?;
+            }
+        }
+        progress.inc(1);
+        Ok(())
+    };
+    let generate_one = |i: usize| generate_lot(&program, &assets, rule, &lots[i], i, &options);
+    run_pipeline(lots.len(), jobs.max(1), generate_one, |i, (out, error)| {
+        take(&lots[i], out, error)
+    })?;
     progress.finish_and_clear();
     let failed = failed_lots > 0;
     if failed && lots.len() > 1 {
@@ -480,6 +468,83 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
     } else {
         Ok(())
     }
+}
+
+/// Derives lots `0..count` on `jobs` worker threads while the calling
+/// thread hands each result to `take` in lot order (writing the model), so
+/// writing overlaps deriving and the output does not depend on the number
+/// of threads. A worker starts a lot only while fewer than a few lots per
+/// worker wait to be taken, so memory holds a bounded number of results,
+/// not the whole city. An error from `take` stops the workers and is
+/// returned.
+fn run_pipeline<R: Send>(
+    count: usize,
+    jobs: usize,
+    generate: impl Fn(usize) -> R + Sync,
+    mut take: impl FnMut(usize, R) -> Result<(), Failure>,
+) -> Result<(), Failure> {
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+    use std::sync::{mpsc, Condvar, Mutex};
+
+    let window = jobs * 4;
+    let next = AtomicUsize::new(0);
+    let stop = AtomicBool::new(false);
+    // Lots taken so far, and a signal when it grows.
+    let taken = (Mutex::new(0usize), Condvar::new());
+    let lock = |m: &Mutex<usize>| *m.lock().unwrap_or_else(|e| e.into_inner());
+    std::thread::scope(|scope| {
+        let (tx, rx) = mpsc::channel::<(usize, R)>();
+        for _ in 0..jobs.min(count) {
+            let tx = tx.clone();
+            let (next, stop, taken, generate) = (&next, &stop, &taken, &generate);
+            let worker = move || loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                if i >= count {
+                    break;
+                }
+                {
+                    let mut done = taken.0.lock().unwrap_or_else(|e| e.into_inner());
+                    while i >= *done + window && !stop.load(Ordering::Relaxed) {
+                        done = taken.1.wait(done).unwrap_or_else(|e| e.into_inner());
+                    }
+                }
+                if stop.load(Ordering::Relaxed) || tx.send((i, generate(i))).is_err() {
+                    break;
+                }
+            };
+            if let Err(e) = std::thread::Builder::new()
+                .stack_size(DERIVATION_STACK)
+                .spawn_scoped(scope, worker)
+            {
+                stop.store(true, Ordering::Relaxed);
+                return Err(Failure::Usage(format!("cannot start worker threads: {e}")));
+            }
+        }
+        drop(tx);
+        let mut pending = std::collections::BTreeMap::new();
+        let mut result = Ok(());
+        for (i, r) in rx.iter() {
+            pending.insert(i, r);
+            let mut expected = lock(&taken.0);
+            while let Some(r) = pending.remove(&expected) {
+                result = take(expected, r);
+                expected += 1;
+                if result.is_err() {
+                    break;
+                }
+            }
+            *taken.0.lock().unwrap_or_else(|e| e.into_inner()) = expected;
+            taken.1.notify_all();
+            if result.is_err() {
+                break;
+            }
+        }
+        // Workers waiting for room (after an error, or a worker that
+        // panicked and never delivered its lot) must not wait forever.
+        stop.store(true, Ordering::Relaxed);
+        taken.1.notify_all();
+        result
+    })
 }
 
 /// Peak resident memory of this process in KiB (Linux: `VmHWM`).

@@ -18,6 +18,7 @@ use cga_value::Value;
 
 use crate::assets::Assets;
 use crate::expr::{RBody, RExpr, RExprKind, RStmt};
+use crate::material_attr::MaterialOverrides;
 use crate::ops;
 use crate::program::{Program, RuleId};
 use crate::shape::Shape;
@@ -239,6 +240,7 @@ pub struct Interp<'a> {
     arg_pool: Vec<Vec<Arg>>,
     frame_pool: Vec<Vec<Value>>,
     pub(crate) memo: MeshMemo,
+    pub(crate) material_memo: MaterialMemo,
     /// The final materials of recently emitted leaves (see `leaf_materials`).
     emitted: EmitCache,
 }
@@ -332,6 +334,77 @@ impl MeshMemo {
     }
 }
 
+/// What an operation does to a shape's material attributes, as far as it
+/// decides the result: `color("#fcefe2")`, `set(material.shininess, 20)`,
+/// `texture("bricks.jpg")` (read from a rule file).
+#[derive(Clone, Debug)]
+pub(crate) enum MaterialEdit {
+    ColorHex(Arc<str>),
+    Color([u64; 4], usize),
+    Field(crate::material_attr::MatField, Value),
+    Texture(Arc<str>, cga_syntax::FileId),
+}
+
+impl MaterialEdit {
+    fn same(&self, other: &MaterialEdit) -> bool {
+        use MaterialEdit::*;
+        let same_str = |a: &Arc<str>, b: &Arc<str>| Arc::ptr_eq(a, b) || a == b;
+        match (self, other) {
+            (ColorHex(a), ColorHex(b)) => same_str(a, b),
+            (Color(a, n), Color(b, m)) => a == b && n == m,
+            (Field(f, a), Field(g, b)) => {
+                f == g
+                    && match (a, b) {
+                        (Value::Float(x), Value::Float(y)) => x.to_bits() == y.to_bits(),
+                        (Value::Bool(x), Value::Bool(y)) => x == y,
+                        (Value::Str(x), Value::Str(y)) => same_str(x, y),
+                        _ => false,
+                    }
+            }
+            (Texture(a, f), Texture(b, g)) => f == g && same_str(a, b),
+            _ => false,
+        }
+    }
+}
+
+/// Recent material edits: (attributes before, edit) → attributes after.
+/// Sibling shapes make the same edits on the attributes they inherited
+/// (every wall of a facade sets the wall colour and texture), so most
+/// edits reuse a result: no copy of the attributes, and the siblings share
+/// one `Arc`, which `leaf_materials` then recognises by address. Entries
+/// hold both `Arc`s, so neither changes while it is here.
+#[derive(Default)]
+pub(crate) struct MaterialMemo {
+    entries: Vec<(Arc<MaterialOverrides>, MaterialEdit, Arc<MaterialOverrides>)>,
+    next: usize,
+}
+
+impl Interp<'_> {
+    /// Applies `edit` to the shape's material attributes with `apply`, or
+    /// reuses the result of the same edit on the same attributes.
+    pub(crate) fn edit_material(
+        &mut self,
+        shape: &mut Shape,
+        edit: MaterialEdit,
+        apply: impl FnOnce(&mut Interp, &mut MaterialOverrides) -> Result<(), RtError>,
+    ) -> Result<(), RtError> {
+        let memo = &self.material_memo.entries;
+        if let Some((_, _, after)) = memo
+            .iter()
+            .find(|(before, e, _)| Arc::ptr_eq(before, &shape.material) && e.same(&edit))
+        {
+            shape.material = after.clone();
+            return Ok(());
+        }
+        let before = shape.material.clone();
+        apply(self, Arc::make_mut(&mut shape.material))?;
+        let entry = (before, edit, shape.material.clone());
+        let memo = &mut self.material_memo;
+        remember(&mut memo.entries, &mut memo.next, entry);
+        Ok(())
+    }
+}
+
 /// Adds `entry` to a memo of at most `MEMO_SIZE` entries, replacing the
 /// oldest when full.
 fn remember<T>(list: &mut Vec<T>, next: &mut usize, entry: T) {
@@ -376,6 +449,7 @@ impl<'a> Interp<'a> {
             arg_pool: Vec::new(),
             frame_pool: Vec::new(),
             memo: MeshMemo::default(),
+            material_memo: MaterialMemo::default(),
         }
     }
 

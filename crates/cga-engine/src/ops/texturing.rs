@@ -49,7 +49,7 @@ use cga_value::Value;
 use super::transform::selector;
 use super::Op;
 use crate::assets::Assets;
-use crate::derive::{Arg, Interp, RtError, ShapeState, SizeKind};
+use crate::derive::{Arg, Interp, MaterialEdit, RtError, ShapeState, SizeKind};
 use crate::expr::OpCall;
 use crate::material_attr::MatField;
 use crate::shape::{Frame, Projection, Shape};
@@ -480,14 +480,16 @@ fn texture(cx: &mut Interp, shape: &mut Shape, call: &OpCall, arg: &Arg) -> Resu
         Value::Str(s) => s.clone(),
         other => Arc::from(crate::values::to_text(other).as_str()),
     };
-    let alpha = cx.textures.has_alpha(cx.assets, call.span.file, &path);
-    let m = Arc::make_mut(&mut shape.material);
-    let opacity = if alpha { path.clone() } else { empty_str() };
-    for (field, v) in [(MatField::Map(0), path), (MatField::Map(4), opacity)] {
-        m.set(field, &Value::Str(v))
-            .map_err(|e| RtError::new(e, arg.span))?;
-    }
-    Ok(())
+    let edit = MaterialEdit::Texture(path.clone(), call.span.file);
+    cx.edit_material(shape, edit, |cx, m| {
+        let alpha = cx.textures.has_alpha(cx.assets, call.span.file, &path);
+        let opacity = if alpha { path.clone() } else { empty_str() };
+        for (field, v) in [(MatField::Map(0), path), (MatField::Map(4), opacity)] {
+            m.set(field, &Value::Str(v))
+                .map_err(|e| RtError::new(e, arg.span))?;
+        }
+        Ok(())
+    })
 }
 
 /// A shared empty string (`Arc::from("")` would allocate every time).

@@ -63,7 +63,7 @@ impl Scope {
     /// Sets the scope axes (object coordinates) and the angles relative to `pivot_axes`.
     pub fn set_axes(&mut self, pivot_axes: &DMat3, axes: DMat3) {
         self.frame.axes = axes;
-        self.rot = mat_to_euler(&(pivot_axes.transpose() * axes));
+        self.rot = relative_euler(pivot_axes, &axes);
     }
 
     pub fn center(&self) -> DVec3 {
@@ -372,6 +372,28 @@ fn splitmix64(state: &mut u64) -> u64 {
 pub fn euler_to_mat(angles: DVec3) -> DMat3 {
     let r = angles * (std::f64::consts::PI / 180.0);
     DMat3::from_rotation_z(r.z) * DMat3::from_rotation_y(r.y) * DMat3::from_rotation_x(r.x)
+}
+
+/// `mat_to_euler(pivot_axes^T * axes)`, remembered for the last inputs:
+/// the parts of a split and the faces of a component split mostly keep
+/// their parent's axes and pivot, and the angles take trigonometry.
+fn relative_euler(pivot_axes: &DMat3, axes: &DMat3) -> DVec3 {
+    type Key = ([f64; 9], [f64; 9]);
+    thread_local! {
+        static LAST: Cell<Option<(Key, DVec3)>> = const { Cell::new(None) };
+    }
+    let key = (pivot_axes.to_cols_array(), axes.to_cols_array());
+    let bits = |k: &Key| (k.0.map(f64::to_bits), k.1.map(f64::to_bits));
+    LAST.with(|last| {
+        if let Some((k, rot)) = last.get() {
+            if bits(&k) == bits(&key) {
+                return rot;
+            }
+        }
+        let rot = mat_to_euler(&(pivot_axes.transpose() * *axes));
+        last.set(Some((key, rot)));
+        rot
+    })
 }
 
 /// CGA Euler angles in degrees of a rotation matrix (inverse of [`euler_to_mat`]).

@@ -79,8 +79,29 @@ impl Bucket {
         self.coords = distinct;
     }
 
+    fn new() -> Bucket {
+        Bucket {
+            min: [f32::INFINITY; 3],
+            max: [f32::NEG_INFINITY; 3],
+            ..Bucket::default()
+        }
+    }
+
+    /// Room for `n` more vertices.
+    fn reserve(&mut self, n: usize) {
+        self.positions.reserve(3 * n);
+        self.normals.reserve(3 * n);
+        for c in &mut self.coords {
+            c.reserve(2 * n);
+        }
+        if let Some(t) = &mut self.tangents {
+            t.reserve(4 * n);
+        }
+    }
+
     /// Appends a vertex at `p` with normal `n`; `sources[k]` is where the
     /// `k`-th written UV set reads (see [`Bucket::sets`]), at `corner`.
+    #[inline(always)]
     fn push_vertex(
         &mut self,
         p: DVec3,
@@ -93,14 +114,10 @@ impl Bucket {
             ExportError::TooLarge("more than 2^32 vertices with one material".into())
         })?;
         let p = p.as_vec3().to_array();
-        if index == 0 {
-            self.min = p;
-            self.max = p;
-        } else {
-            for k in 0..3 {
-                self.min[k] = self.min[k].min(p[k]);
-                self.max[k] = self.max[k].max(p[k]);
-            }
+        // `min` and `max` start at +inf and -inf (see `Bucket::new`).
+        for k in 0..3 {
+            self.min[k] = self.min[k].min(p[k]);
+            self.max[k] = self.max[k].max(p[k]);
         }
         self.positions.extend_from_slice(&p);
         self.normals.extend_from_slice(&n.as_vec3().to_array());
@@ -335,7 +352,7 @@ impl GltfWriter {
                 "opacity map '{opacity_map}' is not the colour map; glTF takes opacity from the colour map's alpha: written without it"
             ));
         }
-        let mut bucket = Bucket::default();
+        let mut bucket = Bucket::new();
         if !maps.is_empty() {
             // Textured: every vertex needs coordinates, set 0 first.
             bucket.sets.push(0);
@@ -391,7 +408,10 @@ impl GltfWriter {
             *src = mesh.uvs[set].as_deref().or(uvs);
         }
         let sources = &sources[..bucket.sets.len()];
-        for &l in mesh.face_loops(f.face) {
+        let loops = mesh.face_loops(f.face);
+        bucket.reserve(loops.iter().map(|l| l.len as usize).sum());
+        bucket.indices.reserve(3 * f.triangles.len());
+        for &l in loops {
             for c in mesh.loop_corners(l) {
                 let position = mesh.corners[c];
                 let p = f.positions[position as usize];

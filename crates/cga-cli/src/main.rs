@@ -14,12 +14,15 @@ mod report;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::mpsc;
 
 use clap::{Args, Parser, Subcommand};
 
+use cga_engine::derive::Leaf;
+use cga_engine::generate::generate_lot_streaming;
 use cga_engine::generate::parse_value;
 use cga_engine::lot::{self, Lot};
-use cga_engine::{generate_lot, GenerateOptions, Limits};
+use cga_engine::{GenerateOptions, Limits, LotOutput, RtError};
 use cga_export::{ExportOptions, Format, ModelWriter};
 use cga_syntax::{Diagnostic, SourceMap};
 
@@ -373,9 +376,24 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
     let mut shapes = 0usize;
     let mut leaves = 0usize;
     let mut seen_warnings = std::collections::HashSet::new();
-    // Takes the results of the lots in lot order: prints, diagnostics,
-    // reports, and the geometry into the writer.
-    let mut take = |lot: &Lot, out: cga_engine::LotOutput, error: Option<cga_engine::RtError>| {
+    // Leaves go to the writing thread as they are emitted, so writing the
+    // model overlaps deriving it even for a single lot. Without an output
+    // they are dropped where they were made.
+    let stream = writer.is_some();
+    // Takes what the lots produce, in lot order: each leaf into the writer
+    // as it comes, then the lot's prints, diagnostics and reports.
+    let mut take = |i: usize, taken: Taken<Leaf, (LotOutput, Option<RtError>)>| {
+        let (out, error) = match taken {
+            Taken::Leaf(leaf) => {
+                leaves += 1;
+                if let Some(w) = writer.as_mut() {
+                    w.add_placed(&leaf.mesh, Some(&leaf.transform), &leaf.materials)
+                        .map_err(|e| Failure::Usage(format!("export failed: {e}")))?;
+                }
+                return Ok(());
+            }
+            Taken::Done(r) => r,
+        };
         {
             use std::io::Write;
             let mut stdout = std::io::stdout().lock();
@@ -391,31 +409,24 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
         if let Some(e) = error {
             let mut d = e.to_diagnostic();
             if lots.len() > 1 {
-                d = d.with_note(format!("in lot `{}`", lot.name));
+                d = d.with_note(format!("in lot `{}`", lots[i].name));
             }
             progress.suspend(|| report_diagnostics(&[d], &sources));
             failed_lots += 1;
         }
         reports.add(&out.reports);
         shapes += out.shapes;
-        leaves += out.meshes.len() + out.leaves.len();
-        if let Some(w) = writer.as_mut() {
-            let export_failed = |e| Failure::Usage(format!("export failed: {e}"));
-            for m in &out.meshes {
-                w.add_mesh(m).map_err(export_failed)?;
-            }
-            for leaf in &out.leaves {
-                w.add_placed(&leaf.mesh, Some(&leaf.transform), &leaf.materials)
-                    .map_err(export_failed)?;
-            }
-        }
         progress.inc(1);
         Ok(())
     };
-    let generate_one = |i: usize| generate_lot(&program, &assets, rule, &lots[i], i, &options);
-    run_pipeline(lots.len(), jobs.max(1), generate_one, |i, (out, error)| {
-        take(&lots[i], out, error)
-    })?;
+    let generate_one = |i: usize, sink: &mut dyn FnMut(Leaf)| {
+        generate_lot_streaming(&program, &assets, rule, &lots[i], i, &options, |leaf| {
+            if stream {
+                sink(leaf)
+            }
+        })
+    };
+    run_pipeline(lots.len(), jobs.max(1), generate_one, &mut take)?;
     progress.finish_and_clear();
     let failed = failed_lots > 0;
     if failed && lots.len() > 1 {
@@ -470,79 +481,162 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
     }
 }
 
+/// What the writing thread is handed for a lot, in order: its leaves as
+/// they are emitted, then its result.
+enum Taken<L, R> {
+    Leaf(L),
+    Done(R),
+}
+
+/// What a worker sends for a lot: the channel its leaves will come
+/// through in batches (when it starts), then its result.
+enum Delivery<L, R> {
+    Leaves(mpsc::Receiver<Vec<L>>),
+    Done(R),
+}
+
+/// Leaves per message from a worker to the writing thread.
+const LEAF_BATCH: usize = 64;
+
 /// Derives lots `0..count` on `jobs` worker threads while the calling
-/// thread hands each result to `take` in lot order (writing the model), so
-/// writing overlaps deriving and the output does not depend on the number
-/// of threads. A worker starts a lot only while fewer than a few lots per
-/// worker wait to be taken, so memory holds a bounded number of results,
-/// not the whole city. An error from `take` stops the workers and is
-/// returned.
-fn run_pipeline<R: Send>(
+/// thread hands what they produce to `take` in lot order: the leaves of a
+/// lot as they come (`generate` emits them through its sink), then its
+/// result. So writing overlaps deriving, even within one lot, and the
+/// output does not depend on the number of threads. A worker starts a lot
+/// only while fewer than a few lots per worker wait to be taken, so memory
+/// holds a bounded number of lots, not the whole city. An error from
+/// `take` stops the workers and is returned.
+fn run_pipeline<L: Send, R: Send>(
     count: usize,
     jobs: usize,
-    generate: impl Fn(usize) -> R + Sync,
-    mut take: impl FnMut(usize, R) -> Result<(), Failure>,
+    generate: impl Fn(usize, &mut dyn FnMut(L)) -> R + Sync,
+    take: &mut dyn FnMut(usize, Taken<L, R>) -> Result<(), Failure>,
 ) -> Result<(), Failure> {
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-    use std::sync::{mpsc, Condvar, Mutex};
+    use std::sync::{Condvar, Mutex};
+
+    /// Stops the other workers if this one panics (they would otherwise
+    /// wait for a lot that never comes).
+    struct StopOnPanic<'a>(&'a dyn Fn());
+    impl Drop for StopOnPanic<'_> {
+        fn drop(&mut self) {
+            if std::thread::panicking() {
+                (self.0)();
+            }
+        }
+    }
 
     let window = jobs * 4;
     let next = AtomicUsize::new(0);
     let stop = AtomicBool::new(false);
-    // Lots taken so far, and a signal when it grows.
+    // Lots taken so far, and a signal when it grows or work stops.
     let taken = (Mutex::new(0usize), Condvar::new());
-    let lock = |m: &Mutex<usize>| *m.lock().unwrap_or_else(|e| e.into_inner());
+    let lock = || taken.0.lock().unwrap_or_else(|e| e.into_inner());
+    let halt = || {
+        // Under the lock, so that no worker misses the signal.
+        let _done = lock();
+        stop.store(true, Ordering::Relaxed);
+        taken.1.notify_all();
+    };
     std::thread::scope(|scope| {
-        let (tx, rx) = mpsc::channel::<(usize, R)>();
+        let (tx, rx) = mpsc::channel::<(usize, Delivery<L, R>)>();
         for _ in 0..jobs.min(count) {
             let tx = tx.clone();
-            let (next, stop, taken, generate) = (&next, &stop, &taken, &generate);
-            let worker = move || loop {
-                let i = next.fetch_add(1, Ordering::Relaxed);
-                if i >= count {
-                    break;
-                }
-                {
-                    let mut done = taken.0.lock().unwrap_or_else(|e| e.into_inner());
-                    while i >= *done + window && !stop.load(Ordering::Relaxed) {
-                        done = taken.1.wait(done).unwrap_or_else(|e| e.into_inner());
+            let (next, stop, taken, generate, lock, halt) =
+                (&next, &stop, &taken, &generate, &lock, &halt);
+            let worker = move || {
+                let _guard = StopOnPanic(halt);
+                loop {
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    if i >= count {
+                        break;
                     }
-                }
-                if stop.load(Ordering::Relaxed) || tx.send((i, generate(i))).is_err() {
-                    break;
+                    {
+                        let mut done = lock();
+                        while i >= *done + window && !stop.load(Ordering::Relaxed) {
+                            done = taken.1.wait(done).unwrap_or_else(|e| e.into_inner());
+                        }
+                    }
+                    let (leaf_tx, leaf_rx) = mpsc::channel();
+                    if stop.load(Ordering::Relaxed)
+                        || tx.send((i, Delivery::Leaves(leaf_rx))).is_err()
+                    {
+                        break;
+                    }
+                    // Leaves go in batches: a message per leaf would wake
+                    // the writing thread for each (a system call apiece).
+                    let mut batch = Vec::with_capacity(LEAF_BATCH);
+                    let r = generate(i, &mut |leaf| {
+                        batch.push(leaf);
+                        if batch.len() == LEAF_BATCH {
+                            let full =
+                                std::mem::replace(&mut batch, Vec::with_capacity(LEAF_BATCH));
+                            // A closed channel means the writing stopped.
+                            let _ = leaf_tx.send(full);
+                        }
+                    });
+                    if !batch.is_empty() {
+                        let _ = leaf_tx.send(batch);
+                    }
+                    drop(leaf_tx);
+                    if tx.send((i, Delivery::Done(r))).is_err() {
+                        break;
+                    }
                 }
             };
             if let Err(e) = std::thread::Builder::new()
                 .stack_size(DERIVATION_STACK)
                 .spawn_scoped(scope, worker)
             {
-                stop.store(true, Ordering::Relaxed);
+                halt();
                 return Err(Failure::Usage(format!("cannot start worker threads: {e}")));
             }
         }
         drop(tx);
-        let mut pending = std::collections::BTreeMap::new();
+        let mut leaves = std::collections::BTreeMap::new();
+        let mut results = std::collections::BTreeMap::new();
+        // The next message for lot `i` of the kind `pick` takes out of the
+        // waiting ones; `None` when the workers are gone.
+        let mut wait_for = |i: usize, want_leaves: bool| loop {
+            if want_leaves {
+                if let Some(r) = leaves.remove(&i) {
+                    return Some(Delivery::Leaves(r));
+                }
+            } else if let Some(r) = results.remove(&i) {
+                return Some(Delivery::Done(r));
+            }
+            match rx.recv() {
+                Ok((j, Delivery::Leaves(r))) => {
+                    leaves.insert(j, r);
+                }
+                Ok((j, Delivery::Done(r))) => {
+                    results.insert(j, r);
+                }
+                Err(_) => return None,
+            }
+        };
         let mut result = Ok(());
-        for (i, r) in rx.iter() {
-            pending.insert(i, r);
-            let mut expected = lock(&taken.0);
-            while let Some(r) = pending.remove(&expected) {
-                result = take(expected, r);
-                expected += 1;
+        'lots: for i in 0..count {
+            let Some(Delivery::Leaves(leaf_rx)) = wait_for(i, true) else {
+                break;
+            };
+            for leaf in leaf_rx.iter().flatten() {
+                result = take(i, Taken::Leaf(leaf));
                 if result.is_err() {
-                    break;
+                    break 'lots;
                 }
             }
-            *taken.0.lock().unwrap_or_else(|e| e.into_inner()) = expected;
-            taken.1.notify_all();
+            let Some(Delivery::Done(r)) = wait_for(i, false) else {
+                break;
+            };
+            result = take(i, Taken::Done(r));
             if result.is_err() {
                 break;
             }
+            *lock() = i + 1;
+            taken.1.notify_all();
         }
-        // Workers waiting for room (after an error, or a worker that
-        // panicked and never delivered its lot) must not wait forever.
-        stop.store(true, Ordering::Relaxed);
-        taken.1.notify_all();
+        halt();
         result
     })
 }

@@ -234,6 +234,10 @@ pub struct Interp<'a> {
     pub(crate) current_file: cga_syntax::FileId,
     /// Emit leaves unbaked into `out.leaves` instead of `out.meshes`.
     pub keep_leaves: bool,
+    /// With `keep_leaves`: hand each leaf to this as it is emitted instead
+    /// of collecting them (an exporter on another thread writes the model
+    /// while the derivation goes on).
+    pub leaf_sink: Option<Box<dyn FnMut(Leaf) + 'a>>,
     /// Empty argument lists and rule frames to reuse: every operation and
     /// rule call needs one, and allocating each is a measurable part of a
     /// derivation.
@@ -271,11 +275,14 @@ const EMIT_CACHE_SIZE: usize = 8;
 /// mesh, so an address names the same mesh as long as it is here.
 #[derive(Default)]
 pub(crate) struct MeshMemo {
-    bounds: Vec<(Arc<Mesh>, Option<(DVec3, DVec3)>)>,
+    bounds: Vec<(Arc<Mesh>, Bounds)>,
     uv: Vec<UvMemo>,
     next_bounds: usize,
     next_uv: usize,
 }
+
+/// A bounding box (`None`: nothing to bound).
+type Bounds = Option<(DVec3, DVec3)>;
 
 /// `uv_bounds` and `uv_unit_scale` of UV set `set` of `mesh` placed by `to_scope`.
 pub(crate) type UvMeasures = (Option<(DVec2, DVec2)>, Option<DVec2>);
@@ -291,7 +298,7 @@ const MEMO_SIZE: usize = 16;
 
 impl MeshMemo {
     /// The bounding box of the positions `mesh`'s faces use.
-    pub(crate) fn bounds(&mut self, mesh: &Arc<Mesh>) -> Option<(DVec3, DVec3)> {
+    pub(crate) fn bounds(&mut self, mesh: &Arc<Mesh>) -> Bounds {
         if Arc::strong_count(mesh) == 1 {
             // Nobody else has it: it will not come again.
             return crate::shape::local_bounds(mesh);
@@ -445,6 +452,7 @@ impl<'a> Interp<'a> {
             textures: Default::default(),
             current_file: cga_syntax::FileId(0),
             keep_leaves: false,
+            leaf_sink: None,
             emitted: EmitCache::default(),
             arg_pool: Vec::new(),
             frame_pool: Vec::new(),
@@ -557,11 +565,15 @@ impl<'a> Interp<'a> {
         let (mesh, _) = shape.geometry.raw();
         let materials = self.leaf_materials(shape, &mesh.materials);
         if self.keep_leaves {
-            self.out.leaves.push(Leaf {
+            let leaf = Leaf {
                 mesh: mesh.clone(),
                 transform: shape.object_transform(),
                 materials,
-            });
+            };
+            match &mut self.leaf_sink {
+                Some(sink) => sink(leaf),
+                None => self.out.leaves.push(leaf),
+            }
         } else {
             let mut mesh = shape.object_mesh();
             mesh.materials = materials;

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use cga_value::Value;
 
 use crate::assets::Assets;
-use crate::derive::{InitialInfo, Interp, Limits, LotOutput, RtError};
+use crate::derive::{InitialInfo, Interp, Leaf, Limits, LotOutput, RtError};
 use crate::expr::RExpr;
 use crate::lot::{initial_shape, Lot};
 use crate::program::{AttrId, Program, RuleId};
@@ -35,6 +35,42 @@ pub fn generate_lot(
     lot_index: usize,
     options: &GenerateOptions,
 ) -> (LotOutput, Option<RtError>) {
+    generate(program, assets, rule, lot, lot_index, options, None)
+}
+
+/// [`generate_lot`] handing each leaf to `sink` as soon as it is emitted,
+/// in derivation order, unbaked (as `GenerateOptions::leaves` gives them);
+/// `LotOutput::leaves` and `LotOutput::meshes` stay empty. A model writer
+/// on another thread can write the leaves while the derivation goes on.
+pub fn generate_lot_streaming<'a>(
+    program: &'a Program,
+    assets: &'a Assets,
+    rule: RuleId,
+    lot: &Lot,
+    lot_index: usize,
+    options: &GenerateOptions,
+    sink: impl FnMut(Leaf) + 'a,
+) -> (LotOutput, Option<RtError>) {
+    generate(
+        program,
+        assets,
+        rule,
+        lot,
+        lot_index,
+        options,
+        Some(Box::new(sink)),
+    )
+}
+
+fn generate<'a>(
+    program: &'a Program,
+    assets: &'a Assets,
+    rule: RuleId,
+    lot: &Lot,
+    lot_index: usize,
+    options: &GenerateOptions,
+    sink: Option<Box<dyn FnMut(Leaf) + 'a>>,
+) -> (LotOutput, Option<RtError>) {
     // Each lot has its own seed: the run's seed for the first lot, then the
     // following numbers (`--seed 666` on one lot gives `seedian` 666).
     let seed = options.seed.wrapping_add(lot_index as u64);
@@ -55,7 +91,8 @@ pub fn generate_lot(
         start_rule: program.rules[rule as usize].name.clone(),
     };
     let mut interp = Interp::new(program, assets, options.limits, info, shape, &[]);
-    interp.keep_leaves = options.leaves;
+    interp.keep_leaves = options.leaves || sink.is_some();
+    interp.leaf_sink = sink;
     let mut error = None;
     // Lot attributes (GeoJSON properties) first, command-line values win.
     let lot_attrs = lot

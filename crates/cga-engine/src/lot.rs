@@ -95,7 +95,9 @@ pub fn degenerate(lot: &Lot) -> Option<String> {
     let size = cga_geometry::measure::bounds(m)
         .map(|(lo, hi)| (hi - lo).length())
         .unwrap_or(0.0);
-    if !(area > 1e-12 * size.max(1.0).powi(2)) {
+    // Not more than the least area (or NaN).
+    let least = 1e-12 * size.max(1.0).powi(2);
+    if area.partial_cmp(&least) != Some(std::cmp::Ordering::Greater) {
         return Some(
             "it has no area (fewer than three distinct corners, or collinear ones)".into(),
         );

@@ -115,9 +115,9 @@ impl Bucket {
         })?;
         let p = p.as_vec3().to_array();
         // `min` and `max` start at +inf and -inf (see `Bucket::new`).
-        for k in 0..3 {
-            self.min[k] = self.min[k].min(p[k]);
-            self.max[k] = self.max[k].max(p[k]);
+        for ((lo, hi), x) in self.min.iter_mut().zip(&mut self.max).zip(p) {
+            *lo = lo.min(x);
+            *hi = hi.max(x);
         }
         self.positions.extend_from_slice(&p);
         self.normals.extend_from_slice(&n.as_vec3().to_array());

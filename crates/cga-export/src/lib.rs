@@ -336,8 +336,8 @@ impl ModelWriter {
         let all_finite = positions.iter().all(|p| p.is_finite())
             && mesh.uvs[0]
                 .as_ref()
-                .map_or(true, |u| u.iter().all(|t| t.is_finite()))
-            && normals.map_or(true, |n| n.iter().all(|v| v.is_finite()));
+                .is_none_or(|u| u.iter().all(|t| t.is_finite()))
+            && normals.is_none_or(|n| n.iter().all(|v| v.is_finite()));
         let mut result = Ok(());
         for face in 0..mesh.faces.len() {
             if mesh.outer_loop(face).len < 3 {

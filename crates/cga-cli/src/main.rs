@@ -674,3 +674,69 @@ fn project_roots(rule_dir: &Path) -> Vec<PathBuf> {
     }
     roots
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Runs the pipeline where lot `i` emits `i % 5` leaves `(i, k)` and
+    /// results in `10 i`; returns what was taken, in order.
+    fn run(count: usize, jobs: usize, fail_at: Option<usize>) -> (Vec<String>, bool) {
+        let mut seen = Vec::new();
+        let generate = |i: usize, sink: &mut dyn FnMut((usize, usize))| {
+            for k in 0..i % 5 {
+                sink((i, k));
+            }
+            10 * i
+        };
+        let r = run_pipeline(count, jobs, generate, &mut |i, taken| {
+            match taken {
+                Taken::Leaf((j, k)) => seen.push(format!("{i}:{j}.{k}")),
+                Taken::Done(r) => seen.push(format!("{i}={r}")),
+            }
+            if Some(i) == fail_at {
+                return Err(Failure::Usage("stop".into()));
+            }
+            Ok(())
+        });
+        (seen, r.is_ok())
+    }
+
+    #[test]
+    fn pipeline_takes_everything_in_lot_order() {
+        let mut want = Vec::new();
+        for i in 0..60 {
+            for k in 0..i % 5 {
+                want.push(format!("{i}:{i}.{k}"));
+            }
+            want.push(format!("{i}={}", 10 * i));
+        }
+        for jobs in [1, 2, 3, 8] {
+            let (seen, ok) = run(60, jobs, None);
+            assert!(ok);
+            assert_eq!(seen, want, "{jobs} jobs");
+        }
+        assert_eq!(run(0, 2, None), (Vec::new(), true));
+    }
+
+    #[test]
+    fn pipeline_stops_on_an_error() {
+        let (seen, ok) = run(100, 3, Some(6));
+        assert!(!ok);
+        // Lot 6 has one leaf: taking it failed, nothing after it is taken.
+        assert_eq!(seen.last().map(String::as_str), Some("6:6.0"));
+        assert_eq!(seen.len(), 17);
+    }
+
+    #[test]
+    fn a_worker_panic_does_not_hang_the_pipeline() {
+        let r = std::panic::catch_unwind(|| {
+            let generate = |i: usize, _: &mut dyn FnMut(())| {
+                assert!(i != 3, "lot 3 fails");
+                i
+            };
+            run_pipeline(40, 2, generate, &mut |_, _| Ok(()))
+        });
+        assert!(r.is_err());
+    }
+}

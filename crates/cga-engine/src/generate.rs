@@ -152,3 +152,73 @@ pub fn parse_value(text: &str) -> Value {
         },
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Leaves handed out unbaked (collected or streamed) bake to exactly
+    /// the meshes the derivation gives otherwise: positions, normals, UVs,
+    /// faces and materials, also under mirroring, rotation and inserts.
+    #[test]
+    fn leaves_bake_to_the_meshes() {
+        let dir = std::env::temp_dir().join(format!("cga-engine-leaves-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("leaves.cga");
+        std::fs::write(
+            &path,
+            r##"
+Lot --> extrude(10) comp(f) { side : Facade | top : Roof }
+Facade --> setupProjection(0, scope.xy, 2, 2) split(y) { ~3 : Floor }*
+Floor --> split(x) { ~2 : Tile | 0.5 : Mirror }*
+Tile --> projectUV(0) color("#806040") texture("bricks.jpg") Wall.
+Mirror --> s(-scope.sx, '1, '1) r(0, 30, 0) i("builtin:cube") set(material.shininess, 12) M.
+Roof --> reverseNormals t(0, 1, 0) primitiveCube() color(0.5, 0.5, 0.9) R.
+"##,
+        )
+        .unwrap();
+        let mut sources = cga_syntax::SourceMap::new();
+        let program = crate::load(&path, &mut sources)
+            .program
+            .expect("rules load");
+        let assets = Assets::new(&sources);
+        let rule = program.start_rule(Some("Lot")).unwrap();
+        let lot = crate::lot::rect(12.0, 7.0);
+        let baked = generate_lot(
+            &program,
+            &assets,
+            rule,
+            &lot,
+            0,
+            &GenerateOptions::default(),
+        );
+        assert!(baked.1.is_none());
+        let meshes = baked.0.meshes;
+        assert!(meshes.len() > 40, "{} leaves", meshes.len());
+        let options = GenerateOptions {
+            leaves: true,
+            ..GenerateOptions::default()
+        };
+        let (kept, error) = generate_lot(&program, &assets, rule, &lot, 0, &options);
+        assert!(error.is_none() && kept.meshes.is_empty());
+        let mut streamed = Vec::new();
+        let (out, error) =
+            generate_lot_streaming(&program, &assets, rule, &lot, 0, &options, |l| {
+                streamed.push(l)
+            });
+        assert!(error.is_none() && out.leaves.is_empty() && out.meshes.is_empty());
+        for leaves in [&kept.leaves, &streamed] {
+            assert_eq!(leaves.len(), meshes.len());
+            for (leaf, mesh) in leaves.iter().zip(&meshes) {
+                assert_eq!(&leaf.to_mesh(), mesh);
+            }
+        }
+        // Some leaves were mirrored, and some share their mesh (the cube).
+        assert!(kept
+            .leaves
+            .iter()
+            .any(|l| l.transform.matrix3.determinant() < 0.0));
+        assert!(kept.leaves.iter().any(|l| Arc::strong_count(&l.mesh) > 2));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

@@ -485,3 +485,146 @@ fn check_mesh(mesh: &Mesh, material_slots: usize) -> Result<(), ExportError> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cga_geometry::{DMat3, DVec2, TextureChannel};
+
+    /// A mesh with a quad, a concave pentagon and a square with a hole,
+    /// per-corner normals on one face's worth of corners and two UV sets.
+    fn sample() -> Mesh {
+        let mut m = Mesh::new();
+        let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+        m.positions.extend([
+            p(0., 0., 0.),
+            p(2., 0., 0.),
+            p(2., 1., 0.),
+            p(0., 1., 0.),
+            p(3., 0., 0.),
+            p(5., 0., 0.),
+            p(5., 2., 0.),
+            p(4., 0.5, 0.),
+            p(3., 2., 0.),
+            p(6., 0., 1.),
+            p(10., 0., 1.),
+            p(10., 4., 1.),
+            p(6., 4., 1.),
+            p(7., 1., 1.),
+            p(7., 3., 1.),
+            p(9., 3., 1.),
+            p(9., 1., 1.),
+        ]);
+        m.add_face(&[&[0, 1, 2, 3]], 0);
+        m.add_face(&[&[4, 5, 6, 7, 8]], 1);
+        m.add_face(&[&[9, 10, 11, 12], &[13, 14, 15, 16]], 0);
+        let n = m.corners.len();
+        m.uvs[0] = Some(
+            (0..n)
+                .map(|i| DVec2::new(i as f64 * 0.25, 1.0 - i as f64 * 0.125))
+                .collect(),
+        );
+        m.uvs[5] = Some((0..n).map(|i| DVec2::new(0.5, i as f64)).collect());
+        m.normals = Some(
+            (0..n)
+                .map(|i| DVec3::new(0.1 * i as f64, 0.0, 1.0))
+                .collect(),
+        );
+        let brick = Material {
+            maps: std::array::from_fn(|k| TextureChannel {
+                path: if k == 0 {
+                    "missing.png".into()
+                } else {
+                    "".into()
+                },
+                ..TextureChannel::default()
+            }),
+            ..Material::default()
+        };
+        m.materials = vec![
+            brick,
+            Material {
+                color: [0.2, 0.4, 0.6],
+                ..Material::default()
+            },
+        ]
+        .into();
+        m
+    }
+
+    fn written(format: Format, name: &str, add: impl Fn(&mut ModelWriter)) -> Vec<u8> {
+        // One name in separate folders: OBJ files name their MTL file.
+        let dir = std::env::temp_dir().join(format!("cga-export-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let ext = if format == Format::Obj { "obj" } else { "glb" };
+        let path = dir.join(format!("model.{ext}"));
+        let mut w = ModelWriter::create(&path, format, ExportOptions::default()).unwrap();
+        add(&mut w);
+        w.finish().unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let _ = std::fs::remove_dir_all(&dir);
+        bytes
+    }
+
+    #[test]
+    fn placing_writes_what_the_transformed_mesh_writes() {
+        let mesh = sample();
+        let other: SharedVec<Material> = vec![
+            Material {
+                color: [0.9, 0.1, 0.1],
+                ..Material::default()
+            },
+            Material {
+                opacity: 0.5,
+                ..Material::default()
+            },
+        ]
+        .into();
+        let turn = DMat3::from_rotation_y(0.7) * DMat3::from_diagonal(DVec3::new(1.5, 0.5, 2.0));
+        for (k, t) in [
+            DAffine3::from_mat3_translation(turn, DVec3::new(100.0, -3.0, 7.5)),
+            // Mirrored: the faces must come out reversed.
+            DAffine3::from_mat3_translation(
+                DMat3::from_diagonal(DVec3::new(-1.0, 1.0, 1.0)) * turn,
+                DVec3::new(-4.0, 2.0, 0.25),
+            ),
+        ]
+        .iter()
+        .enumerate()
+        {
+            for format in [Format::Glb, Format::Obj] {
+                let baked = written(format, &format!("baked{k}"), |w| {
+                    let mut m = mesh.clone();
+                    cga_geometry::transform::transform(&mut m, t);
+                    if t.matrix3.determinant() < 0.0 {
+                        cga_geometry::transform::reverse_faces(&mut m);
+                    }
+                    w.add_mesh(&m).unwrap();
+                    m.materials = other.clone();
+                    w.add_mesh(&m).unwrap();
+                });
+                let placed = written(format, &format!("placed{k}"), |w| {
+                    w.add_placed(&mesh, Some(t), &mesh.materials).unwrap();
+                    w.add_placed(&mesh, Some(t), &other).unwrap();
+                });
+                assert!(baked.len() > 1000);
+                assert!(baked == placed, "transform {k}, {format:?}: outputs differ");
+            }
+        }
+    }
+
+    #[test]
+    fn placing_checks_the_material_slots_given() {
+        let dir = std::env::temp_dir().join(format!("cga-export-slots-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("x.glb");
+        let mut w = ModelWriter::create(&path, Format::Glb, ExportOptions::default()).unwrap();
+        let mesh = sample();
+        let one: SharedVec<Material> = vec![Material::default()].into();
+        let r = w.add_placed(&mesh, Some(&DAffine3::IDENTITY), &one);
+        assert!(
+            matches!(r, Err(ExportError::InvalidMesh(m)) if m.contains("material slot 1 of 1"))
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

@@ -326,6 +326,54 @@ mod tests {
     use super::*;
 
     #[test]
+    fn shared_slots_copy_on_write() {
+        let a = Mesh::new();
+        let mut b = Mesh::new();
+        // New meshes share one default slot list.
+        assert!(SharedVec::ptr_eq(&a.materials, &b.materials));
+        assert!(SharedVec::ptr_eq(&a.groups, &b.groups));
+        let red = Material {
+            color: [1.0, 0.0, 0.0],
+            ..Material::default()
+        };
+        b.materials.push(red.clone());
+        b.materials[0].opacity = 0.5;
+        // `a` and every other new mesh keep the defaults.
+        assert_eq!(a.materials, vec![Material::default()]);
+        assert_eq!(Mesh::new().materials.len(), 1);
+        assert_eq!(b.materials.len(), 2);
+        assert_eq!(b.materials[0].opacity, 0.5);
+        assert_eq!(b.materials[1], red);
+        let c = b.clone();
+        assert!(SharedVec::ptr_eq(&b.materials, &c.materials));
+        let mut d = c.clone();
+        for m in &mut d.materials {
+            m.shininess = 7.0;
+        }
+        assert_eq!(c.materials[1].shininess, 1.0);
+        assert_eq!(d.materials[1].shininess, 7.0);
+        d.materials.clear();
+        assert!(d.materials.is_empty());
+        assert_eq!(c.materials.len(), 2);
+        assert_eq!(d.groups.clone().into_vec(), vec![String::new()]);
+    }
+
+    #[test]
+    fn copy_from_equals_clone() {
+        let mut src = Mesh::polygon(&[DVec3::ZERO, DVec3::X, DVec3::new(1.0, 0.0, -1.0)]);
+        src.uvs[2] = Some(vec![DVec2::new(0.5, 1.0); 3]);
+        src.normals = Some(vec![DVec3::Y; 3]);
+        // A scratch mesh with other attribute sets and larger buffers.
+        let mut dst = Mesh::polygon(&[DVec3::ONE; 5]);
+        dst.uvs[0] = Some(vec![DVec2::ONE; 5]);
+        dst.copy_from(&src);
+        assert_eq!(dst, src);
+        let plain = Mesh::polygon(&[DVec3::ZERO, DVec3::Y, DVec3::Z]);
+        dst.copy_from(&plain);
+        assert_eq!(dst, plain);
+    }
+
+    #[test]
     fn polygon_has_one_face_one_loop() {
         let m = Mesh::polygon(&[DVec3::ZERO, DVec3::X, DVec3::new(1.0, 0.0, -1.0)]);
         assert_eq!(m.faces.len(), 1);

@@ -220,6 +220,22 @@ impl Mesh {
         }
     }
 
+    /// Room for `corners` more corners (and as many positions, a loop and
+    /// a face per four corners) in the arrays, and in the per-corner
+    /// attributes the mesh has.
+    pub fn reserve(&mut self, corners: usize) {
+        self.positions.reserve(corners);
+        self.corners.reserve(corners);
+        self.loops.reserve(corners.div_ceil(4));
+        self.faces.reserve(corners.div_ceil(4));
+        for set in self.uvs.iter_mut().flatten() {
+            set.reserve(corners);
+        }
+        if let Some(n) = &mut self.normals {
+            n.reserve(corners);
+        }
+    }
+
     /// Makes `self` a copy of `src`, reusing `self`'s allocations (a
     /// scratch mesh refilled for every shape costs no allocation).
     pub fn copy_from(&mut self, src: &Mesh) {

@@ -625,6 +625,22 @@ impl Components {
             Align::NoAlign => (DVec3::ZERO, DMat3::IDENTITY),
         };
         let mut mesh = self.builder.begin(&self.mesh, self.kind);
+        // Room for the corners of the faces taken (edges and vertices are a
+        // corner or two), so the component's arrays are allocated once.
+        let corners: usize = set
+            .iter()
+            .map(|&k| match self.items[k as usize] {
+                Item::Faces { start, len } => self.face_list
+                    [start as usize..(start + len) as usize]
+                    .iter()
+                    .flat_map(|&f| self.mesh.face_loops(f as usize))
+                    .map(|l| l.len as usize)
+                    .sum(),
+                Item::Hole { lp, .. } => self.mesh.loops[lp as usize].len as usize,
+                _ => 2,
+            })
+            .sum();
+        mesh.reserve(corners);
         for &k in set {
             let item = self.items[k as usize];
             self.add_item(&mut mesh, item, upward);

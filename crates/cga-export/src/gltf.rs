@@ -930,7 +930,9 @@ fn write_bin(
     path: &Path,
 ) -> Result<(), ExportError> {
     let io = |e| ExportError::io(path, e);
-    let mut scratch = vec![0u8; 1 << 14];
+    // Larger than the output buffer, so full chunks go to the file directly
+    // instead of being copied into the buffer first.
+    let mut scratch = vec![0u8; 1 << 18];
     for b in buckets.iter().filter(|b| !b.indices.is_empty()) {
         write_f32s(w, &b.positions, &mut scratch).map_err(io)?;
         write_f32s(w, &b.normals, &mut scratch).map_err(io)?;

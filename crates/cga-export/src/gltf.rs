@@ -388,8 +388,15 @@ impl GltfWriter {
     }
 
     pub(crate) fn add_face(&mut self, f: &FaceData) -> Result<(), ExportError> {
+        let GltfWriter {
+            buckets,
+            corner_vertex,
+            first_shared,
+            shared: made,
+            ..
+        } = self;
         let mesh = f.mesh;
-        let bucket = &mut self.buckets[f.material as usize];
+        let bucket = &mut buckets[f.material as usize];
         let uvs = mesh.uvs[0].as_deref();
         if uvs.is_some() && bucket.sets.is_empty() {
             bucket.sets.push(0);
@@ -411,49 +418,61 @@ impl GltfWriter {
         let loops = mesh.face_loops(f.face);
         bucket.reserve(loops.iter().map(|l| l.len as usize).sum());
         bucket.indices.reserve(3 * f.triangles.len());
-        for &l in loops {
-            for c in mesh.loop_corners(l) {
-                let position = mesh.corners[c];
-                let p = f.positions[position as usize];
-                let vertex = match f.normals {
-                    Some(normals) if shared => {
-                        let n = normals[c].try_normalize().unwrap_or(f.normal);
-                        let uv = uvs.map(|u| u[c]);
-                        let key = VertexKey {
-                            material: f.material,
-                            normal: n.as_vec3().to_array().map(f32::to_bits),
-                            uv: uv.map_or([0; 2], |t| t.as_vec2().to_array().map(f32::to_bits)),
-                        };
-                        let mut e = self.first_shared[position as usize];
-                        while e != NO_ENTRY && self.shared[e as usize].key != key {
-                            e = self.shared[e as usize].next;
+        let corners = || loops.iter().flat_map(|&l| mesh.loop_corners(l));
+        let positions = f.positions;
+        // One loop over the corners per case.
+        match f.normals {
+            Some(normals) if shared => {
+                for c in corners() {
+                    let position = mesh.corners[c] as usize;
+                    let n = normals[c].try_normalize().unwrap_or(f.normal);
+                    let uv = uvs.map_or([0; 2], |u| u[c].as_vec2().to_array().map(f32::to_bits));
+                    let key = VertexKey {
+                        material: f.material,
+                        normal: n.as_vec3().to_array().map(f32::to_bits),
+                        uv,
+                    };
+                    let mut e = first_shared[position];
+                    while e != NO_ENTRY {
+                        let s = &made[e as usize];
+                        if s.key == key {
+                            break;
                         }
-                        if e != NO_ENTRY {
-                            self.shared[e as usize].vertex
-                        } else {
-                            let v = bucket.push_vertex(p, n, sources, c, tangent)?;
-                            self.shared.push(SharedVertex {
-                                key,
-                                vertex: v,
-                                next: self.first_shared[position as usize],
-                            });
-                            self.first_shared[position as usize] = self.shared.len() as u32 - 1;
-                            v
-                        }
+                        e = s.next;
                     }
-                    Some(normals) => {
-                        let n = normals[c].try_normalize().unwrap_or(f.normal);
-                        bucket.push_vertex(p, n, sources, c, tangent)?
-                    }
-                    // Flat shading: each face has its own vertices.
-                    None => bucket.push_vertex(p, f.normal, sources, c, tangent)?,
-                };
-                self.corner_vertex[c] = vertex;
+                    corner_vertex[c] = if e != NO_ENTRY {
+                        made[e as usize].vertex
+                    } else {
+                        let v = bucket.push_vertex(positions[position], n, sources, c, tangent)?;
+                        made.push(SharedVertex {
+                            key,
+                            vertex: v,
+                            next: first_shared[position],
+                        });
+                        first_shared[position] = made.len() as u32 - 1;
+                        v
+                    };
+                }
+            }
+            Some(normals) => {
+                for c in corners() {
+                    let p = positions[mesh.corners[c] as usize];
+                    let n = normals[c].try_normalize().unwrap_or(f.normal);
+                    corner_vertex[c] = bucket.push_vertex(p, n, sources, c, tangent)?;
+                }
+            }
+            // Flat shading: each face has its own vertices.
+            None => {
+                for c in corners() {
+                    let p = positions[mesh.corners[c] as usize];
+                    corner_vertex[c] = bucket.push_vertex(p, f.normal, sources, c, tangent)?;
+                }
             }
         }
-        let cv = &self.corner_vertex;
         for t in f.triangles {
-            bucket.indices.extend(t.iter().map(|&c| cv[c as usize]));
+            bucket
+                .indices
+                .extend(t.iter().map(|&c| corner_vertex[c as usize]));
         }
         Ok(())
     }

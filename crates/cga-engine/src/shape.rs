@@ -122,7 +122,7 @@ impl Geometry {
             if t != DAffine3::IDENTITY {
                 match Arc::get_mut(&mut self.mesh) {
                     Some(m) => transform_in_place(m, &t),
-                    None => self.mesh = Arc::new(transformed(&self.mesh, &t)),
+                    None => self.mesh = transformed_shared(&self.mesh, &t),
                 }
             }
         }
@@ -145,6 +145,39 @@ pub fn transformed(mesh: &Mesh, t: &DAffine3) -> Mesh {
     let mut m = mesh.clone();
     transform_in_place(&mut m, t);
     m
+}
+
+/// [`transformed`] for a mesh other shapes share (an inserted asset),
+/// remembered for the last few meshes and maps: the windows of a facade
+/// are one asset placed by one map, and the result is the same mesh each
+/// time. The entries hold both meshes, so an address names one mesh.
+fn transformed_shared(mesh: &Arc<Mesh>, t: &DAffine3) -> Arc<Mesh> {
+    type Entry = (Arc<Mesh>, [u64; 12], Arc<Mesh>);
+    thread_local! {
+        static BAKED: std::cell::RefCell<(Vec<Entry>, usize)> = const {
+            std::cell::RefCell::new((Vec::new(), 0))
+        };
+    }
+    const ENTRIES: usize = 8;
+    let key = t.to_cols_array().map(f64::to_bits);
+    BAKED.with(|b| {
+        let (entries, next) = &mut *b.borrow_mut();
+        if let Some((_, _, done)) = entries
+            .iter()
+            .find(|(m, k, _)| Arc::ptr_eq(m, mesh) && *k == key)
+        {
+            return done.clone();
+        }
+        let done = Arc::new(transformed(mesh, t));
+        let entry = (mesh.clone(), key, done.clone());
+        if entries.len() < ENTRIES {
+            entries.push(entry);
+        } else {
+            entries[*next] = entry;
+            *next = (*next + 1) % ENTRIES;
+        }
+        done
+    })
 }
 
 /// [`transformed`] without the copy.

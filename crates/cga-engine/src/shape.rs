@@ -411,21 +411,34 @@ pub fn euler_to_mat(angles: DVec3) -> DMat3 {
 /// the parts of a split and the faces of a component split mostly keep
 /// their parent's axes and pivot, and the angles take trigonometry.
 fn relative_euler(pivot_axes: &DMat3, axes: &DMat3) -> DVec3 {
-    type Key = ([f64; 9], [f64; 9]);
-    thread_local! {
-        static LAST: Cell<Option<(Key, DVec3)>> = const { Cell::new(None) };
+    /// The inputs (bits of both matrices) and the angles.
+    struct Last {
+        valid: bool,
+        key: [u64; 18],
+        rot: DVec3,
     }
-    let key = (pivot_axes.to_cols_array(), axes.to_cols_array());
-    let bits = |k: &Key| (k.0.map(f64::to_bits), k.1.map(f64::to_bits));
+    thread_local! {
+        static LAST: std::cell::RefCell<Last> = const {
+            std::cell::RefCell::new(Last { valid: false, key: [0; 18], rot: DVec3::ZERO })
+        };
+    }
+    let mut key = [0u64; 18];
+    for (k, x) in key.iter_mut().zip(
+        pivot_axes
+            .to_cols_array()
+            .iter()
+            .chain(&axes.to_cols_array()),
+    ) {
+        *k = x.to_bits();
+    }
     LAST.with(|last| {
-        if let Some((k, rot)) = last.get() {
-            if bits(&k) == bits(&key) {
-                return rot;
-            }
+        let mut last = last.borrow_mut();
+        if !(last.valid && last.key == key) {
+            last.rot = mat_to_euler(&(pivot_axes.transpose() * *axes));
+            last.key = key;
+            last.valid = true;
         }
-        let rot = mat_to_euler(&(pivot_axes.transpose() * *axes));
-        last.set(Some((key, rot)));
-        rot
+        last.rot
     })
 }
 

@@ -619,6 +619,10 @@ impl<'a> Interp<'a> {
         result
     }
 
+    /// Runs `body` on the shape of `st`. Callers finish the state right
+    /// after (`finish`) and use nothing else of its shape: a rule called as
+    /// the body's last statement takes the shape's geometry (see
+    /// `exec_stmt`), leaving it empty.
     pub fn exec_body(
         &mut self,
         body: &RBody,

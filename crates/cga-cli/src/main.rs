@@ -14,12 +14,15 @@ mod report;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::mpsc;
 
 use clap::{Args, Parser, Subcommand};
 
+use cga_engine::derive::Leaf;
+use cga_engine::generate::generate_lot_streaming;
 use cga_engine::generate::parse_value;
 use cga_engine::lot::{self, Lot};
-use cga_engine::{generate_lot, GenerateOptions, Limits};
+use cga_engine::{GenerateOptions, Limits, LotOutput, RtError};
 use cga_export::{ExportOptions, Format, ModelWriter};
 use cga_syntax::{Diagnostic, SourceMap};
 
@@ -328,6 +331,9 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
             max_depth: args.max_depth,
             max_shapes: args.max_shapes,
         },
+        // The writer places each leaf's shared mesh while writing: no leaf
+        // is copied into object coordinates first.
+        leaves: true,
         ..GenerateOptions::default()
     };
     for a in &args.attrs {
@@ -380,11 +386,6 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
             .map(|n| n.get())
             .unwrap_or(1)
     });
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(jobs.max(1))
-        .stack_size(DERIVATION_STACK)
-        .build()
-        .map_err(|e| Failure::Usage(format!("cannot start worker threads: {e}")))?;
     let progress = progress_bar(lots.len());
 
     let mut failed_lots = 0usize;
@@ -392,52 +393,57 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
     let mut shapes = 0usize;
     let mut leaves = 0usize;
     let mut seen_warnings = std::collections::HashSet::new();
-    // Lots are derived in parallel a batch at a time; their results are
-    // written in lot order, so the output does not depend on the thread count
-    // and memory holds one batch of results, not the whole city.
-    let batch = (jobs * 8).max(1);
-    for (b, chunk) in lots.chunks(batch).enumerate() {
-        let results: Vec<_> = pool.install(|| {
-            use rayon::prelude::*;
-            chunk
-                .par_iter()
-                .enumerate()
-                .map(|(j, lot)| generate_lot(&program, &assets, rule, lot, b * batch + j, &options))
-                .collect()
-        });
-        for (lot, (out, error)) in chunk.iter().zip(results) {
-            {
-                use std::io::Write;
-                let mut stdout = std::io::stdout().lock();
-                for line in &out.prints {
-                    let _ = writeln!(stdout, "{line}");
-                }
-            }
-            for w in &out.warnings {
-                if seen_warnings.insert((w.message.clone(), w.span)) {
-                    progress.suspend(|| report_diagnostics(std::slice::from_ref(w), &sources));
-                }
-            }
-            if let Some(e) = error {
-                let mut d = e.to_diagnostic();
-                if lots.len() > 1 {
-                    d = d.with_note(format!("in lot `{}`", lot.name));
-                }
-                progress.suspend(|| report_diagnostics(&[d], &sources));
-                failed_lots += 1;
-            }
-            reports.add(&out.reports);
-            shapes += out.shapes;
-            leaves += out.meshes.len();
-            if let Some(w) = writer.as_mut() {
-                for m in &out.meshes {
-                    w.add_mesh(m)
+    // Leaves go to the writing thread as they are emitted, so writing the
+    // model overlaps deriving it even for a single lot. Without an output
+    // they are dropped where they were made.
+    let stream = writer.is_some();
+    // Takes what the lots produce, in lot order: each leaf into the writer
+    // as it comes, then the lot's prints, diagnostics and reports.
+    let mut take = |i: usize, taken: Taken<Leaf, (LotOutput, Option<RtError>)>| {
+        let (out, error) = match taken {
+            Taken::Leaf(leaf) => {
+                leaves += 1;
+                if let Some(w) = writer.as_mut() {
+                    w.add_placed(&leaf.mesh, Some(&leaf.transform), &leaf.materials)
                         .map_err(|e| Failure::Usage(format!("export failed: {e}")))?;
                 }
+                return Ok(());
             }
-            progress.inc(1);
+            Taken::Done(r) => r,
+        };
+        {
+            use std::io::Write;
+            let mut stdout = std::io::stdout().lock();
+            for line in &out.prints {
+                let _ = writeln!(stdout, "{line}");
+            }
         }
-    }
+        for w in &out.warnings {
+            if seen_warnings.insert((w.message.clone(), w.span)) {
+                progress.suspend(|| report_diagnostics(std::slice::from_ref(w), &sources));
+            }
+        }
+        if let Some(e) = error {
+            let mut d = e.to_diagnostic();
+            if lots.len() > 1 {
+                d = d.with_note(format!("in lot `{}`", lots[i].name));
+            }
+            progress.suspend(|| report_diagnostics(&[d], &sources));
+            failed_lots += 1;
+        }
+        reports.add(&out.reports);
+        shapes += out.shapes;
+        progress.inc(1);
+        Ok(())
+    };
+    let generate_one = |i: usize, sink: &mut dyn FnMut(Leaf)| {
+        generate_lot_streaming(&program, &assets, rule, &lots[i], i, &options, |leaf| {
+            if stream {
+                sink(leaf)
+            }
+        })
+    };
+    run_pipeline(lots.len(), jobs.max(1), generate_one, &mut take)?;
     progress.finish_and_clear();
     let failed = failed_lots > 0;
     if failed && lots.len() > 1 {
@@ -492,6 +498,166 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
     }
 }
 
+/// What the writing thread is handed for a lot, in order: its leaves as
+/// they are emitted, then its result.
+enum Taken<L, R> {
+    Leaf(L),
+    Done(R),
+}
+
+/// What a worker sends for a lot: the channel its leaves will come
+/// through in batches (when it starts), then its result.
+enum Delivery<L, R> {
+    Leaves(mpsc::Receiver<Vec<L>>),
+    Done(R),
+}
+
+/// Leaves per message from a worker to the writing thread.
+const LEAF_BATCH: usize = 64;
+
+/// Derives lots `0..count` on `jobs` worker threads while the calling
+/// thread hands what they produce to `take` in lot order: the leaves of a
+/// lot as they come (`generate` emits them through its sink), then its
+/// result. So writing overlaps deriving, even within one lot, and the
+/// output does not depend on the number of threads. A worker starts a lot
+/// only while fewer than a few lots per worker wait to be taken, so memory
+/// holds a bounded number of lots, not the whole city. An error from
+/// `take` stops the workers and is returned.
+fn run_pipeline<L: Send, R: Send>(
+    count: usize,
+    jobs: usize,
+    generate: impl Fn(usize, &mut dyn FnMut(L)) -> R + Sync,
+    take: &mut dyn FnMut(usize, Taken<L, R>) -> Result<(), Failure>,
+) -> Result<(), Failure> {
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+    use std::sync::{Condvar, Mutex};
+
+    /// Stops the other workers if this one panics (they would otherwise
+    /// wait for a lot that never comes).
+    struct StopOnPanic<'a>(&'a dyn Fn());
+    impl Drop for StopOnPanic<'_> {
+        fn drop(&mut self) {
+            if std::thread::panicking() {
+                (self.0)();
+            }
+        }
+    }
+
+    let window = jobs * 4;
+    let next = AtomicUsize::new(0);
+    let stop = AtomicBool::new(false);
+    // Lots taken so far, and a signal when it grows or work stops.
+    let taken = (Mutex::new(0usize), Condvar::new());
+    let lock = || taken.0.lock().unwrap_or_else(|e| e.into_inner());
+    let halt = || {
+        // Under the lock, so that no worker misses the signal.
+        let _done = lock();
+        stop.store(true, Ordering::Relaxed);
+        taken.1.notify_all();
+    };
+    std::thread::scope(|scope| {
+        let (tx, rx) = mpsc::channel::<(usize, Delivery<L, R>)>();
+        for _ in 0..jobs.min(count) {
+            let tx = tx.clone();
+            let (next, stop, taken, generate, lock, halt) =
+                (&next, &stop, &taken, &generate, &lock, &halt);
+            let worker = move || {
+                let _guard = StopOnPanic(halt);
+                loop {
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    if i >= count {
+                        break;
+                    }
+                    {
+                        let mut done = lock();
+                        while i >= *done + window && !stop.load(Ordering::Relaxed) {
+                            done = taken.1.wait(done).unwrap_or_else(|e| e.into_inner());
+                        }
+                    }
+                    let (leaf_tx, leaf_rx) = mpsc::channel();
+                    if stop.load(Ordering::Relaxed)
+                        || tx.send((i, Delivery::Leaves(leaf_rx))).is_err()
+                    {
+                        break;
+                    }
+                    // Leaves go in batches: a message per leaf would wake
+                    // the writing thread for each (a system call apiece).
+                    let mut batch = Vec::with_capacity(LEAF_BATCH);
+                    let r = generate(i, &mut |leaf| {
+                        batch.push(leaf);
+                        if batch.len() == LEAF_BATCH {
+                            let full =
+                                std::mem::replace(&mut batch, Vec::with_capacity(LEAF_BATCH));
+                            // A closed channel means the writing stopped.
+                            let _ = leaf_tx.send(full);
+                        }
+                    });
+                    if !batch.is_empty() {
+                        let _ = leaf_tx.send(batch);
+                    }
+                    drop(leaf_tx);
+                    if tx.send((i, Delivery::Done(r))).is_err() {
+                        break;
+                    }
+                }
+            };
+            if let Err(e) = std::thread::Builder::new()
+                .stack_size(DERIVATION_STACK)
+                .spawn_scoped(scope, worker)
+            {
+                halt();
+                return Err(Failure::Usage(format!("cannot start worker threads: {e}")));
+            }
+        }
+        drop(tx);
+        let mut leaves = std::collections::BTreeMap::new();
+        let mut results = std::collections::BTreeMap::new();
+        // The next message for lot `i` of the kind `pick` takes out of the
+        // waiting ones; `None` when the workers are gone.
+        let mut wait_for = |i: usize, want_leaves: bool| loop {
+            if want_leaves {
+                if let Some(r) = leaves.remove(&i) {
+                    return Some(Delivery::Leaves(r));
+                }
+            } else if let Some(r) = results.remove(&i) {
+                return Some(Delivery::Done(r));
+            }
+            match rx.recv() {
+                Ok((j, Delivery::Leaves(r))) => {
+                    leaves.insert(j, r);
+                }
+                Ok((j, Delivery::Done(r))) => {
+                    results.insert(j, r);
+                }
+                Err(_) => return None,
+            }
+        };
+        let mut result = Ok(());
+        'lots: for i in 0..count {
+            let Some(Delivery::Leaves(leaf_rx)) = wait_for(i, true) else {
+                break;
+            };
+            for leaf in leaf_rx.iter().flatten() {
+                result = take(i, Taken::Leaf(leaf));
+                if result.is_err() {
+                    break 'lots;
+                }
+            }
+            let Some(Delivery::Done(r)) = wait_for(i, false) else {
+                break;
+            };
+            result = take(i, Taken::Done(r));
+            if result.is_err() {
+                break;
+            }
+            *lock() = i + 1;
+            taken.1.notify_all();
+        }
+        halt();
+        result
+    })
+}
+
 /// Peak resident memory of this process in KiB (Linux: `VmHWM`).
 fn peak_memory() -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
@@ -524,4 +690,70 @@ fn project_roots(rule_dir: &Path) -> Vec<PathBuf> {
         roots.push(dir.to_path_buf());
     }
     roots
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Runs the pipeline where lot `i` emits `i % 5` leaves `(i, k)` and
+    /// results in `10 i`; returns what was taken, in order.
+    fn run(count: usize, jobs: usize, fail_at: Option<usize>) -> (Vec<String>, bool) {
+        let mut seen = Vec::new();
+        let generate = |i: usize, sink: &mut dyn FnMut((usize, usize))| {
+            for k in 0..i % 5 {
+                sink((i, k));
+            }
+            10 * i
+        };
+        let r = run_pipeline(count, jobs, generate, &mut |i, taken| {
+            match taken {
+                Taken::Leaf((j, k)) => seen.push(format!("{i}:{j}.{k}")),
+                Taken::Done(r) => seen.push(format!("{i}={r}")),
+            }
+            if Some(i) == fail_at {
+                return Err(Failure::Usage("stop".into()));
+            }
+            Ok(())
+        });
+        (seen, r.is_ok())
+    }
+
+    #[test]
+    fn pipeline_takes_everything_in_lot_order() {
+        let mut want = Vec::new();
+        for i in 0..60 {
+            for k in 0..i % 5 {
+                want.push(format!("{i}:{i}.{k}"));
+            }
+            want.push(format!("{i}={}", 10 * i));
+        }
+        for jobs in [1, 2, 3, 8] {
+            let (seen, ok) = run(60, jobs, None);
+            assert!(ok);
+            assert_eq!(seen, want, "{jobs} jobs");
+        }
+        assert_eq!(run(0, 2, None), (Vec::new(), true));
+    }
+
+    #[test]
+    fn pipeline_stops_on_an_error() {
+        let (seen, ok) = run(100, 3, Some(6));
+        assert!(!ok);
+        // Lot 6 has one leaf: taking it failed, nothing after it is taken.
+        assert_eq!(seen.last().map(String::as_str), Some("6:6.0"));
+        assert_eq!(seen.len(), 17);
+    }
+
+    #[test]
+    fn a_worker_panic_does_not_hang_the_pipeline() {
+        let r = std::panic::catch_unwind(|| {
+            let generate = |i: usize, _: &mut dyn FnMut(())| {
+                assert!(i != 3, "lot 3 fails");
+                i
+            };
+            run_pipeline(40, 2, generate, &mut |_, _| Ok(()))
+        });
+        assert!(r.is_err());
+    }
 }

@@ -10,6 +10,7 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
+use cga_geometry::topology::FxHashMap;
 use cga_geometry::Mesh;
 use cga_syntax::{FileId, SourceMap};
 
@@ -20,6 +21,33 @@ pub struct Assets {
     files: Vec<PathBuf>,
     meshes: Mutex<HashMap<PathBuf, Result<Arc<Mesh>, String>>>,
     texts: Mutex<HashMap<PathBuf, Option<Arc<str>>>>,
+    /// Answers by request (rule file, path as written), shared by all lots:
+    /// a search looks at the file system several times, and Candler alone
+    /// inserts 1,600 assets and names 6,000 textures per building.
+    found: Requests<Option<PathBuf>>,
+    mesh_requests: Requests<Result<Arc<Mesh>, String>>,
+    texture_files: Requests<Option<Arc<str>>>,
+}
+
+/// A cache by rule file and path as written.
+type Requests<T> = Mutex<FxHashMap<u32, FxHashMap<Box<str>, T>>>;
+
+fn cached<T: Clone>(cache: &Requests<T>, from: FileId, path: &str, make: impl FnOnce() -> T) -> T {
+    fn lock<T>(
+        c: &Requests<T>,
+    ) -> std::sync::MutexGuard<'_, FxHashMap<u32, FxHashMap<Box<str>, T>>> {
+        c.lock().unwrap_or_else(|e| e.into_inner())
+    }
+    if let Some(v) = lock(cache).get(&from.0).and_then(|m| m.get(path)) {
+        return v.clone();
+    }
+    // Not under the lock: making it may take a while (loading a mesh).
+    let v = make();
+    lock(cache)
+        .entry(from.0)
+        .or_default()
+        .insert(path.into(), v.clone());
+    v
 }
 
 impl Assets {
@@ -39,6 +67,9 @@ impl Assets {
                 .collect(),
             meshes: Mutex::new(HashMap::new()),
             texts: Mutex::new(HashMap::new()),
+            found: Default::default(),
+            mesh_requests: Default::default(),
+            texture_files: Default::default(),
         }
     }
 
@@ -48,17 +79,41 @@ impl Assets {
             files: Vec::new(),
             meshes: Mutex::new(HashMap::new()),
             texts: Mutex::new(HashMap::new()),
+            found: Default::default(),
+            mesh_requests: Default::default(),
+            texture_files: Default::default(),
         }
     }
 
-    /// The file `path` names, searched from the rule file `from`.
+    /// The file `path` names, searched from the rule file `from` (once per
+    /// rule file and path).
     pub fn resolve(&self, from: FileId, path: &str) -> Option<PathBuf> {
-        let p = std::path::Path::new(path);
-        if p.is_absolute() && p.is_file() {
-            return Some(p.to_path_buf());
-        }
-        let rule_file = self.files.get(from.0 as usize)?;
-        find_relative(rule_file, path)
+        cached(&self.found, from, path, || {
+            let p = std::path::Path::new(path);
+            if p.is_absolute() && p.is_file() {
+                return Some(p.to_path_buf());
+            }
+            let rule_file = self.files.get(from.0 as usize)?;
+            find_relative(rule_file, path)
+        })
+    }
+
+    /// The texture file `path` names, searched from the rule file `from`
+    /// like an asset or else as a path from the working folder, as an
+    /// absolute path (once per rule file and path).
+    pub fn texture_file(&self, from: FileId, path: &str) -> Option<Arc<str>> {
+        cached(&self.texture_files, from, path, || {
+            // Textures of inserted assets come as paths next to the asset
+            // file, which may be relative to the working folder.
+            let file = self.resolve(from, path).or_else(|| {
+                let p = std::path::Path::new(path);
+                p.is_file().then(|| p.to_path_buf())
+            });
+            file.map(|f| {
+                let f = f.canonicalize().unwrap_or(f);
+                Arc::from(f.to_string_lossy().as_ref())
+            })
+        })
     }
 
     /// The geometry of the asset `path`: a built-in (`builtin:cube`, ...)
@@ -68,6 +123,12 @@ impl Assets {
             return builtin_geometry(name)
                 .ok_or_else(|| format!("there is no built-in asset \"{path}\""));
         }
+        cached(&self.mesh_requests, from, path, || {
+            self.load_mesh(from, path)
+        })
+    }
+
+    fn load_mesh(&self, from: FileId, path: &str) -> Result<Arc<Mesh>, String> {
         let file = self
             .resolve(from, path)
             .ok_or_else(|| format!("asset \"{path}\" not found"))?;

@@ -9,13 +9,16 @@
 //! sequence goes on with the current shape (`extrude(15) r(..) X. r(..) X.`).
 
 use std::collections::HashSet;
+use std::sync::Arc;
 
-use cga_geometry::Mesh;
+use cga_geometry::mesh::SharedVec;
+use cga_geometry::{DAffine3, DVec2, DVec3, Material, Mesh};
 use cga_syntax::{Diagnostic, Span};
 use cga_value::Value;
 
 use crate::assets::Assets;
 use crate::expr::{RBody, RExpr, RExprKind, RStmt};
+use crate::material_attr::MaterialOverrides;
 use crate::ops;
 use crate::program::{Program, RuleId};
 use crate::shape::Shape;
@@ -157,11 +160,41 @@ impl ShapeState {
     }
 }
 
+/// A leaf shape's geometry as the derivation left it: the shape's mesh
+/// (shared with the shape, never copied), the map that places it in
+/// object coordinates, and the final materials of its slots. Baking it
+/// ([`Leaf::to_mesh`]) gives the mesh [`LotOutput::meshes`] would hold;
+/// exporters can place it while writing instead
+/// (`cga_export::ModelWriter::add_placed`).
+#[derive(Clone, Debug)]
+pub struct Leaf {
+    pub mesh: Arc<Mesh>,
+    /// From the mesh's coordinates to object coordinates. A map that
+    /// mirrors (negative determinant) also reverses the faces.
+    pub transform: DAffine3,
+    /// The materials of the mesh's slots: its own with the shape's material
+    /// attributes applied and texture paths resolved to files.
+    pub materials: SharedVec<Material>,
+}
+
+impl Leaf {
+    /// The geometry in object coordinates with its final materials.
+    pub fn to_mesh(&self) -> Mesh {
+        let mut m = crate::shape::transformed(&self.mesh, &self.transform);
+        m.materials = self.materials.clone();
+        m
+    }
+}
+
 /// What the derivation of one initial shape produced.
 #[derive(Default)]
 pub struct LotOutput {
-    /// Leaf geometry in object coordinates, with final materials.
+    /// Leaf geometry in object coordinates, with final materials (empty when
+    /// the leaves were asked for as [`LotOutput::leaves`]).
     pub meshes: Vec<Mesh>,
+    /// Leaf geometry unbaked, when asked for (`GenerateOptions::leaves`),
+    /// in derivation order.
+    pub leaves: Vec<Leaf>,
     pub prints: Vec<String>,
     pub reports: Vec<(String, Value)>,
     pub warnings: Vec<Diagnostic>,
@@ -199,6 +232,195 @@ pub struct Interp<'a> {
     /// The rule file of the rule being applied: texture paths of the shapes
     /// it emits are resolved from there.
     pub(crate) current_file: cga_syntax::FileId,
+    /// Emit leaves unbaked into `out.leaves` instead of `out.meshes`.
+    pub keep_leaves: bool,
+    /// With `keep_leaves`: hand each leaf to this as it is emitted instead
+    /// of collecting them (an exporter on another thread writes the model
+    /// while the derivation goes on).
+    pub leaf_sink: Option<Box<dyn FnMut(Leaf) + 'a>>,
+    /// Empty argument lists and rule frames to reuse: every operation and
+    /// rule call needs one, and allocating each is a measurable part of a
+    /// derivation.
+    arg_pool: Vec<Vec<Arg>>,
+    frame_pool: Vec<Vec<Value>>,
+    pub(crate) memo: MeshMemo,
+    pub(crate) material_memo: MaterialMemo,
+    /// The final materials of recently emitted leaves (see `leaf_materials`).
+    emitted: EmitCache,
+}
+
+/// The last few (material attributes, geometry materials, rule file) →
+/// final materials of emitted leaves. Sibling leaves (the walls of a
+/// facade) set equal attributes on pieces of one mesh, so most leaves reuse
+/// a result: no materials are built, and the shared list lets the exporter
+/// recognise it by address.
+#[derive(Default)]
+struct EmitCache {
+    entries: Vec<EmitEntry>,
+    next: usize,
+}
+
+struct EmitEntry {
+    overrides: Arc<crate::material_attr::MaterialOverrides>,
+    base: SharedVec<Material>,
+    file: cga_syntax::FileId,
+    result: SharedVec<Material>,
+}
+
+const EMIT_CACHE_SIZE: usize = 8;
+
+/// Facts about shared meshes (inserted assets), computed once per lot
+/// instead of once per insertion: the asset's bounding box, and the texture
+/// measures `tileUV` needs of it placed by a given map. Entries hold their
+/// mesh, so an address names the same mesh as long as it is here.
+#[derive(Default)]
+pub(crate) struct MeshMemo {
+    bounds: Vec<(Arc<Mesh>, Bounds)>,
+    uv: Vec<UvMemo>,
+    next_bounds: usize,
+    next_uv: usize,
+}
+
+/// A bounding box (`None`: nothing to bound).
+type Bounds = Option<(DVec3, DVec3)>;
+
+/// `uv_bounds` and `uv_unit_scale` of UV set `set` of `mesh` placed by `to_scope`.
+pub(crate) type UvMeasures = (Option<(DVec2, DVec2)>, Option<DVec2>);
+
+struct UvMemo {
+    mesh: Arc<Mesh>,
+    to_scope: Option<DAffine3>,
+    set: usize,
+    measures: UvMeasures,
+}
+
+const MEMO_SIZE: usize = 16;
+
+impl MeshMemo {
+    /// The bounding box of the positions `mesh`'s faces use.
+    pub(crate) fn bounds(&mut self, mesh: &Arc<Mesh>) -> Bounds {
+        if Arc::strong_count(mesh) == 1 {
+            // Nobody else has it: it will not come again.
+            return crate::shape::local_bounds(mesh);
+        }
+        if let Some((_, b)) = self.bounds.iter().find(|(m, _)| Arc::ptr_eq(m, mesh)) {
+            return *b;
+        }
+        let b = crate::shape::local_bounds(mesh);
+        remember(&mut self.bounds, &mut self.next_bounds, (mesh.clone(), b));
+        b
+    }
+
+    /// The UV measures of a shared `mesh` placed by `to_scope`, if known.
+    pub(crate) fn uv(
+        &self,
+        mesh: &Arc<Mesh>,
+        to_scope: Option<&DAffine3>,
+        set: usize,
+    ) -> Option<UvMeasures> {
+        self.uv
+            .iter()
+            .find(|e| Arc::ptr_eq(&e.mesh, mesh) && e.to_scope.as_ref() == to_scope && e.set == set)
+            .map(|e| e.measures)
+    }
+
+    pub(crate) fn remember_uv(
+        &mut self,
+        mesh: Arc<Mesh>,
+        to_scope: Option<DAffine3>,
+        set: usize,
+        measures: UvMeasures,
+    ) {
+        let entry = UvMemo {
+            mesh,
+            to_scope,
+            set,
+            measures,
+        };
+        remember(&mut self.uv, &mut self.next_uv, entry);
+    }
+}
+
+/// What an operation does to a shape's material attributes, as far as it
+/// decides the result: `color("#fcefe2")`, `set(material.shininess, 20)`,
+/// `texture("bricks.jpg")` (read from a rule file).
+#[derive(Clone, Debug)]
+pub(crate) enum MaterialEdit {
+    ColorHex(Arc<str>),
+    Color([u64; 4], usize),
+    Field(crate::material_attr::MatField, Value),
+    Texture(Arc<str>, cga_syntax::FileId),
+}
+
+impl MaterialEdit {
+    fn same(&self, other: &MaterialEdit) -> bool {
+        use MaterialEdit::*;
+        let same_str = |a: &Arc<str>, b: &Arc<str>| Arc::ptr_eq(a, b) || a == b;
+        match (self, other) {
+            (ColorHex(a), ColorHex(b)) => same_str(a, b),
+            (Color(a, n), Color(b, m)) => a == b && n == m,
+            (Field(f, a), Field(g, b)) => {
+                f == g
+                    && match (a, b) {
+                        (Value::Float(x), Value::Float(y)) => x.to_bits() == y.to_bits(),
+                        (Value::Bool(x), Value::Bool(y)) => x == y,
+                        (Value::Str(x), Value::Str(y)) => same_str(x, y),
+                        _ => false,
+                    }
+            }
+            (Texture(a, f), Texture(b, g)) => f == g && same_str(a, b),
+            _ => false,
+        }
+    }
+}
+
+/// Recent material edits: (attributes before, edit) → attributes after.
+/// Sibling shapes make the same edits on the attributes they inherited
+/// (every wall of a facade sets the wall colour and texture), so most
+/// edits reuse a result: no copy of the attributes, and the siblings share
+/// one `Arc`, which `leaf_materials` then recognises by address. Entries
+/// hold both `Arc`s, so neither changes while it is here.
+#[derive(Default)]
+pub(crate) struct MaterialMemo {
+    entries: Vec<(Arc<MaterialOverrides>, MaterialEdit, Arc<MaterialOverrides>)>,
+    next: usize,
+}
+
+impl Interp<'_> {
+    /// Applies `edit` to the shape's material attributes with `apply`, or
+    /// reuses the result of the same edit on the same attributes.
+    pub(crate) fn edit_material(
+        &mut self,
+        shape: &mut Shape,
+        edit: MaterialEdit,
+        apply: impl FnOnce(&mut Interp, &mut MaterialOverrides) -> Result<(), RtError>,
+    ) -> Result<(), RtError> {
+        let memo = &self.material_memo.entries;
+        if let Some((_, _, after)) = memo
+            .iter()
+            .find(|(before, e, _)| Arc::ptr_eq(before, &shape.material) && e.same(&edit))
+        {
+            shape.material = after.clone();
+            return Ok(());
+        }
+        let before = shape.material.clone();
+        apply(self, Arc::make_mut(&mut shape.material))?;
+        let entry = (before, edit, shape.material.clone());
+        let memo = &mut self.material_memo;
+        remember(&mut memo.entries, &mut memo.next, entry);
+        Ok(())
+    }
+}
+
+/// Adds `entry` to a memo of at most `MEMO_SIZE` entries, replacing the
+/// oldest when full.
+fn remember<T>(list: &mut Vec<T>, next: &mut usize, entry: T) {
+    if list.len() < MEMO_SIZE {
+        list.push(entry);
+    } else {
+        list[*next] = entry;
+        *next = (*next + 1) % MEMO_SIZE;
+    }
 }
 
 impl<'a> Interp<'a> {
@@ -229,6 +451,13 @@ impl<'a> Interp<'a> {
             warned: HashSet::new(),
             textures: Default::default(),
             current_file: cga_syntax::FileId(0),
+            keep_leaves: false,
+            leaf_sink: None,
+            emitted: EmitCache::default(),
+            arg_pool: Vec::new(),
+            frame_pool: Vec::new(),
+            memo: MeshMemo::default(),
+            material_memo: MaterialMemo::default(),
         }
     }
 
@@ -287,6 +516,8 @@ impl<'a> Interp<'a> {
         self.depth -= 1;
         let r = r.map(|()| self.finish(st));
         self.current_file = caller_file;
+        frame.clear();
+        self.frame_pool.push(frame);
         r
     }
 
@@ -301,10 +532,15 @@ impl<'a> Interp<'a> {
     /// parent's scope remembered for `center`.
     pub fn child(&mut self, parent: &Shape, span: Span) -> Result<Shape, RtError> {
         self.count_shape(span)?;
+        Ok(self.successor(parent))
+    }
+
+    /// [`child`](Interp::child) without counting it.
+    fn successor(&self, parent: &Shape) -> Shape {
         let mut c = parent.clone();
         c.parent_scope = parent.scope;
         c.rng.set(parent.child_rng(parent.next_random().to_bits()));
-        Ok(c)
+        c
     }
 
     pub fn count_shape(&mut self, span: Span) -> Result<(), RtError> {
@@ -326,18 +562,67 @@ impl<'a> Interp<'a> {
         if shape.geometry.is_empty() {
             return;
         }
-        let mut mesh = shape.object_mesh();
-        if !shape.material.is_empty() {
-            for m in &mut mesh.materials {
-                *m = shape.material.apply(m);
+        let (mesh, _) = shape.geometry.raw();
+        let materials = self.leaf_materials(shape, &mesh.materials);
+        if self.keep_leaves {
+            let leaf = Leaf {
+                mesh: mesh.clone(),
+                transform: shape.object_transform(),
+                materials,
+            };
+            match &mut self.leaf_sink {
+                Some(sink) => sink(leaf),
+                None => self.out.leaves.push(leaf),
             }
+        } else {
+            let mut mesh = shape.object_mesh();
+            mesh.materials = materials;
+            self.out.meshes.push(mesh);
         }
-        // Texture paths as written become the files they name.
-        self.textures
-            .resolve_mesh(self.assets, self.current_file, &mut mesh);
-        self.out.meshes.push(mesh);
     }
 
+    /// The final materials of a leaf whose geometry has the slots `base`:
+    /// the shape's material attributes applied, texture paths as written
+    /// replaced by the files they name.
+    fn leaf_materials(&mut self, shape: &Shape, base: &SharedVec<Material>) -> SharedVec<Material> {
+        let file = self.current_file;
+        let overrides = &shape.material;
+        let hit = self.emitted.entries.iter().find(|e| {
+            e.file == file
+                && SharedVec::ptr_eq(&e.base, base)
+                && (Arc::ptr_eq(&e.overrides, overrides) || *e.overrides == **overrides)
+        });
+        if let Some(e) = hit {
+            return e.result.clone();
+        }
+        let mut result = base.clone();
+        if !overrides.is_empty() {
+            for m in &mut result {
+                *m = overrides.apply(m);
+            }
+        }
+        self.textures
+            .resolve_materials(self.assets, file, &mut result);
+        let entry = EmitEntry {
+            overrides: overrides.clone(),
+            base: base.clone(),
+            file,
+            result: result.clone(),
+        };
+        let cache = &mut self.emitted;
+        if cache.entries.len() < EMIT_CACHE_SIZE {
+            cache.entries.push(entry);
+        } else {
+            cache.entries[cache.next] = entry;
+            cache.next = (cache.next + 1) % EMIT_CACHE_SIZE;
+        }
+        result
+    }
+
+    /// Runs `body` on the shape of `st`. Callers finish the state right
+    /// after (`finish`) and use nothing else of its shape: a rule called as
+    /// the body's last statement takes the shape's geometry (see
+    /// `exec_stmt`), leaving it empty.
     pub fn exec_body(
         &mut self,
         body: &RBody,
@@ -346,11 +631,11 @@ impl<'a> Interp<'a> {
     ) -> Result<(), RtError> {
         match body {
             RBody::Ops(stmts) => {
-                for s in stmts {
+                for (i, s) in stmts.iter().enumerate() {
                     if st.deleted {
                         break;
                     }
-                    self.exec_stmt(s, frame, st)?;
+                    self.exec_stmt(s, frame, st, i + 1 == stmts.len())?;
                 }
                 Ok(())
             }
@@ -404,26 +689,54 @@ impl<'a> Interp<'a> {
         Ok(None)
     }
 
+    /// Runs one statement. `last`: nothing runs on `st` after it but
+    /// `finish` (every caller of `exec_body` finishes the state right
+    /// after), so a rule called last takes the shape's geometry instead of
+    /// sharing it, and can edit it without a copy.
     fn exec_stmt(
         &mut self,
         s: &RStmt,
         frame: &[Value],
         st: &mut ShapeState,
+        last: bool,
     ) -> Result<(), RtError> {
         match s {
             RStmt::Op(call) => {
-                let mut args = Vec::with_capacity(call.args.len());
+                // Argument lists come from a pool (operations nest: a split
+                // runs its parts' operations while its own arguments live).
+                let mut args = self.arg_pool.pop().unwrap_or_default();
                 for a in &call.args {
-                    args.push(self.eval_arg(a, frame, &st.shape)?);
+                    match self.eval_arg(a, frame, &st.shape) {
+                        Ok(v) => args.push(v),
+                        Err(e) => {
+                            args.clear();
+                            self.arg_pool.push(args);
+                            return Err(e);
+                        }
+                    }
                 }
-                ops::exec(self, st, call, &args, frame)
+                let r = ops::exec(self, st, call, &args, frame);
+                args.clear();
+                self.arg_pool.push(args);
+                r
             }
             RStmt::Rule(rc) => {
-                let mut args = Vec::with_capacity(rc.args.len());
+                let mut args = self.frame_pool.pop().unwrap_or_default();
                 for a in &rc.args {
                     args.push(self.eval(a, frame, &st.shape)?);
                 }
-                let mut child = self.child(&st.shape, rc.span)?;
+                let mut child = if last && !rc.dynamic {
+                    // The successor is the shape's last use (a dynamic
+                    // import still evaluates its overrides on the shape).
+                    self.count_shape(rc.span)?;
+                    let geometry =
+                        std::mem::replace(&mut st.shape.geometry, crate::shape::Geometry::empty());
+                    let mut c = self.successor(&st.shape);
+                    c.geometry = geometry;
+                    c
+                } else {
+                    self.child(&st.shape, rc.span)?
+                };
                 if rc.dynamic {
                     self.reinitialize_import(rc, frame, &st.shape, &mut child)?;
                 }

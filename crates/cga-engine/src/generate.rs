@@ -6,7 +6,7 @@ use std::sync::Arc;
 use cga_value::Value;
 
 use crate::assets::Assets;
-use crate::derive::{InitialInfo, Interp, Limits, LotOutput, RtError};
+use crate::derive::{InitialInfo, Interp, Leaf, Limits, LotOutput, RtError};
 use crate::expr::RExpr;
 use crate::lot::{initial_shape, Lot};
 use crate::program::{AttrId, Program, RuleId};
@@ -18,6 +18,11 @@ pub struct GenerateOptions {
     pub attrs: Vec<(AttrId, Value)>,
     pub seed: u64,
     pub limits: Limits,
+    /// Hand leaf geometry out unbaked (`LotOutput::leaves`: each leaf's
+    /// mesh shared with its shape, with the map that places it) instead of
+    /// as meshes in object coordinates (`LotOutput::meshes`). Exporters
+    /// place the leaves while writing, which saves a copy of every leaf.
+    pub leaves: bool,
 }
 
 /// Derives one lot with `rule`. The output holds everything generated,
@@ -29,6 +34,42 @@ pub fn generate_lot(
     lot: &Lot,
     lot_index: usize,
     options: &GenerateOptions,
+) -> (LotOutput, Option<RtError>) {
+    generate(program, assets, rule, lot, lot_index, options, None)
+}
+
+/// [`generate_lot`] handing each leaf to `sink` as soon as it is emitted,
+/// in derivation order, unbaked (as `GenerateOptions::leaves` gives them);
+/// `LotOutput::leaves` and `LotOutput::meshes` stay empty. A model writer
+/// on another thread can write the leaves while the derivation goes on.
+pub fn generate_lot_streaming<'a>(
+    program: &'a Program,
+    assets: &'a Assets,
+    rule: RuleId,
+    lot: &Lot,
+    lot_index: usize,
+    options: &GenerateOptions,
+    sink: impl FnMut(Leaf) + 'a,
+) -> (LotOutput, Option<RtError>) {
+    generate(
+        program,
+        assets,
+        rule,
+        lot,
+        lot_index,
+        options,
+        Some(Box::new(sink)),
+    )
+}
+
+fn generate<'a>(
+    program: &'a Program,
+    assets: &'a Assets,
+    rule: RuleId,
+    lot: &Lot,
+    lot_index: usize,
+    options: &GenerateOptions,
+    sink: Option<Box<dyn FnMut(Leaf) + 'a>>,
 ) -> (LotOutput, Option<RtError>) {
     // Each lot has its own seed: the run's seed for the first lot, then the
     // following numbers (`--seed 666` on one lot gives `seedian` 666).
@@ -50,6 +91,8 @@ pub fn generate_lot(
         start_rule: program.rules[rule as usize].name.clone(),
     };
     let mut interp = Interp::new(program, assets, options.limits, info, shape, &[]);
+    interp.keep_leaves = options.leaves || sink.is_some();
+    interp.leaf_sink = sink;
     let mut error = None;
     // Lot attributes (GeoJSON properties) first, command-line values win.
     let lot_attrs = lot
@@ -107,5 +150,75 @@ pub fn parse_value(text: &str) -> Value {
             Ok(x) => Value::Float(x),
             Err(_) => Value::Str(Arc::from(text)),
         },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Leaves handed out unbaked (collected or streamed) bake to exactly
+    /// the meshes the derivation gives otherwise: positions, normals, UVs,
+    /// faces and materials, also under mirroring, rotation and inserts.
+    #[test]
+    fn leaves_bake_to_the_meshes() {
+        let dir = std::env::temp_dir().join(format!("cga-engine-leaves-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("leaves.cga");
+        std::fs::write(
+            &path,
+            r##"
+Lot --> extrude(10) comp(f) { side : Facade | top : Roof }
+Facade --> setupProjection(0, scope.xy, 2, 2) split(y) { ~3 : Floor }*
+Floor --> split(x) { ~2 : Tile | 0.5 : Mirror }*
+Tile --> projectUV(0) color("#806040") texture("bricks.jpg") Wall.
+Mirror --> s(-scope.sx, '1, '1) r(0, 30, 0) i("builtin:cube") set(material.shininess, 12) M.
+Roof --> reverseNormals t(0, 1, 0) primitiveCube() color(0.5, 0.5, 0.9) R.
+"##,
+        )
+        .unwrap();
+        let mut sources = cga_syntax::SourceMap::new();
+        let program = crate::load(&path, &mut sources)
+            .program
+            .expect("rules load");
+        let assets = Assets::new(&sources);
+        let rule = program.start_rule(Some("Lot")).unwrap();
+        let lot = crate::lot::rect(12.0, 7.0);
+        let baked = generate_lot(
+            &program,
+            &assets,
+            rule,
+            &lot,
+            0,
+            &GenerateOptions::default(),
+        );
+        assert!(baked.1.is_none());
+        let meshes = baked.0.meshes;
+        assert!(meshes.len() > 40, "{} leaves", meshes.len());
+        let options = GenerateOptions {
+            leaves: true,
+            ..GenerateOptions::default()
+        };
+        let (kept, error) = generate_lot(&program, &assets, rule, &lot, 0, &options);
+        assert!(error.is_none() && kept.meshes.is_empty());
+        let mut streamed = Vec::new();
+        let (out, error) =
+            generate_lot_streaming(&program, &assets, rule, &lot, 0, &options, |l| {
+                streamed.push(l)
+            });
+        assert!(error.is_none() && out.leaves.is_empty() && out.meshes.is_empty());
+        for leaves in [&kept.leaves, &streamed] {
+            assert_eq!(leaves.len(), meshes.len());
+            for (leaf, mesh) in leaves.iter().zip(&meshes) {
+                assert_eq!(&leaf.to_mesh(), mesh);
+            }
+        }
+        // Some leaves were mirrored, and some share their mesh (the cube).
+        assert!(kept
+            .leaves
+            .iter()
+            .any(|l| l.transform.matrix3.determinant() < 0.0));
+        assert!(kept.leaves.iter().any(|l| Arc::strong_count(&l.mesh) > 2));
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -63,7 +63,7 @@ impl Scope {
     /// Sets the scope axes (object coordinates) and the angles relative to `pivot_axes`.
     pub fn set_axes(&mut self, pivot_axes: &DMat3, axes: DMat3) {
         self.frame.axes = axes;
-        self.rot = mat_to_euler(&(pivot_axes.transpose() * axes));
+        self.rot = relative_euler(pivot_axes, &axes);
     }
 
     pub fn center(&self) -> DVec3 {
@@ -87,6 +87,11 @@ impl Geometry {
         }
     }
 
+    /// No geometry (a shared empty mesh: no allocation).
+    pub fn empty() -> Geometry {
+        Geometry::new(empty_mesh())
+    }
+
     /// Applies `m` (scope-local → scope-local) after the current map.
     pub fn transform(&mut self, m: DAffine3) {
         self.to_scope = Some(match self.to_scope {
@@ -96,14 +101,31 @@ impl Geometry {
     }
 
     /// The mesh in scope-local coordinates, transforming it if needed (once:
-    /// the result replaces the stored mesh).
+    /// the result replaces the stored mesh). A mesh no other shape shares is
+    /// transformed where it is, without a copy.
     pub fn local(&mut self) -> &Arc<Mesh> {
+        self.bake();
+        &self.mesh
+    }
+
+    /// The mesh in scope-local coordinates for editing: copied first only if
+    /// another shape shares it (an operation that changes UVs or winding of
+    /// a freshly cut piece edits it in place).
+    pub fn local_mut(&mut self) -> &mut Mesh {
+        self.bake();
+        Arc::make_mut(&mut self.mesh)
+    }
+
+    /// Applies the pending map to the vertices.
+    fn bake(&mut self) {
         if let Some(t) = self.to_scope.take() {
             if t != DAffine3::IDENTITY {
-                self.mesh = Arc::new(transformed(&self.mesh, &t));
+                match Arc::get_mut(&mut self.mesh) {
+                    Some(m) => transform_in_place(m, &t),
+                    None => self.mesh = transformed_shared(&self.mesh, &t),
+                }
             }
         }
-        &self.mesh
     }
 
     /// The stored mesh and its map, without transforming anything.
@@ -121,11 +143,49 @@ impl Geometry {
 /// facing outwards.
 pub fn transformed(mesh: &Mesh, t: &DAffine3) -> Mesh {
     let mut m = mesh.clone();
-    cga_geometry::transform::transform(&mut m, t);
-    if t.matrix3.determinant() < 0.0 {
-        cga_geometry::transform::reverse_faces(&mut m);
-    }
+    transform_in_place(&mut m, t);
     m
+}
+
+/// [`transformed`] for a mesh other shapes share (an inserted asset),
+/// remembered for the last few meshes and maps: the windows of a facade
+/// are one asset placed by one map, and the result is the same mesh each
+/// time. The entries hold both meshes, so an address names one mesh.
+fn transformed_shared(mesh: &Arc<Mesh>, t: &DAffine3) -> Arc<Mesh> {
+    type Entry = (Arc<Mesh>, [u64; 12], Arc<Mesh>);
+    thread_local! {
+        static BAKED: std::cell::RefCell<(Vec<Entry>, usize)> = const {
+            std::cell::RefCell::new((Vec::new(), 0))
+        };
+    }
+    const ENTRIES: usize = 8;
+    let key = t.to_cols_array().map(f64::to_bits);
+    BAKED.with(|b| {
+        let (entries, next) = &mut *b.borrow_mut();
+        if let Some((_, _, done)) = entries
+            .iter()
+            .find(|(m, k, _)| Arc::ptr_eq(m, mesh) && *k == key)
+        {
+            return done.clone();
+        }
+        let done = Arc::new(transformed(mesh, t));
+        let entry = (mesh.clone(), key, done.clone());
+        if entries.len() < ENTRIES {
+            entries.push(entry);
+        } else {
+            entries[*next] = entry;
+            *next = (*next + 1) % ENTRIES;
+        }
+        done
+    })
+}
+
+/// [`transformed`] without the copy.
+pub fn transform_in_place(mesh: &mut Mesh, t: &DAffine3) {
+    cga_geometry::transform::transform(mesh, t);
+    if t.matrix3.determinant() < 0.0 {
+        cga_geometry::transform::reverse_faces(mesh);
+    }
 }
 
 /// Trim state of a shape: the switches `trim.horizontal` and
@@ -293,14 +353,36 @@ impl Shape {
 
     /// The geometry in object coordinates (for output and world queries).
     pub fn object_mesh(&self) -> Mesh {
-        let (mesh, to_scope) = self.geometry.raw();
+        transformed(self.geometry.raw().0, &self.object_transform())
+    }
+
+    /// The map from the stored mesh's coordinates to object coordinates
+    /// (what [`object_mesh`](Shape::object_mesh) applies).
+    pub fn object_transform(&self) -> DAffine3 {
         let frame = self.scope.frame.affine();
-        let t = match to_scope {
+        match self.geometry.raw().1 {
             Some(m) => frame * *m,
             None => frame,
-        };
-        transformed(mesh, &t)
+        }
     }
+
+    /// [`object_mesh`](Shape::object_mesh), taking the mesh out of the shape
+    /// (no copy when no other shape shares it); the shape is left without
+    /// geometry, for an operation that replaces it.
+    pub fn take_object_mesh(&mut self) -> Mesh {
+        let t = self.object_transform();
+        let g = std::mem::replace(&mut self.geometry, Geometry::empty());
+        let mut m = Arc::try_unwrap(g.mesh).unwrap_or_else(|shared| (*shared).clone());
+        transform_in_place(&mut m, &t);
+        m
+    }
+}
+
+/// A shared empty mesh (a placeholder that costs no allocation).
+fn empty_mesh() -> Arc<Mesh> {
+    static EMPTY: std::sync::LazyLock<Arc<Mesh>> =
+        std::sync::LazyLock::new(|| Arc::new(Mesh::new()));
+    EMPTY.clone()
 }
 
 /// Bounding box of the positions a mesh's faces use.
@@ -323,6 +405,41 @@ fn splitmix64(state: &mut u64) -> u64 {
 pub fn euler_to_mat(angles: DVec3) -> DMat3 {
     let r = angles * (std::f64::consts::PI / 180.0);
     DMat3::from_rotation_z(r.z) * DMat3::from_rotation_y(r.y) * DMat3::from_rotation_x(r.x)
+}
+
+/// `mat_to_euler(pivot_axes^T * axes)`, remembered for the last inputs:
+/// the parts of a split and the faces of a component split mostly keep
+/// their parent's axes and pivot, and the angles take trigonometry.
+fn relative_euler(pivot_axes: &DMat3, axes: &DMat3) -> DVec3 {
+    /// The inputs (bits of both matrices) and the angles.
+    struct Last {
+        valid: bool,
+        key: [u64; 18],
+        rot: DVec3,
+    }
+    thread_local! {
+        static LAST: std::cell::RefCell<Last> = const {
+            std::cell::RefCell::new(Last { valid: false, key: [0; 18], rot: DVec3::ZERO })
+        };
+    }
+    let mut key = [0u64; 18];
+    for (k, x) in key.iter_mut().zip(
+        pivot_axes
+            .to_cols_array()
+            .iter()
+            .chain(&axes.to_cols_array()),
+    ) {
+        *k = x.to_bits();
+    }
+    LAST.with(|last| {
+        let mut last = last.borrow_mut();
+        if !(last.valid && last.key == key) {
+            last.rot = mat_to_euler(&(pivot_axes.transpose() * *axes));
+            last.key = key;
+            last.valid = true;
+        }
+        last.rot
+    })
 }
 
 /// CGA Euler angles in degrees of a rotation matrix (inverse of [`euler_to_mat`]).

@@ -5,14 +5,14 @@ use cga_geometry::{DVec3, Mesh};
 /// Unit normal of a face from its outer loop (Newell's method, which works
 /// for any planar polygon, convex or not, and averages slightly non-planar
 /// ones). `None` for a degenerate (zero-area) loop.
-pub(crate) fn face_normal(mesh: &Mesh, face: usize) -> Option<DVec3> {
+pub(crate) fn face_normal(mesh: &Mesh, positions: &[DVec3], face: usize) -> Option<DVec3> {
     let outer = mesh.outer_loop(face);
     let idx = mesh.loop_indices(outer);
     let mut n = DVec3::ZERO;
     let &last = idx.last()?;
-    let mut prev = mesh.positions[last as usize];
+    let mut prev = positions[last as usize];
     for &i in idx {
-        let p = mesh.positions[i as usize];
+        let p = positions[i as usize];
         n += DVec3::new(
             (prev.y - p.y) * (prev.z + p.z),
             (prev.z - p.z) * (prev.x + p.x),
@@ -26,9 +26,13 @@ pub(crate) fn face_normal(mesh: &Mesh, face: usize) -> Option<DVec3> {
 
 /// Whether every position, UV (set 0) and normal of the face is finite;
 /// NaN or infinite values would make the written file invalid.
-pub(crate) fn face_is_finite(mesh: &Mesh, face: usize) -> bool {
+pub(crate) fn face_is_finite(
+    mesh: &Mesh,
+    positions: &[DVec3],
+    normals: Option<&[DVec3]>,
+    face: usize,
+) -> bool {
     let uvs = mesh.uvs[0].as_deref();
-    let normals = mesh.normals.as_deref();
     mesh.face_loops(face).iter().all(|&l| {
         mesh.loop_corners(l).all(|c| {
             let uv_ok = match uvs {
@@ -39,7 +43,7 @@ pub(crate) fn face_is_finite(mesh: &Mesh, face: usize) -> bool {
                 Some(n) => n[c].is_finite(),
                 None => true,
             };
-            mesh.positions[mesh.corners[c] as usize].is_finite() && uv_ok && normal_ok
+            positions[mesh.corners[c] as usize].is_finite() && uv_ok && normal_ok
         })
     })
 }
@@ -69,7 +73,7 @@ mod tests {
             DVec3::new(3.0, 0.0, -1.0),
         ]);
         m.add_face(&[&[0, 1, 2, 3], &[4, 5, 6, 7]], 0);
-        let n = face_normal(&m, 0).unwrap();
+        let n = face_normal(&m, &m.positions, 0).unwrap();
         assert!((n - DVec3::Y).length() < 1e-12);
         let mut tris = Vec::new();
         cga_geometry::triangulate_face(&m, 0, &mut tris);
@@ -86,7 +90,7 @@ mod tests {
     #[test]
     fn degenerate_face_gives_no_triangles() {
         let m = Mesh::polygon(&[DVec3::ZERO, DVec3::X, DVec3::X * 2.0, DVec3::X * 3.0]);
-        assert_eq!(face_normal(&m, 0), None);
+        assert_eq!(face_normal(&m, &m.positions, 0), None);
         let mut tris = Vec::new();
         cga_geometry::triangulate_face(&m, 0, &mut tris);
         assert!(tris.is_empty());

@@ -26,11 +26,10 @@ use std::path::{Path, PathBuf};
 
 use std::sync::Arc;
 
-use cga_geometry::{DVec3, Material, Mesh};
+use cga_geometry::{DVec2, DVec3, Material, Mesh, UV_SETS};
 use gltf_json as json;
 use json::validation::{Checked::Valid, USize64};
 
-use crate::hash::FastMap;
 use crate::materials::{srgb_to_linear, MaterialTable};
 use crate::textures::{uri_encode, Textures};
 use crate::{ExportError, ExportStats, FaceData};
@@ -80,11 +79,34 @@ impl Bucket {
         self.coords = distinct;
     }
 
+    fn new() -> Bucket {
+        Bucket {
+            min: [f32::INFINITY; 3],
+            max: [f32::NEG_INFINITY; 3],
+            ..Bucket::default()
+        }
+    }
+
+    /// Room for `n` more vertices.
+    fn reserve(&mut self, n: usize) {
+        self.positions.reserve(3 * n);
+        self.normals.reserve(3 * n);
+        for c in &mut self.coords {
+            c.reserve(2 * n);
+        }
+        if let Some(t) = &mut self.tangents {
+            t.reserve(4 * n);
+        }
+    }
+
+    /// Appends a vertex at `p` with normal `n`; `sources[k]` is where the
+    /// `k`-th written UV set reads (see [`Bucket::sets`]), at `corner`.
+    #[inline(always)]
     fn push_vertex(
         &mut self,
         p: DVec3,
         n: DVec3,
-        mesh: &Mesh,
+        sources: &[Option<&[DVec2]>],
         corner: usize,
         tangent: (DVec3, f64),
     ) -> Result<u32, ExportError> {
@@ -92,24 +114,19 @@ impl Bucket {
             ExportError::TooLarge("more than 2^32 vertices with one material".into())
         })?;
         let p = p.as_vec3().to_array();
-        if index == 0 {
-            self.min = p;
-            self.max = p;
-        } else {
-            for ((lo, hi), x) in self.min.iter_mut().zip(&mut self.max).zip(p) {
-                *lo = lo.min(x);
-                *hi = hi.max(x);
-            }
+        // `min` and `max` start at +inf and -inf (see `Bucket::new`).
+        for ((lo, hi), x) in self.min.iter_mut().zip(&mut self.max).zip(p) {
+            *lo = lo.min(x);
+            *hi = hi.max(x);
         }
         self.positions.extend_from_slice(&p);
         self.normals.extend_from_slice(&n.as_vec3().to_array());
-        for (&set, coords) in self.sets.iter().zip(&mut self.coords) {
-            let uv = mesh.uvs[set]
-                .as_deref()
-                .or(mesh.uvs[0].as_deref())
-                .and_then(|u| u.get(corner));
+        for (src, coords) in sources.iter().zip(&mut self.coords) {
             // glTF puts v = 0 at the top of the image, CGA at the bottom.
-            let (u, v) = uv.map_or((0.0, 0.0), |t| (t.x as f32, (1.0 - t.y) as f32));
+            let (u, v) = match src.and_then(|u| u.get(corner)) {
+                Some(t) => (t.x as f32, (1.0 - t.y) as f32),
+                None => (0.0, 0.0),
+            };
             coords.extend_from_slice(&[u, v]);
         }
         if let Some(tangents) = &mut self.tangents {
@@ -150,7 +167,7 @@ fn face_tangent(f: &FaceData) -> (DVec3, f64) {
     };
     for t in f.triangles {
         let c = t.map(|c| c as usize);
-        let p = c.map(|c| mesh.positions[mesh.corners[c] as usize]);
+        let p = c.map(|c| f.positions[mesh.corners[c] as usize]);
         let q = c.map(|c| uvs.get(c).copied().unwrap_or_default());
         let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
         let (d1, d2) = (q[1] - q[0], q[2] - q[0]);
@@ -191,15 +208,26 @@ struct MapUse {
     channel: usize,
 }
 
-/// Identifies a vertex within one input mesh that carries its own normals,
-/// so corners that share position, normal and UV share one output vertex.
-#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+/// Identifies a vertex at one position of an input mesh that carries its
+/// own normals, so corners that share position, normal and UV (and
+/// material) share one output vertex.
+#[derive(Clone, Copy, PartialEq, Eq)]
 struct VertexKey {
     material: u32,
-    position: u32,
     normal: [u32; 3],
     uv: [u32; 2],
 }
+
+/// An output vertex made for a position of the mesh being added: its key,
+/// the vertex, and the next entry of the same position (`NO_ENTRY`: none).
+#[derive(Clone, Copy)]
+struct SharedVertex {
+    key: VertexKey,
+    vertex: u32,
+    next: u32,
+}
+
+const NO_ENTRY: u32 = u32::MAX;
 
 pub(crate) struct GltfWriter {
     path: PathBuf,
@@ -219,7 +247,12 @@ pub(crate) struct GltfWriter {
     uses_transform: bool,
     /// Output vertex of each corner of the mesh being added.
     corner_vertex: Vec<u32>,
-    dedup: FastMap<VertexKey, u32>,
+    /// The output vertices made for each position of the mesh being added
+    /// (per position the first entry in `shared`, chained by `next`): a
+    /// position rarely has more than a few, so this is a short walk
+    /// instead of hashing every corner.
+    first_shared: Vec<u32>,
+    shared: Vec<SharedVertex>,
 }
 
 impl GltfWriter {
@@ -243,7 +276,8 @@ impl GltfWriter {
             alpha_maps: Vec::new(),
             uses_transform: false,
             corner_vertex: Vec::new(),
-            dedup: FastMap::default(),
+            first_shared: Vec::new(),
+            shared: Vec::new(),
         })
     }
 
@@ -318,7 +352,7 @@ impl GltfWriter {
                 "opacity map '{opacity_map}' is not the colour map; glTF takes opacity from the colour map's alpha: written without it"
             ));
         }
-        let mut bucket = Bucket::default();
+        let mut bucket = Bucket::new();
         if !maps.is_empty() {
             // Textured: every vertex needs coordinates, set 0 first.
             bucket.sets.push(0);
@@ -346,12 +380,23 @@ impl GltfWriter {
     pub(crate) fn begin_mesh(&mut self, mesh: &Mesh) {
         self.corner_vertex.clear();
         self.corner_vertex.resize(mesh.corners.len(), 0);
-        self.dedup.clear();
+        self.first_shared.clear();
+        if mesh.normals.is_some() {
+            self.first_shared.resize(mesh.positions.len(), NO_ENTRY);
+        }
+        self.shared.clear();
     }
 
     pub(crate) fn add_face(&mut self, f: &FaceData) -> Result<(), ExportError> {
+        let GltfWriter {
+            buckets,
+            corner_vertex,
+            first_shared,
+            shared: made,
+            ..
+        } = self;
         let mesh = f.mesh;
-        let bucket = &mut self.buckets[f.material as usize];
+        let bucket = &mut buckets[f.material as usize];
         let uvs = mesh.uvs[0].as_deref();
         if uvs.is_some() && bucket.sets.is_empty() {
             bucket.sets.push(0);
@@ -364,42 +409,70 @@ impl GltfWriter {
             Some(_) => face_tangent(f),
             None => (DVec3::X, 1.0),
         };
-        for &l in mesh.face_loops(f.face) {
-            for c in mesh.loop_corners(l) {
-                let position = mesh.corners[c];
-                let p = mesh.positions[position as usize];
-                let vertex = match &mesh.normals {
-                    Some(normals) if shared => {
-                        let n = normals[c].try_normalize().unwrap_or(f.normal);
-                        let uv = uvs.map(|u| u[c]);
-                        let key = VertexKey {
-                            material: f.material,
-                            position,
-                            normal: n.as_vec3().to_array().map(f32::to_bits),
-                            uv: uv.map_or([0; 2], |t| t.as_vec2().to_array().map(f32::to_bits)),
-                        };
-                        match self.dedup.get(&key) {
-                            Some(&v) => v,
-                            None => {
-                                let v = bucket.push_vertex(p, n, mesh, c, tangent)?;
-                                self.dedup.insert(key, v);
-                                v
-                            }
+        // Where each written UV set reads: the mesh's set, else set 0.
+        let mut sources: [Option<&[DVec2]>; UV_SETS] = [None; UV_SETS];
+        for (src, &set) in sources.iter_mut().zip(&bucket.sets) {
+            *src = mesh.uvs[set].as_deref().or(uvs);
+        }
+        let sources = &sources[..bucket.sets.len()];
+        let loops = mesh.face_loops(f.face);
+        bucket.reserve(loops.iter().map(|l| l.len as usize).sum());
+        bucket.indices.reserve(3 * f.triangles.len());
+        let corners = || loops.iter().flat_map(|&l| mesh.loop_corners(l));
+        let positions = f.positions;
+        // One loop over the corners per case.
+        match f.normals {
+            Some(normals) if shared => {
+                for c in corners() {
+                    let position = mesh.corners[c] as usize;
+                    let n = normals[c].try_normalize().unwrap_or(f.normal);
+                    let uv = uvs.map_or([0; 2], |u| u[c].as_vec2().to_array().map(f32::to_bits));
+                    let key = VertexKey {
+                        material: f.material,
+                        normal: n.as_vec3().to_array().map(f32::to_bits),
+                        uv,
+                    };
+                    let mut e = first_shared[position];
+                    while e != NO_ENTRY {
+                        let s = &made[e as usize];
+                        if s.key == key {
+                            break;
                         }
+                        e = s.next;
                     }
-                    Some(normals) => {
-                        let n = normals[c].try_normalize().unwrap_or(f.normal);
-                        bucket.push_vertex(p, n, mesh, c, tangent)?
-                    }
-                    // Flat shading: each face has its own vertices.
-                    None => bucket.push_vertex(p, f.normal, mesh, c, tangent)?,
-                };
-                self.corner_vertex[c] = vertex;
+                    corner_vertex[c] = if e != NO_ENTRY {
+                        made[e as usize].vertex
+                    } else {
+                        let v = bucket.push_vertex(positions[position], n, sources, c, tangent)?;
+                        made.push(SharedVertex {
+                            key,
+                            vertex: v,
+                            next: first_shared[position],
+                        });
+                        first_shared[position] = made.len() as u32 - 1;
+                        v
+                    };
+                }
+            }
+            Some(normals) => {
+                for c in corners() {
+                    let p = positions[mesh.corners[c] as usize];
+                    let n = normals[c].try_normalize().unwrap_or(f.normal);
+                    corner_vertex[c] = bucket.push_vertex(p, n, sources, c, tangent)?;
+                }
+            }
+            // Flat shading: each face has its own vertices.
+            None => {
+                for c in corners() {
+                    let p = positions[mesh.corners[c] as usize];
+                    corner_vertex[c] = bucket.push_vertex(p, f.normal, sources, c, tangent)?;
+                }
             }
         }
-        let cv = &self.corner_vertex;
         for t in f.triangles {
-            bucket.indices.extend(t.iter().map(|&c| cv[c as usize]));
+            bucket
+                .indices
+                .extend(t.iter().map(|&c| corner_vertex[c as usize]));
         }
         Ok(())
     }
@@ -876,7 +949,9 @@ fn write_bin(
     path: &Path,
 ) -> Result<(), ExportError> {
     let io = |e| ExportError::io(path, e);
-    let mut scratch = vec![0u8; 1 << 14];
+    // Larger than the output buffer, so full chunks go to the file directly
+    // instead of being copied into the buffer first.
+    let mut scratch = vec![0u8; 1 << 18];
     for b in buckets.iter().filter(|b| !b.indices.is_empty()) {
         write_f32s(w, &b.positions, &mut scratch).map_err(io)?;
         write_f32s(w, &b.normals, &mut scratch).map_err(io)?;

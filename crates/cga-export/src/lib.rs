@@ -37,14 +37,16 @@ mod textures;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use cga_geometry::{DVec3, Material, Mesh};
+use cga_geometry::mesh::SharedVec;
+use cga_geometry::{DAffine3, DVec3, Material, Mesh};
 
 use crate::faces::{face_is_finite, face_normal};
+use crate::hash::FastMap;
 use crate::materials::MaterialTable;
 use crate::textures::Textures;
 
 /// The triangulation every writer uses.
-use cga_geometry::triangulate_face;
+use cga_geometry::triangulate::triangulate_face_at;
 
 /// Output file format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -161,6 +163,11 @@ impl std::error::Error for ExportError {
 /// computed once, by [`ModelWriter`], for every format.
 pub(crate) struct FaceData<'a> {
     pub mesh: &'a Mesh,
+    /// Where the mesh's vertices are placed (world coordinates): the mesh's
+    /// own positions, or the placed copies the writer made.
+    pub positions: &'a [DVec3],
+    /// The per-corner normals as placed, if the mesh has normals.
+    pub normals: Option<&'a [DVec3]>,
     pub face: usize,
     /// Output material id.
     pub material: u32,
@@ -187,12 +194,26 @@ pub struct ModelWriter {
     /// Output material id of each material slot of the mesh being added
     /// (`UNSEEN` until a face uses the slot).
     slot_ids: Vec<u32>,
+    /// The slot ids of material lists seen before, by the address of the
+    /// shared list (the entry holds a clone, so the address stays valid):
+    /// the many shapes that share a material list are looked up once, not
+    /// compared by value slot by slot.
+    known_slots: FastMap<usize, (SharedVec<Material>, Vec<u32>)>,
     triangles: Vec<[u32; 3]>,
+    /// Placed positions and normals of the mesh being added.
+    positions: Vec<DVec3>,
+    normals: Vec<DVec3>,
+    /// A placed copy of a mesh whose map mirrors it (its faces reversed).
+    mirrored: Mesh,
     stats: ExportStats,
     skipped_non_finite: u64,
 }
 
 const UNSEEN: u32 = u32::MAX;
+
+/// Entries of [`ModelWriter::known_slots`] above which it is emptied, so
+/// memory stays bounded on cities of distinct materials.
+const KNOWN_SLOTS_LIMIT: usize = 1 << 12;
 
 impl ModelWriter {
     /// Creates the output file (and, for glTF and OBJ, claims the names of
@@ -228,7 +249,11 @@ impl ModelWriter {
             textures,
             sink,
             slot_ids: Vec::new(),
+            known_slots: FastMap::default(),
             triangles: Vec::new(),
+            positions: Vec::new(),
+            normals: Vec::new(),
+            mirrored: Mesh::new(),
             stats: ExportStats::default(),
             skipped_non_finite: 0,
         })
@@ -238,52 +263,138 @@ impl ModelWriter {
     /// than 3 corners (edges, points) and faces of zero area are left out;
     /// faces with non-finite coordinates are left out with a warning.
     pub fn add_mesh(&mut self, mesh: &Mesh) -> Result<(), ExportError> {
-        check_mesh(mesh)?;
-        self.slot_ids.clear();
-        self.slot_ids.resize(mesh.materials.len(), UNSEEN);
+        self.add_placed(mesh, None, &mesh.materials)
+    }
+
+    /// Adds one shape's geometry given in its own coordinates, placed in the
+    /// world by `transform` (positions mapped by it, normals by its inverse
+    /// transpose, and faces reversed if it mirrors, exactly as
+    /// `cga_geometry::transform::transform` and `reverse_faces` would), with
+    /// `materials` for its material slots instead of the mesh's own. The
+    /// output is the same as adding the transformed mesh with those
+    /// materials, without copying it: shapes that share one mesh (inserted
+    /// assets, copies) are written from that one mesh.
+    pub fn add_placed(
+        &mut self,
+        mesh: &Mesh,
+        transform: Option<&DAffine3>,
+        materials: &SharedVec<Material>,
+    ) -> Result<(), ExportError> {
+        check_mesh(mesh, materials.len())?;
+        let mut positions = std::mem::take(&mut self.positions);
+        let mut normals = std::mem::take(&mut self.normals);
+        let mut mirrored = std::mem::take(&mut self.mirrored);
+        let view = match transform {
+            None => (mesh, &mesh.positions[..], mesh.normals.as_deref()),
+            Some(t) if t.matrix3.determinant() < 0.0 => {
+                mirrored.copy_from(mesh);
+                cga_geometry::transform::transform(&mut mirrored, t);
+                cga_geometry::transform::reverse_faces(&mut mirrored);
+                (
+                    &mirrored,
+                    &mirrored.positions[..],
+                    mirrored.normals.as_deref(),
+                )
+            }
+            Some(t) => {
+                positions.clear();
+                positions.extend(mesh.positions.iter().map(|&p| t.transform_point3(p)));
+                let n = mesh.normals.as_ref().map(|src| {
+                    let nm = cga_geometry::transform::normal_matrix(t);
+                    normals.clear();
+                    normals.extend(src.iter().map(|&n| (nm * n).normalize_or_zero()));
+                    &normals[..]
+                });
+                (mesh, &positions[..], n)
+            }
+        };
+        let result = self.add_view(view, materials);
+        self.positions = positions;
+        self.normals = normals;
+        self.mirrored = mirrored;
+        result
+    }
+
+    fn add_view(
+        &mut self,
+        (mesh, positions, normals): (&Mesh, &[DVec3], Option<&[DVec3]>),
+        materials: &SharedVec<Material>,
+    ) -> Result<(), ExportError> {
+        let key = materials.as_ptr() as usize;
+        match self.known_slots.get_mut(&key) {
+            Some((_, ids)) => std::mem::swap(&mut self.slot_ids, ids),
+            None => {
+                self.slot_ids.clear();
+                self.slot_ids.resize(materials.len(), UNSEEN);
+            }
+        }
         match &mut self.sink {
             Sink::Gltf(w) => w.begin_mesh(mesh),
             Sink::Obj(w) => w.begin_mesh(mesh),
         }
+        // Most meshes are finite throughout: then no face needs the check.
+        let all_finite = positions.iter().all(|p| p.is_finite())
+            && mesh.uvs[0]
+                .as_ref()
+                .is_none_or(|u| u.iter().all(|t| t.is_finite()))
+            && normals.is_none_or(|n| n.iter().all(|v| v.is_finite()));
+        let mut result = Ok(());
         for face in 0..mesh.faces.len() {
             if mesh.outer_loop(face).len < 3 {
                 continue;
             }
-            if !face_is_finite(mesh, face) {
+            if !all_finite && !face_is_finite(mesh, positions, normals, face) {
                 self.skipped_non_finite += 1;
                 continue;
             }
             self.triangles.clear();
-            triangulate_face(mesh, face, &mut self.triangles);
+            triangulate_face_at(mesh, positions, face, &mut self.triangles);
             if self.triangles.is_empty() {
                 continue;
             }
             // No normal means zero area: nothing to see, and no valid normal
             // to write.
-            let Some(normal) =
-                face_normal(mesh, face).or_else(|| triangles_normal(mesh, &self.triangles))
+            let Some(normal) = face_normal(mesh, positions, face)
+                .or_else(|| triangles_normal(mesh, positions, &self.triangles))
             else {
                 continue;
             };
             let slot = mesh.faces[face].material as usize;
             if self.slot_ids[slot] == UNSEEN {
-                self.slot_ids[slot] = self.intern(&mesh.materials[slot]);
+                self.slot_ids[slot] = self.intern(&materials[slot]);
             }
             let data = FaceData {
                 mesh,
+                positions,
+                normals,
                 face,
                 material: self.slot_ids[slot],
                 normal,
                 triangles: &self.triangles,
             };
-            match &mut self.sink {
-                Sink::Gltf(w) => w.add_face(&data)?,
-                Sink::Obj(w) => w.add_face(&data)?,
+            result = match &mut self.sink {
+                Sink::Gltf(w) => w.add_face(&data),
+                Sink::Obj(w) => w.add_face(&data),
+            };
+            if result.is_err() {
+                break;
             }
             self.stats.faces += 1;
             self.stats.triangles += self.triangles.len() as u64;
         }
-        Ok(())
+        // Remember the slot ids of this material list for the next mesh
+        // that shares it.
+        match self.known_slots.get_mut(&key) {
+            Some((_, ids)) => std::mem::swap(&mut self.slot_ids, ids),
+            None => {
+                if self.known_slots.len() >= KNOWN_SLOTS_LIMIT {
+                    self.known_slots.clear();
+                }
+                self.known_slots
+                    .insert(key, (materials.clone(), self.slot_ids.clone()));
+            }
+        }
+        result
     }
 
     fn intern(&mut self, material: &Material) -> u32 {
@@ -316,8 +427,8 @@ impl ModelWriter {
 
 /// Area-weighted normal of triangles, for faces whose outer loop alone is
 /// degenerate.
-fn triangles_normal(mesh: &Mesh, triangles: &[[u32; 3]]) -> Option<DVec3> {
-    let p = |c: u32| mesh.positions[mesh.corners[c as usize] as usize];
+fn triangles_normal(mesh: &Mesh, positions: &[DVec3], triangles: &[[u32; 3]]) -> Option<DVec3> {
+    let p = |c: u32| positions[mesh.corners[c as usize] as usize];
     let n: DVec3 = triangles
         .iter()
         .map(|&[a, b, c]| (p(b) - p(a)).cross(p(c) - p(a)))
@@ -326,7 +437,7 @@ fn triangles_normal(mesh: &Mesh, triangles: &[[u32; 3]]) -> Option<DVec3> {
 }
 
 /// Rejects meshes whose indices would make a writer read out of bounds.
-fn check_mesh(mesh: &Mesh) -> Result<(), ExportError> {
+fn check_mesh(mesh: &Mesh, material_slots: usize) -> Result<(), ExportError> {
     let bad = |msg: String| Err(ExportError::InvalidMesh(msg));
     let corners = mesh.corners.len();
     if let Some(c) = mesh
@@ -365,13 +476,155 @@ fn check_mesh(mesh: &Mesh) -> Result<(), ExportError> {
         {
             return bad(format!("face {i} has loops out of range"));
         }
-        if f.material as usize >= mesh.materials.len() {
+        if f.material as usize >= material_slots {
             return bad(format!(
-                "face {i} uses material slot {} of {}",
+                "face {i} uses material slot {} of {material_slots}",
                 f.material,
-                mesh.materials.len()
             ));
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cga_geometry::{DMat3, DVec2, TextureChannel};
+
+    /// A mesh with a quad, a concave pentagon and a square with a hole,
+    /// per-corner normals on one face's worth of corners and two UV sets.
+    fn sample() -> Mesh {
+        let mut m = Mesh::new();
+        let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+        m.positions.extend([
+            p(0., 0., 0.),
+            p(2., 0., 0.),
+            p(2., 1., 0.),
+            p(0., 1., 0.),
+            p(3., 0., 0.),
+            p(5., 0., 0.),
+            p(5., 2., 0.),
+            p(4., 0.5, 0.),
+            p(3., 2., 0.),
+            p(6., 0., 1.),
+            p(10., 0., 1.),
+            p(10., 4., 1.),
+            p(6., 4., 1.),
+            p(7., 1., 1.),
+            p(7., 3., 1.),
+            p(9., 3., 1.),
+            p(9., 1., 1.),
+        ]);
+        m.add_face(&[&[0, 1, 2, 3]], 0);
+        m.add_face(&[&[4, 5, 6, 7, 8]], 1);
+        m.add_face(&[&[9, 10, 11, 12], &[13, 14, 15, 16]], 0);
+        let n = m.corners.len();
+        m.uvs[0] = Some(
+            (0..n)
+                .map(|i| DVec2::new(i as f64 * 0.25, 1.0 - i as f64 * 0.125))
+                .collect(),
+        );
+        m.uvs[5] = Some((0..n).map(|i| DVec2::new(0.5, i as f64)).collect());
+        m.normals = Some(
+            (0..n)
+                .map(|i| DVec3::new(0.1 * i as f64, 0.0, 1.0))
+                .collect(),
+        );
+        let brick = Material {
+            maps: std::array::from_fn(|k| TextureChannel {
+                path: if k == 0 {
+                    "missing.png".into()
+                } else {
+                    "".into()
+                },
+                ..TextureChannel::default()
+            }),
+            ..Material::default()
+        };
+        m.materials = vec![
+            brick,
+            Material {
+                color: [0.2, 0.4, 0.6],
+                ..Material::default()
+            },
+        ]
+        .into();
+        m
+    }
+
+    fn written(format: Format, name: &str, add: impl Fn(&mut ModelWriter)) -> Vec<u8> {
+        // One name in separate folders: OBJ files name their MTL file.
+        let dir = std::env::temp_dir().join(format!("cga-export-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let ext = if format == Format::Obj { "obj" } else { "glb" };
+        let path = dir.join(format!("model.{ext}"));
+        let mut w = ModelWriter::create(&path, format, ExportOptions::default()).unwrap();
+        add(&mut w);
+        w.finish().unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let _ = std::fs::remove_dir_all(&dir);
+        bytes
+    }
+
+    #[test]
+    fn placing_writes_what_the_transformed_mesh_writes() {
+        let mesh = sample();
+        let other: SharedVec<Material> = vec![
+            Material {
+                color: [0.9, 0.1, 0.1],
+                ..Material::default()
+            },
+            Material {
+                opacity: 0.5,
+                ..Material::default()
+            },
+        ]
+        .into();
+        let turn = DMat3::from_rotation_y(0.7) * DMat3::from_diagonal(DVec3::new(1.5, 0.5, 2.0));
+        for (k, t) in [
+            DAffine3::from_mat3_translation(turn, DVec3::new(100.0, -3.0, 7.5)),
+            // Mirrored: the faces must come out reversed.
+            DAffine3::from_mat3_translation(
+                DMat3::from_diagonal(DVec3::new(-1.0, 1.0, 1.0)) * turn,
+                DVec3::new(-4.0, 2.0, 0.25),
+            ),
+        ]
+        .iter()
+        .enumerate()
+        {
+            for format in [Format::Glb, Format::Obj] {
+                let baked = written(format, &format!("baked{k}"), |w| {
+                    let mut m = mesh.clone();
+                    cga_geometry::transform::transform(&mut m, t);
+                    if t.matrix3.determinant() < 0.0 {
+                        cga_geometry::transform::reverse_faces(&mut m);
+                    }
+                    w.add_mesh(&m).unwrap();
+                    m.materials = other.clone();
+                    w.add_mesh(&m).unwrap();
+                });
+                let placed = written(format, &format!("placed{k}"), |w| {
+                    w.add_placed(&mesh, Some(t), &mesh.materials).unwrap();
+                    w.add_placed(&mesh, Some(t), &other).unwrap();
+                });
+                assert!(baked.len() > 1000);
+                assert!(baked == placed, "transform {k}, {format:?}: outputs differ");
+            }
+        }
+    }
+
+    #[test]
+    fn placing_checks_the_material_slots_given() {
+        let dir = std::env::temp_dir().join(format!("cga-export-slots-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("x.glb");
+        let mut w = ModelWriter::create(&path, Format::Glb, ExportOptions::default()).unwrap();
+        let mesh = sample();
+        let one: SharedVec<Material> = vec![Material::default()].into();
+        let r = w.add_placed(&mesh, Some(&DAffine3::IDENTITY), &one);
+        assert!(
+            matches!(r, Err(ExportError::InvalidMesh(m)) if m.contains("material slot 1 of 1"))
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

@@ -153,7 +153,7 @@ impl ObjWriter {
                 let position = mesh.corners[c] as usize;
                 let mut v = self.position_v[position];
                 if v == 0 {
-                    let p = mesh.positions[position];
+                    let p = f.positions[position];
                     v = next(&mut self.v_count)?;
                     self.position_v[position] = v;
                     write_line(&mut self.out, &mut self.line, "v", &[p.x, p.y, p.z])
@@ -176,7 +176,7 @@ impl ObjWriter {
                         }
                     }
                 };
-                let n = match &mesh.normals {
+                let n = match f.normals {
                     Some(normals) => normals[c].try_normalize().unwrap_or(f.normal),
                     None => f.normal,
                 };

@@ -16,17 +16,21 @@ use crate::triangulate::triangulate_face;
 /// loop's normal (counter-clockwise), its length twice the enclosed area.
 /// Exact for planar polygons, concave or not; a best-fit normal otherwise.
 pub fn loop_newell(mesh: &Mesh, l: Loop) -> DVec3 {
-    let idx = mesh.loop_indices(l);
+    newell(&mesh.positions, mesh.loop_indices(l))
+}
+
+/// [`loop_newell`] of the polygon through `positions[i]` for `i` in `idx`.
+pub fn newell(positions: &[DVec3], idx: &[u32]) -> DVec3 {
     let n = idx.len();
     let mut acc = DVec3::ZERO;
     if n < 3 {
         return acc;
     }
     // Relative to the first point, to keep precision for far-away geometry.
-    let o = mesh.positions[idx[0] as usize];
-    let mut prev = mesh.positions[idx[n - 1] as usize] - o;
+    let o = positions[idx[0] as usize];
+    let mut prev = positions[idx[n - 1] as usize] - o;
     for &i in idx {
-        let p = mesh.positions[i as usize] - o;
+        let p = positions[i as usize] - o;
         acc += prev.cross(p);
         prev = p;
     }
@@ -36,7 +40,13 @@ pub fn loop_newell(mesh: &Mesh, l: Loop) -> DVec3 {
 /// The unit normal of a face (Newell normal of its outer loop), or zero for
 /// faces without area (edge and vertex shapes, collapsed polygons).
 pub fn face_normal(mesh: &Mesh, face: usize) -> DVec3 {
-    let v = loop_newell(mesh, mesh.outer_loop(face));
+    face_normal_at(mesh, &mesh.positions, face)
+}
+
+/// [`face_normal`] with the mesh's vertices at `positions` instead of its
+/// own (the same mesh moved, as the exporter places a shape's geometry).
+pub fn face_normal_at(mesh: &Mesh, positions: &[DVec3], face: usize) -> DVec3 {
+    let v = newell(positions, mesh.loop_indices(mesh.outer_loop(face)));
     let len = v.length();
     if len > 0.0 && len.is_finite() {
         v / len

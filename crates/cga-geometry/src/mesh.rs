@@ -9,6 +9,8 @@
 //! - `faces`: ranges of `loops`, each with a material slot and a group;
 //! - `uvs[k]`, `normals`: per-corner attributes aligned with `corners`.
 
+use std::sync::{Arc, LazyLock};
+
 use glam::{DVec2, DVec3};
 
 use crate::material::Material;
@@ -45,10 +47,155 @@ pub struct Mesh {
     pub uvs: [Option<Vec<DVec2>>; UV_SETS],
     /// Per-corner normals, if the geometry carries its own (assets, `setNormals`).
     pub normals: Option<Vec<DVec3>>,
-    /// Material slots referenced by `Face::material`; never empty.
-    pub materials: Vec<Material>,
+    /// Material slots referenced by `Face::material`; never empty. Shared
+    /// between the meshes cut, extruded or copied from one another.
+    pub materials: SharedVec<Material>,
     /// Group names referenced by `Face::group` (OBJ `g`); never empty.
-    pub groups: Vec<String>,
+    pub groups: SharedVec<String>,
+}
+
+/// A vector shared between meshes until one of them changes it (copy on
+/// write). Every piece of a cut, every extrusion and every copy of a mesh
+/// keeps the material slots and groups of its source: sharing them makes
+/// those copies one reference count each instead of an allocation and a
+/// deep copy of every material, and lets the exporter recognise material
+/// lists it has seen by their address.
+///
+/// Reads go through `Deref` to a slice (`m.materials[0]`, `.iter()`,
+/// `.len()`); writes (`m.materials[0] = x`, `.push(x)`, `iter_mut()`) copy
+/// the vector first if another mesh shares it.
+#[derive(Debug, PartialEq)]
+pub struct SharedVec<T>(Arc<Vec<T>>);
+
+impl<T> Clone for SharedVec<T> {
+    fn clone(&self) -> Self {
+        SharedVec(self.0.clone())
+    }
+}
+
+impl<T> Default for SharedVec<T> {
+    fn default() -> Self {
+        SharedVec(Arc::new(Vec::new()))
+    }
+}
+
+impl<T: Clone> SharedVec<T> {
+    /// The vector for writing (copied first if shared).
+    pub fn make_mut(&mut self) -> &mut Vec<T> {
+        Arc::make_mut(&mut self.0)
+    }
+
+    pub fn push(&mut self, value: T) {
+        self.make_mut().push(value);
+    }
+
+    pub fn clear(&mut self) {
+        if !self.0.is_empty() {
+            match Arc::get_mut(&mut self.0) {
+                Some(v) => v.clear(),
+                None => *self = SharedVec::default(),
+            }
+        }
+    }
+
+    pub fn truncate(&mut self, len: usize) {
+        if len < self.0.len() {
+            self.make_mut().truncate(len);
+        }
+    }
+
+    pub fn retain(&mut self, keep: impl FnMut(&T) -> bool) {
+        self.make_mut().retain(keep);
+    }
+
+    /// The elements as an owned vector.
+    pub fn into_vec(self) -> Vec<T> {
+        Arc::try_unwrap(self.0).unwrap_or_else(|shared| (*shared).clone())
+    }
+}
+
+impl<T> SharedVec<T> {
+    /// Whether both share one vector (then they are equal without comparing).
+    pub fn ptr_eq(a: &SharedVec<T>, b: &SharedVec<T>) -> bool {
+        Arc::ptr_eq(&a.0, &b.0)
+    }
+
+    /// The address of the shared vector: an identity for caches (valid while
+    /// this value, or a clone of it, lives).
+    pub fn as_ptr(&self) -> *const Vec<T> {
+        Arc::as_ptr(&self.0)
+    }
+
+    pub fn as_slice(&self) -> &[T] {
+        &self.0
+    }
+}
+
+impl<T> std::ops::Deref for SharedVec<T> {
+    type Target = [T];
+    fn deref(&self) -> &[T] {
+        &self.0
+    }
+}
+
+impl<T: Clone> std::ops::DerefMut for SharedVec<T> {
+    fn deref_mut(&mut self) -> &mut [T] {
+        self.make_mut()
+    }
+}
+
+impl<T> From<Vec<T>> for SharedVec<T> {
+    fn from(v: Vec<T>) -> Self {
+        SharedVec(Arc::new(v))
+    }
+}
+
+impl<T> FromIterator<T> for SharedVec<T> {
+    fn from_iter<I: IntoIterator<Item = T>>(iter: I) -> Self {
+        SharedVec(Arc::new(iter.into_iter().collect()))
+    }
+}
+
+impl<T: Clone> Extend<T> for SharedVec<T> {
+    fn extend<I: IntoIterator<Item = T>>(&mut self, iter: I) {
+        self.make_mut().extend(iter);
+    }
+}
+
+impl<'a, T> IntoIterator for &'a SharedVec<T> {
+    type Item = &'a T;
+    type IntoIter = std::slice::Iter<'a, T>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.0.iter()
+    }
+}
+
+impl<'a, T: Clone> IntoIterator for &'a mut SharedVec<T> {
+    type Item = &'a mut T;
+    type IntoIter = std::slice::IterMut<'a, T>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.make_mut().iter_mut()
+    }
+}
+
+impl<T: PartialEq> PartialEq<Vec<T>> for SharedVec<T> {
+    fn eq(&self, other: &Vec<T>) -> bool {
+        *self.0 == *other
+    }
+}
+
+impl<T: PartialEq> PartialEq<[T]> for SharedVec<T> {
+    fn eq(&self, other: &[T]) -> bool {
+        self.0.as_slice() == other
+    }
+}
+
+/// The material slots and groups of a new mesh (one default material, one
+/// unnamed group), made once and shared by every mesh that has them.
+fn default_slots() -> (SharedVec<Material>, SharedVec<String>) {
+    static SLOTS: LazyLock<(SharedVec<Material>, SharedVec<String>)> =
+        LazyLock::new(|| (vec![Material::default()].into(), vec![String::new()].into()));
+    (SLOTS.0.clone(), SLOTS.1.clone())
 }
 
 impl Default for Mesh {
@@ -60,6 +207,7 @@ impl Default for Mesh {
 impl Mesh {
     /// An empty mesh with one default material slot and one unnamed group.
     pub fn new() -> Mesh {
+        let (materials, groups) = default_slots();
         Mesh {
             positions: Vec::new(),
             corners: Vec::new(),
@@ -67,9 +215,48 @@ impl Mesh {
             faces: Vec::new(),
             uvs: Default::default(),
             normals: None,
-            materials: vec![Material::default()],
-            groups: vec![String::new()],
+            materials,
+            groups,
         }
+    }
+
+    /// Room for `corners` more corners (and as many positions, a loop and
+    /// a face per four corners) in the arrays, and in the per-corner
+    /// attributes the mesh has.
+    pub fn reserve(&mut self, corners: usize) {
+        self.positions.reserve(corners);
+        self.corners.reserve(corners);
+        self.loops.reserve(corners.div_ceil(4));
+        self.faces.reserve(corners.div_ceil(4));
+        for set in self.uvs.iter_mut().flatten() {
+            set.reserve(corners);
+        }
+        if let Some(n) = &mut self.normals {
+            n.reserve(corners);
+        }
+    }
+
+    /// Makes `self` a copy of `src`, reusing `self`'s allocations (a
+    /// scratch mesh refilled for every shape costs no allocation).
+    pub fn copy_from(&mut self, src: &Mesh) {
+        self.positions.clone_from(&src.positions);
+        self.corners.clone_from(&src.corners);
+        self.loops.clone_from(&src.loops);
+        self.faces.clone_from(&src.faces);
+        for (d, s) in self.uvs.iter_mut().zip(&src.uvs) {
+            match (d.as_mut(), s) {
+                (Some(d), Some(s)) => d.clone_from(s),
+                (_, None) => *d = None,
+                (None, Some(s)) => *d = Some(s.clone()),
+            }
+        }
+        match (self.normals.as_mut(), &src.normals) {
+            (Some(d), Some(s)) => d.clone_from(s),
+            (_, None) => self.normals = None,
+            (None, Some(s)) => self.normals = Some(s.clone()),
+        }
+        self.materials = src.materials.clone();
+        self.groups = src.groups.clone();
     }
 
     /// A mesh of one polygon face (no holes) through `points` in order.
@@ -153,6 +340,54 @@ impl Mesh {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn shared_slots_copy_on_write() {
+        let a = Mesh::new();
+        let mut b = Mesh::new();
+        // New meshes share one default slot list.
+        assert!(SharedVec::ptr_eq(&a.materials, &b.materials));
+        assert!(SharedVec::ptr_eq(&a.groups, &b.groups));
+        let red = Material {
+            color: [1.0, 0.0, 0.0],
+            ..Material::default()
+        };
+        b.materials.push(red.clone());
+        b.materials[0].opacity = 0.5;
+        // `a` and every other new mesh keep the defaults.
+        assert_eq!(a.materials, vec![Material::default()]);
+        assert_eq!(Mesh::new().materials.len(), 1);
+        assert_eq!(b.materials.len(), 2);
+        assert_eq!(b.materials[0].opacity, 0.5);
+        assert_eq!(b.materials[1], red);
+        let c = b.clone();
+        assert!(SharedVec::ptr_eq(&b.materials, &c.materials));
+        let mut d = c.clone();
+        for m in &mut d.materials {
+            m.shininess = 7.0;
+        }
+        assert_eq!(c.materials[1].shininess, 1.0);
+        assert_eq!(d.materials[1].shininess, 7.0);
+        d.materials.clear();
+        assert!(d.materials.is_empty());
+        assert_eq!(c.materials.len(), 2);
+        assert_eq!(d.groups.clone().into_vec(), vec![String::new()]);
+    }
+
+    #[test]
+    fn copy_from_equals_clone() {
+        let mut src = Mesh::polygon(&[DVec3::ZERO, DVec3::X, DVec3::new(1.0, 0.0, -1.0)]);
+        src.uvs[2] = Some(vec![DVec2::new(0.5, 1.0); 3]);
+        src.normals = Some(vec![DVec3::Y; 3]);
+        // A scratch mesh with other attribute sets and larger buffers.
+        let mut dst = Mesh::polygon(&[DVec3::ONE; 5]);
+        dst.uvs[0] = Some(vec![DVec2::ONE; 5]);
+        dst.copy_from(&src);
+        assert_eq!(dst, src);
+        let plain = Mesh::polygon(&[DVec3::ZERO, DVec3::Y, DVec3::Z]);
+        dst.copy_from(&plain);
+        assert_eq!(dst, plain);
+    }
 
     #[test]
     fn polygon_has_one_face_one_loop() {

@@ -17,8 +17,9 @@ use crate::mesh::Mesh;
 /// A fast non-cryptographic hasher (the multiply-rotate scheme of rustc's
 /// `FxHasher`) for the integer keys of the geometry maps, which SipHash
 /// would make several times slower. Keys are not attacker-controlled.
+/// Also used by the interpreter's caches.
 #[derive(Default, Clone, Copy)]
-pub(crate) struct FxHasher(u64);
+pub struct FxHasher(u64);
 
 impl Hasher for FxHasher {
     #[inline]
@@ -52,9 +53,9 @@ impl Hasher for FxHasher {
 }
 
 /// A `HashMap` with [`FxHasher`].
-pub(crate) type FxHashMap<K, V> = HashMap<K, V, BuildHasherDefault<FxHasher>>;
+pub type FxHashMap<K, V> = HashMap<K, V, BuildHasherDefault<FxHasher>>;
 
-pub(crate) fn fx_map<K, V>(capacity: usize) -> FxHashMap<K, V> {
+pub fn fx_map<K, V>(capacity: usize) -> FxHashMap<K, V> {
     FxHashMap::with_capacity_and_hasher(capacity, Default::default())
 }
 

@@ -1,6 +1,6 @@
 //! Moving meshes between frames, reversing faces, and merging meshes.
 
-use glam::{DAffine3, DVec2, DVec3};
+use glam::{DAffine3, DMat3, DVec2, DVec3};
 
 use crate::mesh::{Face, Mesh};
 
@@ -13,15 +13,21 @@ pub fn transform(mesh: &mut Mesh, m: &DAffine3) {
         *p = m.transform_point3(*p);
     }
     if let Some(normals) = &mut mesh.normals {
-        let lin = m.matrix3;
-        let nm = if lin.determinant().abs() > 0.0 {
-            lin.inverse().transpose()
-        } else {
-            lin
-        };
+        let nm = normal_matrix(m);
         for n in normals {
             *n = (nm * *n).normalize_or_zero();
         }
+    }
+}
+
+/// The matrix [`transform`] maps normals with (before renormalising): the
+/// inverse transpose of `m`'s linear part, or that part itself if singular.
+pub fn normal_matrix(m: &DAffine3) -> DMat3 {
+    let lin = m.matrix3;
+    if lin.determinant().abs() > 0.0 {
+        lin.inverse().transpose()
+    } else {
+        lin
     }
 }
 
@@ -29,8 +35,8 @@ pub fn transform(mesh: &mut Mesh, m: &DAffine3) {
 /// first (`c0 cn-1 .. c1`), with its per-corner attributes; per-corner
 /// normals are negated.
 pub fn reverse_faces(mesh: &mut Mesh) {
-    for l in mesh.loops.clone() {
-        let r = mesh.loop_corners(l);
+    for i in 0..mesh.loops.len() {
+        let r = mesh.loop_corners(mesh.loops[i]);
         if r.len() < 3 {
             continue;
         }
@@ -203,9 +209,9 @@ mod tests {
             color: [1.0, 0.0, 0.0],
             ..Material::default()
         };
-        b.materials = vec![Material::default(), red.clone()];
+        b.materials = vec![Material::default(), red.clone()].into();
         b.faces[1].material = 1;
-        b.groups = vec![String::new(), "roof".into()];
+        b.groups = vec![String::new(), "roof".into()].into();
         b.faces[1].group = 1;
         b.uvs[2] = Some(vec![DVec2::ONE; b.corners.len()]);
         merge(&mut a, &b);

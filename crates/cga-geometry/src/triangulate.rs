@@ -56,6 +56,13 @@ pub fn plane_basis(n: DVec3) -> (DVec3, DVec3) {
 /// to. Faces with loops of fewer than three corners (edge and vertex shapes)
 /// and faces of zero area give no triangles.
 pub fn triangulate_face(mesh: &Mesh, face: usize, out: &mut Vec<[u32; 3]>) {
+    triangulate_face_at(mesh, &mesh.positions, face, out)
+}
+
+/// [`triangulate_face`] with the mesh's vertices at `positions` instead of
+/// its own (the exporter triangulates a shape's geometry where it places
+/// it, without copying the mesh).
+pub fn triangulate_face_at(mesh: &Mesh, positions: &[DVec3], face: usize, out: &mut Vec<[u32; 3]>) {
     let Some(f) = mesh.faces.get(face) else {
         return;
     };
@@ -64,22 +71,22 @@ pub fn triangulate_face(mesh: &Mesh, face: usize, out: &mut Vec<[u32; 3]>) {
     if outer.len < 3 {
         return;
     }
-    let n = crate::measure::face_normal(mesh, face);
+    let n = crate::measure::face_normal_at(mesh, positions, face);
     if n == DVec3::ZERO {
         return;
     }
-    let (u, v) = plane_basis(n);
-    let project = |c: usize| {
-        let p = mesh.positions[mesh.corners[c] as usize];
-        DVec2::new(p.dot(u), p.dot(v))
-    };
     let s = outer.start;
-
-    // Fast paths for the overwhelmingly common triangles and quads.
+    // Fast paths for the overwhelmingly common triangles and quads (a
+    // triangle needs no projection).
     if f.loop_count == 1 && outer.len == 3 {
         out.push([s, s + 1, s + 2]);
         return;
     }
+    let (u, v) = plane_basis(n);
+    let project = |c: usize| {
+        let p = positions[mesh.corners[c] as usize];
+        DVec2::new(p.dot(u), p.dot(v))
+    };
     if f.loop_count == 1 && outer.len == 4 {
         let q = [0, 1, 2, 3].map(|i| project((s + i) as usize));
         let area = |a: DVec2, b: DVec2, c: DVec2| (b - a).perp_dot(c - a);

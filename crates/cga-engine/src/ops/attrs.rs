@@ -6,7 +6,7 @@ use std::sync::Arc;
 use cga_value::Value;
 
 use super::{Op, SetTarget};
-use crate::derive::{Arg, Interp, RtError, ShapeState};
+use crate::derive::{Arg, Interp, MaterialEdit, RtError, ShapeState};
 use crate::expr::OpCall;
 use crate::material_attr::{parse_hex_color, MatField, MaterialOverrides};
 use crate::shape::{euler_to_mat, Shape};
@@ -21,11 +21,14 @@ pub fn exec(
 ) -> Result<(), RtError> {
     let shape = &mut st.shape;
     match call.op {
-        Op::Color => {
-            let m = Arc::make_mut(&mut shape.material);
-            match args {
-                [hex] => {
-                    let s = hex.text()?;
+        Op::Color => match args {
+            [hex] => {
+                let s = hex.text()?;
+                let edit = MaterialEdit::ColorHex(match &hex.value {
+                    Value::Str(s) => s.clone(),
+                    _ => Arc::from(s),
+                });
+                cx.edit_material(shape, edit, |_, m| {
                     let (rgb, o) = parse_hex_color(s).ok_or_else(|| {
                         RtError::new(
                             format!(
@@ -40,23 +43,35 @@ pub fn exec(
                     if let Some(o) = o {
                         set_field(m, MatField::Opacity, &Value::Float(o), hex)?;
                     }
+                    Ok(())
+                })?;
+            }
+            [r, g, b, rest @ ..] => {
+                let mut key = [0u64; 4];
+                let given = [Some(r), Some(g), Some(b), rest.first()];
+                for (k, a) in key.iter_mut().zip(given) {
+                    if let Some(a) = a {
+                        *k = a.num()?.to_bits();
+                    }
                 }
-                [r, g, b, rest @ ..] => {
+                let edit = MaterialEdit::Color(key, 3 + rest.len().min(1));
+                cx.edit_material(shape, edit, |_, m| {
                     for (i, a) in [r, g, b].into_iter().enumerate() {
                         set_field(m, MatField::Color(i as u8), &Value::Float(a.num()?), a)?;
                     }
                     if let Some(o) = rest.first() {
                         set_field(m, MatField::Opacity, &Value::Float(o.num()?), o)?;
                     }
-                }
-                _ => {
-                    return Err(RtError::new(
-                        "`color` takes a \"#rrggbb\" string or 3 or 4 numbers",
-                        call.span,
-                    ))
-                }
+                    Ok(())
+                })?;
             }
-        }
+            _ => {
+                return Err(RtError::new(
+                    "`color` takes a \"#rrggbb\" string or 3 or 4 numbers",
+                    call.span,
+                ))
+            }
+        },
         Op::Set(target) => set(cx, shape, target, &args[0])?,
         Op::SetMaterial => {
             let pairs: Vec<Arc<str>> = match &args[0].value {
@@ -90,11 +105,9 @@ pub fn exec(
                 shape.material = Arc::new(MaterialOverrides::default());
             }
             if target != "shape" {
-                let mut mesh = (**shape.geometry.local()).clone();
-                for m in &mut mesh.materials {
+                for m in &mut shape.geometry.local_mut().materials {
                     *m = cga_geometry::Material::default();
                 }
-                shape.set_local_mesh(mesh);
             }
         }
         Op::Print => cx.out.prints.push(to_text(&args[0].value)),
@@ -150,9 +163,13 @@ fn set(cx: &mut Interp, shape: &mut Shape, target: SetTarget, arg: &Arg) -> Resu
             shape.set_attr(id, v.clone());
         }
         SetTarget::Shape(f) => match f {
-            ShapeFn::Material(field) => {
-                set_field(Arc::make_mut(&mut shape.material), field, v, arg)?
-            }
+            ShapeFn::Material(field) => match v {
+                Value::Float(_) | Value::Bool(_) | Value::Str(_) => {
+                    let edit = MaterialEdit::Field(field, v.clone());
+                    cx.edit_material(shape, edit, |_, m| set_field(m, field, v, arg))?
+                }
+                _ => set_field(Arc::make_mut(&mut shape.material), field, v, arg)?,
+            },
             ShapeFn::TrimHorizontal => shape.trim.horizontal = arg.boolean()?,
             ShapeFn::TrimVertical => shape.trim.vertical = arg.boolean()?,
             ShapeFn::Seedian => {

@@ -40,7 +40,7 @@
 
 use std::sync::Arc;
 
-use cga_geometry::mesh::{Face, Loop};
+use cga_geometry::mesh::{Face, Loop, SharedVec};
 use cga_geometry::{measure, DMat3, DVec3, Mesh, Topology};
 use cga_syntax::ast::{BinaryOp, BlockOp};
 use cga_syntax::Span;
@@ -620,6 +620,22 @@ impl Components {
             Align::NoAlign => (DVec3::ZERO, DMat3::IDENTITY),
         };
         let mut mesh = self.builder.begin(&self.mesh, self.kind);
+        // Room for the corners of the faces taken (edges and vertices are a
+        // corner or two), so the component's arrays are allocated once.
+        let corners: usize = set
+            .iter()
+            .map(|&k| match self.items[k as usize] {
+                Item::Faces { start, len } => self.face_list
+                    [start as usize..(start + len) as usize]
+                    .iter()
+                    .flat_map(|&f| self.mesh.face_loops(f as usize))
+                    .map(|l| l.len as usize)
+                    .sum(),
+                Item::Hole { lp, .. } => self.mesh.loops[lp as usize].len as usize,
+                _ => 2,
+            })
+            .sum();
+        mesh.reserve(corners);
         for &k in set {
             let item = self.items[k as usize];
             self.add_item(&mut mesh, item, upward);
@@ -1026,6 +1042,10 @@ struct MeshBuilder {
     touched: Vec<u32>,
     mat_remap: Vec<u32>,
     group_remap: Vec<u32>,
+    /// The source slots the component uses, in order of first use: its
+    /// material slots and groups (see `finish`).
+    used_mats: Vec<u32>,
+    used_groups: Vec<u32>,
     /// Edge and vertex components carry their normal on their corners.
     force_normals: bool,
 }
@@ -1037,14 +1057,15 @@ impl MeshBuilder {
             touched: Vec::new(),
             mat_remap: vec![u32::MAX; src.materials.len()],
             group_remap: vec![u32::MAX; src.groups.len()],
+            used_mats: Vec::new(),
+            used_groups: Vec::new(),
             force_normals: false,
         }
     }
 
     fn begin(&mut self, src: &Mesh, kind: Kind) -> Mesh {
+        // Material slots and groups are set by `finish`.
         let mut m = Mesh::new();
-        m.materials.clear();
-        m.groups.clear();
         for (dst, s) in m.uvs.iter_mut().zip(&src.uvs) {
             if s.is_some() {
                 *dst = Some(Vec::new());
@@ -1070,17 +1091,17 @@ impl MeshBuilder {
         *slot
     }
 
-    fn slots(&mut self, src: &Mesh, out: &mut Mesh, face: usize) -> (u32, u32) {
+    fn slots(&mut self, src: &Mesh, face: usize) -> (u32, u32) {
         let f = src.faces[face];
         let m = f.material as usize;
         if self.mat_remap.get(m) == Some(&u32::MAX) {
-            self.mat_remap[m] = out.materials.len() as u32;
-            out.materials.push(src.materials[m].clone());
+            self.mat_remap[m] = self.used_mats.len() as u32;
+            self.used_mats.push(m as u32);
         }
         let g = f.group as usize;
         if self.group_remap.get(g) == Some(&u32::MAX) {
-            self.group_remap[g] = out.groups.len() as u32;
-            out.groups.push(src.groups[g].clone());
+            self.group_remap[g] = self.used_groups.len() as u32;
+            self.used_groups.push(g as u32);
         }
         (
             self.mat_remap.get(m).copied().unwrap_or(0),
@@ -1107,7 +1128,7 @@ impl MeshBuilder {
     }
 
     fn add_face(&mut self, src: &Mesh, out: &mut Mesh, face: usize) {
-        let (material, group) = self.slots(src, out, face);
+        let (material, group) = self.slots(src, face);
         let first_loop = out.loops.len() as u32;
         let loops = src.face_loops(face);
         for &l in loops {
@@ -1128,7 +1149,7 @@ impl MeshBuilder {
     /// A hole loop as a face of its own, facing like the face it is cut
     /// from (the clockwise hole loop reversed, first corner kept).
     fn add_hole(&mut self, src: &Mesh, out: &mut Mesh, face: usize, lp: usize) {
-        let (material, group) = self.slots(src, out, face);
+        let (material, group) = self.slots(src, face);
         let l = src.loops[lp];
         let mut corners: Vec<usize> = src.loop_corners(l).collect();
         reverse_keep_first(&mut corners);
@@ -1155,7 +1176,7 @@ impl MeshBuilder {
         face: usize,
         normal: DVec3,
     ) {
-        let (material, group) = self.slots(src, out, face);
+        let (material, group) = self.slots(src, face);
         let start = out.corners.len() as u32;
         for &c in corners {
             self.corner(src, out, c, Some(normal));
@@ -1177,15 +1198,41 @@ impl MeshBuilder {
         for p in self.touched.drain(..) {
             self.remap[p as usize] = u32::MAX;
         }
-        self.mat_remap.fill(u32::MAX);
-        self.group_remap.fill(u32::MAX);
-        if out.materials.is_empty() {
-            out.materials
-                .push(src.materials.first().cloned().unwrap_or_default());
+        for &m in &self.used_mats {
+            self.mat_remap[m as usize] = u32::MAX;
         }
-        if out.groups.is_empty() {
-            out.groups.push(String::new());
+        for &g in &self.used_groups {
+            self.group_remap[g as usize] = u32::MAX;
         }
+        // The slots used, in order of first use. When that is the source's
+        // whole list in order (a one-material mesh, the usual case), the
+        // component shares the source's list: no copy, and the exporter
+        // and the leaf material cache recognise it.
+        out.materials = if self.used_mats.is_empty() {
+            match src.materials.len() {
+                0 => vec![cga_geometry::Material::default()].into(),
+                1 => src.materials.clone(),
+                _ => vec![src.materials[0].clone()].into(),
+            }
+        } else {
+            pick(&src.materials, &self.used_mats)
+        };
+        if !self.used_groups.is_empty() {
+            out.groups = pick(&src.groups, &self.used_groups);
+        } // else: Mesh::new's one unnamed group
+        self.used_mats.clear();
+        self.used_groups.clear();
+    }
+}
+
+/// The elements `used` of `src`, in that order: `src` itself (shared) when
+/// that is all of it in order.
+fn pick<T: Clone>(src: &SharedVec<T>, used: &[u32]) -> SharedVec<T> {
+    let all = used.len() == src.len() && used.iter().enumerate().all(|(i, &k)| k as usize == i);
+    if all {
+        src.clone()
+    } else {
+        used.iter().map(|&k| src[k as usize].clone()).collect()
     }
 }
 

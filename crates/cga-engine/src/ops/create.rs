@@ -28,9 +28,7 @@ pub fn exec(
         | Op::PrimitiveCone => primitive(shape, call.op, args),
         Op::Insert => insert(cx, shape, call, args),
         Op::ReverseNormals => {
-            let mut mesh = (**shape.geometry.local()).clone();
-            cga_geometry::transform::reverse_faces(&mut mesh);
-            shape.set_local_mesh(mesh);
+            cga_geometry::transform::reverse_faces(shape.geometry.local_mut());
             Ok(())
         }
         _ => unreachable!("not a geometry creation operation"),
@@ -186,7 +184,8 @@ fn insert(cx: &mut Interp, shape: &mut Shape, call: &OpCall, args: &[Arg]) -> Re
                 cga_geometry::transform::transform(&mut m, &rot);
                 mesh = Arc::new(m);
             }
-            insert_fitted(shape, mesh, mode);
+            let bounds = cx.memo.bounds(&mesh);
+            insert_fitted_in(shape, mesh, bounds, mode);
         }
         Err(message) => {
             // A missing asset must not lose the model: warn and go on.
@@ -213,7 +212,18 @@ pub enum InsertMode {
 /// Places `asset` (in its own coordinates) into the scope as CGA's insert
 /// does, including the rules for scope sizes that are zero.
 pub fn insert_fitted(shape: &mut Shape, asset: Arc<Mesh>, mode: InsertMode) {
-    let Some((lo, hi)) = local_bounds(&asset) else {
+    let bounds = local_bounds(&asset);
+    insert_fitted_in(shape, asset, bounds, mode)
+}
+
+/// [`insert_fitted`] with the asset's bounds (`local_bounds`) known.
+fn insert_fitted_in(
+    shape: &mut Shape,
+    asset: Arc<Mesh>,
+    bounds: Option<(DVec3, DVec3)>,
+    mode: InsertMode,
+) {
+    let Some((lo, hi)) = bounds else {
         shape.set_local_mesh(Mesh::new());
         return;
     };
@@ -302,10 +312,10 @@ fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {
         _ => unreachable!("arity checked by the resolver"),
     };
     // Extrude in object coordinates, where "world up" is +y.
-    let mesh = shape.object_mesh();
-    if mesh.faces.is_empty() {
+    if shape.geometry.is_empty() {
         return Ok(());
     }
+    let mesh = shape.take_object_mesh();
     let how = match kind {
         "world.up" => Extrusion::Direction(DVec3::Y),
         "world.up.flatTop" => Extrusion::DirectionFlatTop(DVec3::Y),
@@ -330,7 +340,9 @@ fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {
         .unwrap_or_else(|| y.any_orthonormal_vector());
     let axes = DMat3::from_cols(x, y, x.cross(y));
     let to_scope = shape.scope.frame.affine().inverse();
-    shape.set_local_mesh(crate::shape::transformed(&out, &to_scope));
+    let mut out = out;
+    crate::shape::transform_in_place(&mut out, &to_scope);
+    shape.set_local_mesh(out);
     shape.fit_scope(axes);
     if dist < 0.0 {
         // A negative extrusion keeps the base at the scope origin with sy < 0.

@@ -140,24 +140,38 @@ fn cut_parts(mesh: &Arc<Mesh>, axis: usize, sign: f64, placed: &[Placed]) -> Vec
     if mesh.faces.is_empty() {
         return placed.iter().map(|_| Mesh::new()).collect();
     }
-    let slabs = cga_geometry::split_along_axis(mesh, axis, &cuts);
+    let mut slabs = cga_geometry::split_along_axis(mesh, axis, &cuts);
     // Slab i lies between cuts[i-1] and cuts[i].
     let slab_index = |c: f64| cuts.partition_point(|&x| x < c - 1e-12 * (1.0 + c.abs()));
-    placed
+    let ranges: Vec<(usize, usize)> = placed
         .iter()
         .map(|p| {
-            let (a, b) = {
-                let (a, b) = (coord(p.start), coord(p.end));
-                (a.min(b), a.max(b))
-            };
-            let first = slab_index(a) + 1;
-            let last = slab_index(b);
+            let (a, b) = (coord(p.start), coord(p.end));
+            (slab_index(a.min(b)) + 1, slab_index(a.max(b)))
+        })
+        .collect();
+    // A part that is exactly one slab takes it (no copy) unless another
+    // part still needs it; parts do not overlap, so that is the rule.
+    let mut uses = vec![0u32; slabs.len()];
+    for &(first, last) in &ranges {
+        for u in uses.iter_mut().take(last + 1).skip(first) {
+            *u += 1;
+        }
+    }
+    ranges
+        .iter()
+        .map(|&(first, last)| {
             let mut out = Mesh::new();
-            for (k, slab) in slabs.iter().enumerate().take(last + 1).skip(first) {
-                if k == first && first == last {
-                    return slab.clone();
+            for k in first..=last.min(slabs.len().saturating_sub(1)) {
+                uses[k] -= 1;
+                if first == last {
+                    return if uses[k] == 0 {
+                        std::mem::take(&mut slabs[k])
+                    } else {
+                        slabs[k].clone()
+                    };
                 }
-                cga_geometry::transform::merge(&mut out, slab);
+                cga_geometry::transform::merge(&mut out, &slabs[k]);
             }
             out
         })
@@ -260,18 +274,33 @@ fn uv_split(
         .collect();
     cuts.sort_by(f64::total_cmp);
     cuts.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * (1.0 + a.abs()));
-    let slabs = super::texturing::cut_along_uv(&mesh, set, axis, &cuts);
+    let mut slabs = super::texturing::cut_along_uv(&mesh, set, axis, &cuts);
     // Slab i lies between cuts[i-1] and cuts[i].
     let slab_index = |c: f64| cuts.partition_point(|&x| x < c - 1e-12 * (1.0 + c.abs()));
     let axes = st.shape.scope.frame.axes;
     let total = placed.len() as f64;
-    for part in &placed {
-        let first = slab_index(coord(part.start)) + 1;
-        let last = slab_index(coord(part.end));
+    let ranges: Vec<(usize, usize)> = placed
+        .iter()
+        .map(|p| (slab_index(coord(p.start)) + 1, slab_index(coord(p.end))))
+        .collect();
+    let mut uses = vec![0u32; slabs.len()];
+    for &(first, last) in &ranges {
+        for u in uses.iter_mut().take(last + 1).skip(first) {
+            *u += 1;
+        }
+    }
+    for (part, &(first, last)) in placed.iter().zip(&ranges) {
         let mut piece = Mesh::new();
-        for slab in slabs.iter().take(last + 1).skip(first) {
+        for (slab, u) in slabs.iter_mut().zip(&mut uses).take(last + 1).skip(first) {
+            *u -= 1;
             if piece.faces.is_empty() {
-                piece = slab.clone();
+                // The last part that needs a slab takes it; parts do not
+                // overlap, so that is the only one.
+                piece = if *u == 0 {
+                    std::mem::take(slab)
+                } else {
+                    slab.clone()
+                };
             } else {
                 cga_geometry::transform::merge(&mut piece, slab);
             }

@@ -37,11 +37,11 @@
 
 pub mod insert_along_uv;
 
-use std::collections::HashMap;
 use std::io::Read;
 use std::sync::Arc;
 
 use cga_geometry::measure::{uv_bounds, uv_unit_scale};
+use cga_geometry::topology::FxHashMap;
 use cga_geometry::{DMat3, DVec2, DVec3, Face, Loop, Mesh, UV_SETS};
 use cga_syntax::FileId;
 use cga_value::Value;
@@ -49,7 +49,7 @@ use cga_value::Value;
 use super::transform::selector;
 use super::Op;
 use crate::assets::Assets;
-use crate::derive::{Arg, Interp, RtError, ShapeState, SizeKind};
+use crate::derive::{Arg, Interp, MaterialEdit, RtError, ShapeState, SizeKind};
 use crate::expr::OpCall;
 use crate::material_attr::MatField;
 use crate::shape::{Frame, Projection, Shape};
@@ -116,9 +116,7 @@ pub fn exec(
         Op::DeleteUV => {
             let set = uv_set(&args[0])?;
             if shape.geometry.raw().0.uvs[set].is_some() {
-                let mut m = (**shape.geometry.local()).clone();
-                m.uvs[set] = None;
-                shape.set_local_mesh(m);
+                shape.geometry.local_mut().uvs[set] = None;
             }
             Ok(())
         }
@@ -127,9 +125,8 @@ pub fn exec(
             let to = uv_set(&args[1])?;
             let mesh = shape.geometry.raw().0;
             if from != to && mesh.uvs[from] != mesh.uvs[to] {
-                let mut m = (**shape.geometry.local()).clone();
+                let m = shape.geometry.local_mut();
                 m.uvs[to] = m.uvs[from].clone();
-                shape.set_local_mesh(m);
             }
             Ok(())
         }
@@ -309,14 +306,23 @@ pub fn project_uv(shape: &mut Shape, set: usize, p: &Projection) {
         return;
     }
     let frame = shape.scope.frame;
-    let mut m = (**shape.geometry.local()).clone();
-    let at: Vec<DVec2> = m
-        .positions
-        .iter()
-        .map(|&q| p.uv(frame.to_object(q)))
-        .collect();
-    m.uvs[set] = Some(m.corners.iter().map(|&c| at[c as usize]).collect());
-    shape.set_local_mesh(m);
+    // In place: the geometry is usually this shape's own (a piece just cut),
+    // and the UV array of a set being re-projected is reused.
+    let m = shape.geometry.local_mut();
+    PROJECTED.with(|at| {
+        let mut at = at.borrow_mut();
+        at.clear();
+        at.extend(m.positions.iter().map(|&q| p.uv(frame.to_object(q))));
+        let mut uvs = m.uvs[set].take().unwrap_or_default();
+        uvs.clear();
+        uvs.extend(m.corners.iter().map(|&c| at[c as usize]));
+        m.uvs[set] = Some(uvs);
+    });
+}
+
+thread_local! {
+    /// The texture coordinates of each position, reused by `project_uv`.
+    static PROJECTED: std::cell::RefCell<Vec<DVec2>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// Runs `f` on UV set `set` of the shape's geometry (scope-local), if the
@@ -325,12 +331,11 @@ fn edit_uvs(shape: &mut Shape, set: usize, f: impl FnOnce(&Mesh, &mut Vec<DVec2>
     if shape.geometry.raw().0.uvs[set].is_none() {
         return;
     }
-    let mut m = (**shape.geometry.local()).clone();
+    let m = shape.geometry.local_mut();
     if let Some(mut uvs) = m.uvs[set].take() {
-        f(&m, &mut uvs);
+        f(m, &mut uvs);
         m.uvs[set] = Some(uvs);
     }
-    shape.set_local_mesh(m);
 }
 
 #[derive(Clone, Copy, PartialEq)]
@@ -396,13 +401,35 @@ fn tile_uv(cx: &mut Interp, shape: &mut Shape, call: &OpCall, args: &[Arg]) -> R
     if shape.geometry.raw().0.uvs[set].is_none() {
         return Ok(());
     }
-    let mesh = shape.geometry.local().clone();
-    let Some((lo, hi)) = uv_bounds(&mesh, set) else {
+    // An inserted asset placed like one before (the windows of a facade)
+    // has the same measures: they are remembered.
+    let (raw, to_scope) = shape.geometry.raw();
+    let shared = Arc::strong_count(raw) > 1;
+    let known = if shared {
+        cx.memo.uv(raw, to_scope, set)
+    } else {
+        None
+    };
+    let (bounds, unit) = match known {
+        Some(m) => m,
+        None => {
+            let key = shared.then(|| (raw.clone(), to_scope.copied()));
+            // Borrowed, not shared: `edit_uvs` below then edits an unshared
+            // mesh in place.
+            let mesh = shape.geometry.local();
+            // Scene units per unit of u and of v (None: no usable
+            // parameterisation).
+            let m = (uv_bounds(mesh, set), uv_unit_scale(mesh, set));
+            if let Some((raw, to_scope)) = key {
+                cx.memo.remember_uv(raw, to_scope, set, m);
+            }
+            m
+        }
+    };
+    let Some((lo, hi)) = bounds else {
         return Ok(());
     };
     let range = hi - lo;
-    // Scene units per unit of u and of v (None: no usable parameterisation).
-    let unit = uv_unit_scale(&mesh, set);
     let mut factor = DVec2::ONE;
     for (k, arg) in args[1..3].iter().enumerate() {
         let x = arg.num()?;
@@ -453,22 +480,30 @@ fn texture(cx: &mut Interp, shape: &mut Shape, call: &OpCall, arg: &Arg) -> Resu
         Value::Str(s) => s.clone(),
         other => Arc::from(crate::values::to_text(other).as_str()),
     };
-    let alpha = cx.textures.has_alpha(cx.assets, call.span.file, &path);
-    let m = Arc::make_mut(&mut shape.material);
-    let opacity = if alpha { path.clone() } else { Arc::from("") };
-    for (field, v) in [(MatField::Map(0), path), (MatField::Map(4), opacity)] {
-        m.set(field, &Value::Str(v))
-            .map_err(|e| RtError::new(e, arg.span))?;
-    }
-    Ok(())
+    let edit = MaterialEdit::Texture(path.clone(), call.span.file);
+    cx.edit_material(shape, edit, |cx, m| {
+        let alpha = cx.textures.has_alpha(cx.assets, call.span.file, &path);
+        let opacity = if alpha { path.clone() } else { empty_str() };
+        for (field, v) in [(MatField::Map(0), path), (MatField::Map(4), opacity)] {
+            m.set(field, &Value::Str(v))
+                .map_err(|e| RtError::new(e, arg.span))?;
+        }
+        Ok(())
+    })
+}
+
+/// A shared empty string (`Arc::from("")` would allocate every time).
+fn empty_str() -> Arc<str> {
+    static EMPTY: std::sync::LazyLock<Arc<str>> = std::sync::LazyLock::new(|| Arc::from(""));
+    EMPTY.clone()
 }
 
 /// Texture files named by rules: where they are and whether they have an
 /// alpha channel, found once per path and rule file (per initial shape).
 #[derive(Default)]
 pub struct TextureFiles {
-    found: HashMap<(u32, Arc<str>), Option<Arc<str>>>,
-    alpha: HashMap<Arc<str>, bool>,
+    found: FxHashMap<(u32, Arc<str>), Option<Arc<str>>>,
+    alpha: FxHashMap<Arc<str>, bool>,
 }
 
 impl TextureFiles {
@@ -481,16 +516,7 @@ impl TextureFiles {
         if let Some(r) = self.found.get(&(from.0, path.clone())) {
             return r.clone();
         }
-        // Textures of inserted assets come as paths next to the asset file,
-        // which may be relative to the working folder.
-        let file = assets.resolve(from, path).or_else(|| {
-            let p = std::path::Path::new(&**path);
-            p.is_file().then(|| p.to_path_buf())
-        });
-        let r = file.map(|f| {
-            let f = f.canonicalize().unwrap_or(f);
-            Arc::from(f.to_string_lossy().as_ref())
-        });
+        let r = assets.texture_file(from, path);
         self.found.insert((from.0, path.clone()), r.clone());
         r
     }
@@ -513,10 +539,24 @@ impl TextureFiles {
     /// Replaces the texture paths of `mesh`'s materials by the files they
     /// name, searched from rule file `from` (see the module docs).
     pub fn resolve_mesh(&mut self, assets: &Assets, from: FileId, mesh: &mut Mesh) {
-        for m in &mut mesh.materials {
-            for ch in &mut m.maps {
-                if let Some(found) = self.resolve(assets, from, &ch.path) {
-                    ch.path = found;
+        self.resolve_materials(assets, from, &mut mesh.materials);
+    }
+
+    /// [`resolve_mesh`](TextureFiles::resolve_mesh) for a list of materials;
+    /// a shared list is copied only if a path changes.
+    pub fn resolve_materials(
+        &mut self,
+        assets: &Assets,
+        from: FileId,
+        materials: &mut cga_geometry::mesh::SharedVec<cga_geometry::Material>,
+    ) {
+        for i in 0..materials.len() {
+            for k in 0..materials[i].maps.len() {
+                let path = &materials[i].maps[k].path;
+                if let Some(found) = self.resolve(assets, from, path) {
+                    if found != *path {
+                        materials.make_mut()[i].maps[k].path = found;
+                    }
                 }
             }
         }

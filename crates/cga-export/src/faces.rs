@@ -4,7 +4,9 @@ use cga_geometry::{DVec3, Mesh};
 
 /// Unit normal of a face from its outer loop (Newell's method, which works
 /// for any planar polygon, convex or not, and averages slightly non-planar
-/// ones). `None` for a degenerate (zero-area) loop.
+/// ones). `None` for a degenerate (zero-area) loop. The writers take it from
+/// [`face_normals`]; this is its reference.
+#[cfg(test)]
 pub(crate) fn face_normal(mesh: &Mesh, positions: &[DVec3], face: usize) -> Option<DVec3> {
     let outer = mesh.outer_loop(face);
     let idx = mesh.loop_indices(outer);
@@ -22,6 +24,48 @@ pub(crate) fn face_normal(mesh: &Mesh, positions: &[DVec3], face: usize) -> Opti
     }
     let len = n.length();
     (len > 0.0 && len.is_finite()).then(|| n / len)
+}
+
+/// The two normals the writers need of a face, in one pass over its outer
+/// loop: the unit normal the triangulation works with
+/// (`cga_geometry::measure::face_normal_at`: Newell's method relative to the
+/// first corner; zero if degenerate) and [`face_normal`]. Each is computed
+/// exactly as its own function computes it.
+pub(crate) fn face_normals(
+    mesh: &Mesh,
+    positions: &[DVec3],
+    face: usize,
+) -> (DVec3, Option<DVec3>) {
+    let idx = mesh.loop_indices(mesh.outer_loop(face));
+    let (Some(&first), Some(&last)) = (idx.first(), idx.last()) else {
+        return (DVec3::ZERO, None);
+    };
+    let o = positions[first as usize];
+    let mut prev = positions[last as usize];
+    let mut rel = DVec3::ZERO;
+    let mut abs = DVec3::ZERO;
+    for &i in idx {
+        let p = positions[i as usize];
+        rel += (prev - o).cross(p - o);
+        abs += DVec3::new(
+            (prev.y - p.y) * (prev.z + p.z),
+            (prev.z - p.z) * (prev.x + p.x),
+            (prev.x - p.x) * (prev.y + p.y),
+        );
+        prev = p;
+    }
+    if idx.len() < 3 {
+        // `newell` gives zero for edges and points.
+        rel = DVec3::ZERO;
+    }
+    let len = rel.length();
+    let unit = if len > 0.0 && len.is_finite() {
+        rel / len
+    } else {
+        DVec3::ZERO
+    };
+    let len = abs.length();
+    (unit, (len > 0.0 && len.is_finite()).then(|| abs / len))
 }
 
 /// Whether every position, UV (set 0) and normal of the face is finite;
@@ -85,6 +129,44 @@ mod tests {
             total += a;
         }
         assert!((total - 12.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn face_normals_are_the_single_computations_bit_for_bit() {
+        let mut m = Mesh::new();
+        // Far from the origin, tilted, a non-planar quad, a concave
+        // pentagon, a triangle, an edge and a collapsed quad.
+        let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z) + DVec3::new(1e5, 3.25, -7e4);
+        m.positions.extend([
+            p(0.0, 0.0, 0.0),
+            p(2.0, 0.1, 0.0),
+            p(2.0, 1.0, -0.3),
+            p(0.0, 1.1, 0.2),
+            p(3.0, 0.0, 0.0),
+            p(5.0, 0.0, 1.0),
+            p(5.0, 2.0, 1.0),
+            p(4.0, 0.5, 0.5),
+            p(3.0, 2.0, 0.0),
+        ]);
+        m.add_face(&[&[0, 1, 2, 3]], 0);
+        m.add_face(&[&[4, 5, 6, 7, 8]], 0);
+        m.add_face(&[&[0, 5, 8]], 0);
+        m.add_face(&[&[0, 1]], 0);
+        m.add_face(&[&[0, 0, 0, 0]], 0);
+        for f in 0..m.faces.len() {
+            let (unit, normal) = face_normals(&m, &m.positions, f);
+            let want = cga_geometry::measure::face_normal_at(&m, &m.positions, f);
+            assert_eq!(
+                unit.to_array().map(f64::to_bits),
+                want.to_array().map(f64::to_bits)
+            );
+            let want = face_normal(&m, &m.positions, f);
+            assert_eq!(
+                normal.map(|n| n.to_array().map(f64::to_bits)),
+                want.map(|n| n.to_array().map(f64::to_bits))
+            );
+            assert_eq!(normal.is_some(), f < 3, "face {f}");
+        }
     }
 
     #[test]

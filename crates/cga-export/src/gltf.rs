@@ -34,41 +34,80 @@ use crate::materials::{srgb_to_linear, MaterialTable};
 use crate::textures::{uri_encode, Textures};
 use crate::{ExportError, ExportStats, FaceData};
 
-/// Vertex data of one material.
+/// Vertex data of one material, kept as the little-endian bytes the binary
+/// buffer holds (so writing it is one copy, and no conversion per value).
 #[derive(Default)]
 struct Bucket {
-    positions: Vec<f32>,
-    normals: Vec<f32>,
+    /// Vertices so far.
+    vertices: usize,
+    /// `f32` x, y, z per vertex.
+    positions: Vec<u8>,
+    /// `f32` x, y, z per vertex.
+    normals: Vec<u8>,
     /// The UV sets written as `TEXCOORD` arrays, set 0 first when present,
-    /// and their coordinates (v flipped, two per vertex). A set a mesh lacks
-    /// reads set 0 instead, as CGA does for texture layers; vertices without
-    /// either get (0, 0). Set 0 is added when the first mesh with UVs comes
-    /// (earlier vertices get (0, 0)); a textured material has it from the
-    /// start, with one more set per other texture layer it uses.
+    /// and their coordinates (`f32` u and flipped v per vertex). A set a mesh
+    /// lacks reads set 0 instead, as CGA does for texture layers; vertices
+    /// without either get (0, 0). Set 0 is added when the first mesh with
+    /// UVs comes (earlier vertices get (0, 0)); a textured material has it
+    /// from the start, with one more set per other texture layer it uses.
     sets: Vec<usize>,
-    coords: Vec<Vec<f32>>,
+    coords: Vec<Vec<u8>>,
     /// After [`Bucket::merge_equal_coords`]: the `TEXCOORD` index of each
     /// set (sets with equal coordinates share one array).
     tex_coords: Vec<u32>,
-    /// `TANGENT` (xyz, w) per vertex, for normal-mapped materials.
-    tangents: Option<Vec<f32>>,
-    indices: Vec<u32>,
+    /// `TANGENT` (`f32` x, y, z, w) per vertex, for normal-mapped materials.
+    tangents: Option<Vec<u8>>,
+    /// `u32` per triangle corner.
+    indices: Vec<u8>,
     min: [f32; 3],
     max: [f32; 3],
 }
 
-impl Bucket {
-    fn vertex_count(&self) -> usize {
-        self.normals.len() / 3
+/// Appends the little-endian bytes of `x`.
+#[inline(always)]
+fn put<const N: usize>(out: &mut Vec<u8>, x: [f32; N]) {
+    // Built in a local array so that the append is one bounds check and one
+    // copy (`N` is 2 to 4).
+    let mut b = [[0u8; 4]; N];
+    for (d, v) in b.iter_mut().zip(x) {
+        *d = v.to_le_bytes();
     }
+    out.extend_from_slice(b.as_flattened());
+}
 
+/// Whether two arrays of little-endian `f32`s are equal as numbers (as
+/// comparing the `f32` values would: 0 equals -0, NaN equals nothing).
+fn same_f32s(a: &[u8], b: &[u8]) -> bool {
+    let f = |x: &[u8]| f32::from_le_bytes([x[0], x[1], x[2], x[3]]);
+    a.len() == b.len()
+        && a.chunks_exact(4)
+            .zip(b.chunks_exact(4))
+            .all(|(x, y)| f(x) == f(y))
+}
+
+/// The tangent written for a vertex with normal `n` given the face's
+/// tangent: perpendicular to the normal, as glTF requires.
+#[inline]
+fn vertex_tangent(n: DVec3, (t, w): (DVec3, f64)) -> [f32; 4] {
+    let t = (t - n * n.dot(t))
+        .try_normalize()
+        .unwrap_or_else(|| n.any_orthonormal_vector());
+    let t = t.as_vec3();
+    [t.x, t.y, t.z, w as f32]
+}
+
+fn too_many_vertices() -> ExportError {
+    ExportError::TooLarge("more than 2^32 vertices with one material".into())
+}
+
+impl Bucket {
     /// Keeps one coordinate array per distinct content: a layer whose UV set
     /// no mesh had reads set 0's array.
     fn merge_equal_coords(&mut self) {
-        let mut distinct: Vec<Vec<f32>> = Vec::new();
+        let mut distinct: Vec<Vec<u8>> = Vec::new();
         self.tex_coords.clear();
         for c in std::mem::take(&mut self.coords) {
-            match distinct.iter().position(|d| *d == c) {
+            match distinct.iter().position(|d| same_f32s(d, &c)) {
                 Some(i) => self.tex_coords.push(i as u32),
                 None => {
                     self.tex_coords.push(distinct.len() as u32);
@@ -89,13 +128,13 @@ impl Bucket {
 
     /// Room for `n` more vertices.
     fn reserve(&mut self, n: usize) {
-        self.positions.reserve(3 * n);
-        self.normals.reserve(3 * n);
+        self.positions.reserve(12 * n);
+        self.normals.reserve(12 * n);
         for c in &mut self.coords {
-            c.reserve(2 * n);
+            c.reserve(8 * n);
         }
         if let Some(t) = &mut self.tangents {
-            t.reserve(4 * n);
+            t.reserve(16 * n);
         }
     }
 
@@ -110,35 +149,47 @@ impl Bucket {
         corner: usize,
         tangent: (DVec3, f64),
     ) -> Result<u32, ExportError> {
-        let index = u32::try_from(self.vertex_count()).map_err(|_| {
-            ExportError::TooLarge("more than 2^32 vertices with one material".into())
-        })?;
-        let p = p.as_vec3().to_array();
-        // `min` and `max` start at +inf and -inf (see `Bucket::new`).
-        for ((lo, hi), x) in self.min.iter_mut().zip(&mut self.max).zip(p) {
-            *lo = lo.min(x);
-            *hi = hi.max(x);
-        }
-        self.positions.extend_from_slice(&p);
-        self.normals.extend_from_slice(&n.as_vec3().to_array());
+        let index = u32::try_from(self.vertices).map_err(|_| too_many_vertices())?;
+        self.vertices += 1;
+        self.push_position(p);
+        put(&mut self.normals, n.as_vec3().to_array());
         for (src, coords) in sources.iter().zip(&mut self.coords) {
-            // glTF puts v = 0 at the top of the image, CGA at the bottom.
-            let (u, v) = match src.and_then(|u| u.get(corner)) {
-                Some(t) => (t.x as f32, (1.0 - t.y) as f32),
-                None => (0.0, 0.0),
-            };
-            coords.extend_from_slice(&[u, v]);
+            put(coords, uv_at(*src, corner));
         }
         if let Some(tangents) = &mut self.tangents {
-            // Perpendicular to this vertex's normal, as glTF requires.
-            let (t, w) = tangent;
-            let t = (t - n * n.dot(t))
-                .try_normalize()
-                .unwrap_or_else(|| n.any_orthonormal_vector());
-            let t = t.as_vec3();
-            tangents.extend_from_slice(&[t.x, t.y, t.z, w as f32]);
+            put(tangents, vertex_tangent(n, tangent));
         }
         Ok(index)
+    }
+
+    /// Appends a position and widens the bounds.
+    #[inline(always)]
+    fn push_position(&mut self, p: DVec3) {
+        let p = p.as_vec3().to_array();
+        // `min` and `max` start at +inf and -inf (see `Bucket::new`) and are
+        // never NaN, so plain comparisons keep what `f32::min` and `max`
+        // would (a NaN coordinate changes nothing; of 0 and -0 the first
+        // stays) without their NaN handling.
+        for ((lo, hi), x) in self.min.iter_mut().zip(&mut self.max).zip(p) {
+            if x < *lo {
+                *lo = x;
+            }
+            if x > *hi {
+                *hi = x;
+            }
+        }
+        put(&mut self.positions, p);
+    }
+}
+
+/// The written texture coordinates of `corner` from a UV source: v flipped
+/// (glTF puts v = 0 at the top of the image, CGA at the bottom); (0, 0)
+/// without a source.
+#[inline(always)]
+fn uv_at(src: Option<&[DVec2]>, corner: usize) -> [f32; 2] {
+    match src.and_then(|u| u.get(corner)) {
+        Some(t) => [t.x as f32, (1.0 - t.y) as f32],
+        None => [0.0, 0.0],
     }
 }
 
@@ -400,7 +451,7 @@ impl GltfWriter {
         let uvs = mesh.uvs[0].as_deref();
         if uvs.is_some() && bucket.sets.is_empty() {
             bucket.sets.push(0);
-            bucket.coords.push(vec![0.0; bucket.vertex_count() * 2]);
+            bucket.coords.push(vec![0; bucket.vertices * 8]);
         }
         // Vertices are shared only where one UV set is written (the key
         // holds set 0's coordinates) and no tangents (which are per face).
@@ -416,14 +467,11 @@ impl GltfWriter {
         }
         let sources = &sources[..bucket.sets.len()];
         let loops = mesh.face_loops(f.face);
-        bucket.reserve(loops.iter().map(|l| l.len as usize).sum());
-        bucket.indices.reserve(3 * f.triangles.len());
-        let corners = || loops.iter().flat_map(|&l| mesh.loop_corners(l));
-        let positions = f.positions;
-        // One loop over the corners per case.
         match f.normals {
             Some(normals) if shared => {
-                for c in corners() {
+                bucket.reserve(loops.iter().map(|l| l.len as usize).sum());
+                let corners = loops.iter().flat_map(|&l| mesh.loop_corners(l));
+                for c in corners {
                     let position = mesh.corners[c] as usize;
                     let n = normals[c].try_normalize().unwrap_or(f.normal);
                     let uv = uvs.map_or([0; 2], |u| u[c].as_vec2().to_array().map(f32::to_bits));
@@ -443,7 +491,8 @@ impl GltfWriter {
                     corner_vertex[c] = if e != NO_ENTRY {
                         made[e as usize].vertex
                     } else {
-                        let v = bucket.push_vertex(positions[position], n, sources, c, tangent)?;
+                        let v =
+                            bucket.push_vertex(f.positions[position], n, sources, c, tangent)?;
                         made.push(SharedVertex {
                             key,
                             vertex: v,
@@ -454,25 +503,35 @@ impl GltfWriter {
                     };
                 }
             }
-            Some(normals) => {
-                for c in corners() {
-                    let p = positions[mesh.corners[c] as usize];
-                    let n = normals[c].try_normalize().unwrap_or(f.normal);
-                    corner_vertex[c] = bucket.push_vertex(p, n, sources, c, tangent)?;
-                }
-            }
-            // Flat shading: each face has its own vertices.
-            None => {
-                for c in corners() {
-                    let p = positions[mesh.corners[c] as usize];
-                    corner_vertex[c] = bucket.push_vertex(p, f.normal, sources, c, tangent)?;
-                }
-            }
+            // Every corner its own vertex: the attributes are appended one
+            // array at a time (a face's corners are mostly one range).
+            _ => match loops {
+                [l] => own_vertices(
+                    bucket,
+                    f,
+                    sources,
+                    tangent,
+                    corner_vertex,
+                    mesh.loop_corners(*l),
+                )?,
+                _ => own_vertices(
+                    bucket,
+                    f,
+                    sources,
+                    tangent,
+                    corner_vertex,
+                    loops.iter().flat_map(|&l| mesh.loop_corners(l)),
+                )?,
+            },
         }
+        bucket.indices.reserve(12 * f.triangles.len());
         for t in f.triangles {
-            bucket
-                .indices
-                .extend(t.iter().map(|&c| corner_vertex[c as usize]));
+            let [a, b, c] = t.map(|c| corner_vertex[c as usize].to_le_bytes());
+            let mut bytes = [0u8; 12];
+            bytes[..4].copy_from_slice(&a);
+            bytes[4..8].copy_from_slice(&b);
+            bytes[8..].copy_from_slice(&c);
+            bucket.indices.extend_from_slice(&bytes);
         }
         Ok(())
     }
@@ -505,11 +564,11 @@ impl GltfWriter {
             }
             let id = id as u32;
             let name = table.name(id).to_string();
-            let count = bucket.vertex_count() as u64;
+            let count = bucket.vertices as u64;
             let mut attributes = std::collections::BTreeMap::new();
             let positions = layout.accessor(
                 &mut root,
-                bucket.positions.len(),
+                bucket.positions.len() / 4,
                 count,
                 json::accessor::Type::Vec3,
                 json::accessor::ComponentType::F32,
@@ -521,7 +580,7 @@ impl GltfWriter {
             attributes.insert(Valid(json::mesh::Semantic::Positions), positions);
             let normals = layout.accessor(
                 &mut root,
-                bucket.normals.len(),
+                bucket.normals.len() / 4,
                 count,
                 json::accessor::Type::Vec3,
                 json::accessor::ComponentType::F32,
@@ -531,7 +590,7 @@ impl GltfWriter {
             for (n, coords) in bucket.coords.iter().enumerate() {
                 let tex = layout.accessor(
                     &mut root,
-                    coords.len(),
+                    coords.len() / 4,
                     count,
                     json::accessor::Type::Vec2,
                     json::accessor::ComponentType::F32,
@@ -542,7 +601,7 @@ impl GltfWriter {
             if let Some(tangents) = &bucket.tangents {
                 let acc = layout.accessor(
                     &mut root,
-                    tangents.len(),
+                    tangents.len() / 4,
                     count,
                     json::accessor::Type::Vec4,
                     json::accessor::ComponentType::F32,
@@ -552,8 +611,8 @@ impl GltfWriter {
             }
             let indices = layout.accessor(
                 &mut root,
-                bucket.indices.len(),
-                bucket.indices.len() as u64,
+                bucket.indices.len() / 4,
+                bucket.indices.len() as u64 / 4,
                 json::accessor::Type::Scalar,
                 json::accessor::ComponentType::U32,
                 Some(json::buffer::Target::ElementArrayBuffer),
@@ -710,6 +769,64 @@ impl GltfWriter {
         }
         out.flush().map_err(io)
     }
+}
+
+/// Appends one vertex per corner of face `f` (`corners`, in order) to
+/// `bucket`, recording each corner's vertex in `corner_vertex`: the values
+/// `Bucket::push_vertex` would append corner by corner, written one
+/// attribute array at a time. Without normals of its own every vertex has
+/// the face normal (flat shading), so the normal and tangent are converted
+/// once for the face.
+fn own_vertices(
+    bucket: &mut Bucket,
+    f: &FaceData,
+    sources: &[Option<&[DVec2]>],
+    tangent: (DVec3, f64),
+    corner_vertex: &mut [u32],
+    corners: impl Iterator<Item = usize> + Clone,
+) -> Result<(), ExportError> {
+    let mesh = f.mesh;
+    let count = corners.clone().count();
+    let first = bucket.vertices;
+    // Vertex indices are u32: the last one must fit.
+    if first + count > u32::MAX as usize + 1 {
+        return Err(too_many_vertices());
+    }
+    bucket.reserve(count);
+    bucket.vertices += count;
+    for (v, c) in (first as u32..).zip(corners.clone()) {
+        bucket.push_position(f.positions[mesh.corners[c] as usize]);
+        corner_vertex[c] = v;
+    }
+    match f.normals {
+        Some(normals) => {
+            for c in corners.clone() {
+                let n = normals[c].try_normalize().unwrap_or(f.normal);
+                put(&mut bucket.normals, n.as_vec3().to_array());
+                if let Some(tangents) = &mut bucket.tangents {
+                    put(tangents, vertex_tangent(n, tangent));
+                }
+            }
+        }
+        None => {
+            let n = f.normal.as_vec3().to_array();
+            for _ in 0..count {
+                put(&mut bucket.normals, n);
+            }
+            if let Some(tangents) = &mut bucket.tangents {
+                let t = vertex_tangent(f.normal, tangent);
+                for _ in 0..count {
+                    put(tangents, t);
+                }
+            }
+        }
+    }
+    for (src, coords) in sources.iter().zip(&mut bucket.coords) {
+        for c in corners.clone() {
+            put(coords, uv_at(*src, c));
+        }
+    }
+    Ok(())
 }
 
 /// Assigns buffer views and accessors their place in the binary buffer.
@@ -949,19 +1066,18 @@ fn write_bin(
     path: &Path,
 ) -> Result<(), ExportError> {
     let io = |e| ExportError::io(path, e);
-    // Larger than the output buffer, so full chunks go to the file directly
-    // instead of being copied into the buffer first.
-    let mut scratch = vec![0u8; 1 << 18];
+    // The arrays hold the bytes to write; arrays larger than the output
+    // buffer go to the file directly.
     for b in buckets.iter().filter(|b| !b.indices.is_empty()) {
-        write_f32s(w, &b.positions, &mut scratch).map_err(io)?;
-        write_f32s(w, &b.normals, &mut scratch).map_err(io)?;
+        w.write_all(&b.positions).map_err(io)?;
+        w.write_all(&b.normals).map_err(io)?;
         for coords in &b.coords {
-            write_f32s(w, coords, &mut scratch).map_err(io)?;
+            w.write_all(coords).map_err(io)?;
         }
         if let Some(tangents) = &b.tangents {
-            write_f32s(w, tangents, &mut scratch).map_err(io)?;
+            w.write_all(tangents).map_err(io)?;
         }
-        write_u32s(w, &b.indices, &mut scratch).map_err(io)?;
+        w.write_all(&b.indices).map_err(io)?;
     }
     for &t in images {
         let tex = textures.get(t);
@@ -986,22 +1102,29 @@ fn write_bin(
     Ok(())
 }
 
-fn write_f32s(w: &mut impl Write, data: &[f32], scratch: &mut [u8]) -> std::io::Result<()> {
-    for chunk in data.chunks(scratch.len() / 4) {
-        for (dst, x) in scratch.chunks_exact_mut(4).zip(chunk) {
-            dst.copy_from_slice(&x.to_le_bytes());
-        }
-        w.write_all(&scratch[..chunk.len() * 4])?;
-    }
-    Ok(())
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-fn write_u32s(w: &mut impl Write, data: &[u32], scratch: &mut [u8]) -> std::io::Result<()> {
-    for chunk in data.chunks(scratch.len() / 4) {
-        for (dst, x) in scratch.chunks_exact_mut(4).zip(chunk) {
-            dst.copy_from_slice(&x.to_le_bytes());
+    fn bytes(x: &[f32]) -> Vec<u8> {
+        let mut out = Vec::new();
+        for &v in x {
+            put(&mut out, [v]);
         }
-        w.write_all(&scratch[..chunk.len() * 4])?;
+        out
     }
-    Ok(())
+
+    #[test]
+    fn coordinate_arrays_compare_as_numbers() {
+        assert_eq!(bytes(&[1.5, -2.0]), [0, 0, 192, 63, 0, 0, 0, 192]);
+        assert!(same_f32s(&bytes(&[0.0, 1.0]), &bytes(&[-0.0, 1.0])));
+        assert!(!same_f32s(&bytes(&[f32::NAN]), &bytes(&[f32::NAN])));
+        assert!(!same_f32s(&bytes(&[1.0]), &bytes(&[1.0, 2.0])));
+        // Sets with equal numbers share one array, as before.
+        let mut b = Bucket::new();
+        b.coords = vec![bytes(&[0.0, 0.5]), bytes(&[-0.0, 0.5]), bytes(&[1.0, 0.5])];
+        b.merge_equal_coords();
+        assert_eq!(b.tex_coords, [0, 0, 1]);
+        assert_eq!(b.coords.len(), 2);
+    }
 }

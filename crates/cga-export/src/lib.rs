@@ -40,13 +40,13 @@ use std::path::{Path, PathBuf};
 use cga_geometry::mesh::SharedVec;
 use cga_geometry::{DAffine3, DVec3, Material, Mesh};
 
-use crate::faces::{face_is_finite, face_normal};
+use crate::faces::{face_is_finite, face_normals};
 use crate::hash::FastMap;
 use crate::materials::MaterialTable;
 use crate::textures::Textures;
 
 /// The triangulation every writer uses.
-use cga_geometry::triangulate::triangulate_face_at;
+use cga_geometry::triangulate::triangulate_face_with_normal;
 
 /// Output file format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -348,14 +348,15 @@ impl ModelWriter {
                 continue;
             }
             self.triangles.clear();
-            triangulate_face_at(mesh, positions, face, &mut self.triangles);
+            let (unit, normal) = face_normals(mesh, positions, face);
+            triangulate_face_with_normal(mesh, positions, face, unit, &mut self.triangles);
             if self.triangles.is_empty() {
                 continue;
             }
             // No normal means zero area: nothing to see, and no valid normal
             // to write.
-            let Some(normal) = face_normal(mesh, positions, face)
-                .or_else(|| triangles_normal(mesh, positions, &self.triangles))
+            let Some(normal) =
+                normal.or_else(|| triangles_normal(mesh, positions, &self.triangles))
             else {
                 continue;
             };

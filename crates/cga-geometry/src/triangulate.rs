@@ -63,16 +63,28 @@ pub fn triangulate_face(mesh: &Mesh, face: usize, out: &mut Vec<[u32; 3]>) {
 /// its own (the exporter triangulates a shape's geometry where it places
 /// it, without copying the mesh).
 pub fn triangulate_face_at(mesh: &Mesh, positions: &[DVec3], face: usize, out: &mut Vec<[u32; 3]>) {
+    if face < mesh.faces.len() && mesh.outer_loop(face).len >= 3 {
+        let n = crate::measure::face_normal_at(mesh, positions, face);
+        triangulate_face_with_normal(mesh, positions, face, n, out);
+    }
+}
+
+/// [`triangulate_face_at`] given the face's unit normal `n`, which must be
+/// `measure::face_normal_at(mesh, positions, face)` (the exporter computes
+/// it in one pass with the normal it writes).
+pub fn triangulate_face_with_normal(
+    mesh: &Mesh,
+    positions: &[DVec3],
+    face: usize,
+    n: DVec3,
+    out: &mut Vec<[u32; 3]>,
+) {
     let Some(f) = mesh.faces.get(face) else {
         return;
     };
     let loops = mesh.face_loops(face);
     let outer = loops[0];
-    if outer.len < 3 {
-        return;
-    }
-    let n = crate::measure::face_normal_at(mesh, positions, face);
-    if n == DVec3::ZERO {
+    if outer.len < 3 || n == DVec3::ZERO {
         return;
     }
     let s = outer.start;
@@ -88,7 +100,15 @@ pub fn triangulate_face_at(mesh: &Mesh, positions: &[DVec3], face: usize, out: &
         DVec2::new(p.dot(u), p.dot(v))
     };
     if f.loop_count == 1 && outer.len == 4 {
-        let q = [0, 1, 2, 3].map(|i| project((s + i) as usize));
+        // Not `[0, 1, 2, 3].map(..)`: that is not inlined, and this runs
+        // for most faces of a model.
+        let s0 = s as usize;
+        let q = [
+            project(s0),
+            project(s0 + 1),
+            project(s0 + 2),
+            project(s0 + 3),
+        ];
         let area = |a: DVec2, b: DVec2, c: DVec2| (b - a).perp_dot(c - a);
         // Use the diagonal a–c if both halves turn left, else b–d (one of the
         // two diagonals of a simple quad always lies inside it).

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Writes the models that performance work must not change into a directory,
+# so two builds can be compared byte for byte:
+#
+#   tools/perf/outputs.sh path/to/old/cga /tmp/old
+#   tools/perf/outputs.sh path/to/new/cga /tmp/new
+#   diff -r /tmp/old /tmp/new && echo identical
+#
+# Candler (rect:20,30, its footprint, its footprint with Mode=3DPrint), the
+# other oracle rule packages and the example city, as OBJ, GLB and glTF, with
+# one and two workers; prints and reports are kept too.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/../.." && pwd)
+cga=$(realpath "$1")
+out=$(realpath -m "$2")
+mkdir -p "$out"
+oracle=$root/crates/cga-cli/tests/oracle
+
+run() { # name dir args...
+    local name=$1 dir=$2
+    shift 2
+    for ext in obj glb gltf; do
+        (cd "$dir" && "$cga" generate "$@" --jobs 1 -o "$out/$name.$ext" \
+            --report "$out/$name.$ext.report.json" >"$out/$name.$ext.stdout" 2>"$out/$name.$ext.stderr") || echo "$name.$ext failed" >&2
+    done
+    (cd "$dir" && "$cga" generate "$@" --jobs 2 -o "$out/$name.j2.glb" >/dev/null 2>&1) || echo "$name.j2 failed" >&2
+    # The messages name the output folder.
+    sed -i "s|$out|OUT|g" "$out/$name".*.stderr
+}
+
+run candler.rect "$oracle" candler/rules/candler.cga --lot rect:20,30
+run candler.footprint "$oracle" candler/rules/candler.cga --lot lots/candler_footprint.obj
+run candler.3dprint "$oracle" candler/rules/candler.cga --lot lots/candler_footprint.obj --attr Mode=3DPrint
+run candler.grid "$oracle" candler/rules/candler.cga --lot grid:2x2:lots/candler_footprint.obj
+run identity "$oracle/identity" rules/identity.cga
+run fhv "$oracle/FacesHolesVerticesrule" rules/FacesHolesVerticesrule.cga
+run arrayAttrs "$oracle/arrayAttrs" rules/arrayAttrs.cga
+run arrayAttrs2d "$oracle/arrayAttrs2d" rules/arrayAttrs2d.cga
+run dynamic_imports "$oracle/dynamic_imports" rules/prt3_dynamic_imports/ruleA.cga
+run extrusion "$oracle/extrusion_rule" rules/extrusion_rule.cga --attr minBuildingHeight=23 --attr maxBuildingHeight=23
+run extrusion.seed "$oracle/extrusion_rule" rules/extrusion_rule.cga --seed 7
+run envelope "$oracle/envelope2002" rules/typology/envelope2002.cga --lot "$oracle/lots/building_parcel.obj" --seed 666
+run city "$root" examples/building.cga --lot grid:6x6

@@ -18,7 +18,31 @@ fn prints_go_to_stdout_in_derivation_order_and_nothing_else() {
     );
     let out = run(&["generate", rules.to_str().unwrap()]);
     assert!(out.status.success(), "{}", stderr(&out));
-    assert_eq!(stdout(&out), "first\n4\nin A 2\nlast\n");
+    // A rule's own operations all run before the rules it calls: CityEngine
+    // derives in generation (breadth-first) order.
+    assert_eq!(stdout(&out), "first\n4\nlast\nin A 2\n");
+}
+
+#[test]
+fn rules_are_derived_generation_by_generation() {
+    // Measured with CityEngine's runtime: every rule of one generation prints
+    // before any rule of the next, in the order the shapes were created.
+    let dir = temp_dir("generations");
+    let rules = rule_file(
+        &dir,
+        "g.cga",
+        "Lot --> print(1) B1 B2\n\
+         B1 --> print(10) C1\n\
+         B2 --> print(11) C2\n\
+         C1 --> print(20) D1 D2\n\
+         C2 --> NIL\n\
+         D1 --> print(100) E\n\
+         D2 --> print(200)\n\
+         E --> print(1000)\n",
+    );
+    let out = run(&["generate", rules.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(stdout(&out), "1\n10\n11\n20\n100\n200\n1000\n");
 }
 
 #[test]
@@ -458,4 +482,51 @@ fn assets_are_found_from_a_relative_rule_path() {
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
     assert_eq!(stdout(&out), "1\n");
+}
+
+#[test]
+fn slow_lots_stop_at_the_time_limit() {
+    let dir = temp_dir("time");
+    let rules = rule_file(
+        &dir,
+        "t.cga",
+        "Lot --> split(x) { ~0.01 : A }*\nA --> split(z) { ~0.5 : B. }*\n",
+    );
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--max-seconds",
+        "0.000001",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("time limit (0.000001 s)"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+#[test]
+fn assets_over_the_size_limit_are_a_warning() {
+    let dir = temp_dir("asset-size");
+    std::fs::write(
+        dir.join("big.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".repeat(300),
+    )
+    .unwrap();
+    let rules = rule_file(
+        &dir,
+        "a.cga",
+        "Lot --> i(\"big.obj\") print(geometry.nFaces)\n",
+    );
+    let out = run(&["generate", rules.to_str().unwrap(), "--max-asset-mib", "0"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("larger than the asset size limit (0 MiB"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(stdout(&out), "1\n", "the lot keeps its own geometry");
+    let out = run(&["generate", rules.to_str().unwrap()]);
+    assert_eq!(stdout(&out), "300\n");
 }

@@ -21,9 +21,10 @@ use clap::{Args, Parser, Subcommand};
 use cga_engine::derive::Leaf;
 use cga_engine::generate::generate_lot_streaming;
 use cga_engine::generate::parse_value;
+use cga_engine::geo::GeoOrigin;
 use cga_engine::lot::{self, Lot};
 use cga_engine::{GenerateOptions, Limits, LotOutput, RtError};
-use cga_export::{ExportOptions, Format, ModelWriter};
+use cga_export::{ExportOptions, Format, Georeference, ModelWriter};
 use cga_syntax::{Diagnostic, SourceMap};
 
 #[derive(Parser)]
@@ -216,11 +217,15 @@ fn diagnostic_json(d: &Diagnostic, sources: &SourceMap) -> serde_json::Value {
     v
 }
 
-fn read_lots(specs: &[String]) -> Result<Vec<Lot>, Failure> {
+/// The lots of the `--lot` options, and the geographic origin of their
+/// frame when some were given in longitude/latitude (all geographic files
+/// are projected about the first one's origin, so they share one frame).
+fn read_lots(specs: &[String]) -> Result<(Vec<Lot>, Option<GeoOrigin>), Failure> {
     if specs.is_empty() {
-        return Ok(vec![lot::rect(20.0, 30.0)]);
+        return Ok((vec![lot::rect(20.0, 30.0)], None));
     }
     let mut lots = Vec::new();
+    let mut frame: Option<GeoOrigin> = None;
     for spec in specs {
         if let Some(rect) = spec.strip_prefix("rect:") {
             lots.push(lot::parse_rect(rect).map_err(Failure::Usage)?);
@@ -239,18 +244,19 @@ fn read_lots(specs: &[String]) -> Result<Vec<Lot>, Failure> {
             Some("obj") => lot::from_obj(path),
             Some(ext @ ("geojson" | "json" | "fgb")) => {
                 let read = if ext == "fgb" {
-                    lot::from_flatgeobuf(path)
+                    lot::from_flatgeobuf(path, frame)
                 } else {
-                    lot::from_geojson_georeferenced(path)
+                    lot::from_geojson_georeferenced(path, frame)
                 };
                 read.map(|(lots, origin)| {
                     if let Some(o) = origin {
                         eprintln!(
-                            "note: {} is in longitude/latitude; lots are in metres east (x) and north (-z) of lon {:.7}, lat {:.7}",
+                            "note: {} is in longitude/latitude; lots are in metres east (x) and north (-z) of lon {:.7}, lat {:.7} (recorded in the output)",
                             path.display(),
                             o.lon,
                             o.lat
                         );
+                        frame = Some(o);
                     }
                     lots
                 })
@@ -263,7 +269,7 @@ fn read_lots(specs: &[String]) -> Result<Vec<Lot>, Failure> {
         };
         lots.extend(more.map_err(Failure::Usage)?);
     }
-    Ok(lots)
+    Ok((lots, frame))
 }
 
 /// `grid:COLSxROWS` (20 x 30 lots) or `grid:COLSxROWS:LOTS.obj` (copies of
@@ -325,7 +331,7 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
         })?),
         None => None,
     };
-    let lots = read_lots(&args.lots)?;
+    let (lots, geo_origin) = read_lots(&args.lots)?;
     let mut sources = SourceMap::new();
     let program = load(&args.rules, &mut sources)?;
     let rule = program
@@ -378,6 +384,11 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
                 .unwrap_or_default();
             let export = ExportOptions {
                 texture_roots: project_roots(&root),
+                georeference: geo_origin.map(|o| Georeference {
+                    longitude: o.lon,
+                    latitude: o.lat,
+                    earth_radius: cga_engine::geo::EARTH_RADIUS,
+                }),
                 ..ExportOptions::default()
             };
             Some(

@@ -416,6 +416,114 @@ fn geographic_geojson_is_projected_to_metres() {
 }
 
 #[test]
+fn geographic_origin_is_recorded_in_the_output_and_shared_by_all_files() {
+    // Two blocks 0.001 deg of longitude apart, in two files: both are
+    // projected about the first file's centre, and the output says where
+    // that is so the model can be placed back on the globe.
+    let dir = temp_dir("georef");
+    let rules = rule_file(&dir, "g.cga", "Lot --> extrude(3) X.\n");
+    let block = |name: &str, lon: f64| {
+        let path = dir.join(name);
+        std::fs::write(
+            &path,
+            format!(
+                r#"{{"type":"FeatureCollection","features":[{{"type":"Feature","properties":{{}},"geometry":{{"type":"Polygon",
+                   "coordinates":[[[{a},47.3700],[{b},47.3700],[{b},47.3702],[{a},47.3702],[{a},47.3700]]]}}}}]}}"#,
+                a = lon,
+                b = lon + 0.0004
+            ),
+        )
+        .unwrap();
+        path
+    };
+    let first = block("a.geojson", 8.5400);
+    let second = block("b.geojson", 8.5410);
+    let glb = dir.join("city.gltf");
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--lot",
+        first.to_str().unwrap(),
+        "--lot",
+        second.to_str().unwrap(),
+        "-o",
+        glb.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_valid_gltf(&glb);
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&glb).unwrap()).unwrap();
+    let g = &doc["asset"]["extras"]["georeference"];
+    assert_eq!(g["crs"], "EPSG:4326");
+    // The first file's centre: the mean of its five ring positions.
+    let lon = g["origin"]["longitude"].as_f64().unwrap();
+    let lat = g["origin"]["latitude"].as_f64().unwrap();
+    assert!(
+        (lon - (8.5400 * 3.0 + 8.5404 * 2.0) / 5.0).abs() < 1e-12,
+        "{lon}"
+    );
+    assert!(
+        (lat - (47.3700 * 3.0 + 47.3702 * 2.0) / 5.0).abs() < 1e-12,
+        "{lat}"
+    );
+    assert_eq!(g["earthRadius"].as_f64(), Some(6_371_008.8));
+    // The second block lies 0.001 deg (about 75.4 m) east of the first.
+    let s = summarize_gltf_bounds(&glb);
+    let k = std::f64::consts::PI / 180.0 * 6_371_008.8 * lat.to_radians().cos();
+    let width = (0.0014 * k) as f32;
+    assert!((s.1[0] - s.0[0] - width).abs() < 0.01, "{s:?} vs {width}");
+
+    let obj = dir.join("city.obj");
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--lot",
+        first.to_str().unwrap(),
+        "-o",
+        obj.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = std::fs::read_to_string(&obj).unwrap();
+    let header = text.lines().nth(1).unwrap();
+    assert!(
+        header.starts_with(&format!(
+            "# georeference: origin longitude {lon} latitude {lat}"
+        )),
+        "{header}"
+    );
+    // Lots in metres carry no georeference.
+    let plain = dir.join("plain.obj");
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "-o",
+        plain.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!std::fs::read_to_string(&plain)
+        .unwrap()
+        .contains("georeference"));
+}
+
+/// The (min, max) of the POSITION accessors of a glTF file.
+fn summarize_gltf_bounds(path: &std::path::Path) -> ([f32; 3], [f32; 3]) {
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    for m in doc["meshes"].as_array().unwrap() {
+        for p in m["primitives"].as_array().unwrap() {
+            let a = &doc["accessors"][p["attributes"]["POSITION"].as_u64().unwrap() as usize];
+            for k in 0..3 {
+                lo[k] = lo[k].min(a["min"][k].as_f64().unwrap() as f32);
+                hi[k] = hi[k].max(a["max"][k].as_f64().unwrap() as f32);
+            }
+        }
+    }
+    (lo, hi)
+}
+
+#[test]
 fn flatgeobuf_lots_with_attributes() {
     use flatgeobuf::{ColumnType, FgbWriter, FgbWriterOptions, GeometryType};
     use geozero::{ColumnValue, PropertyProcessor};

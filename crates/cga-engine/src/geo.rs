@@ -9,7 +9,7 @@
 //! back on the globe.
 
 /// Mean Earth radius (WGS84), metres.
-const EARTH_RADIUS: f64 = 6_371_008.8;
+pub const EARTH_RADIUS: f64 = 6_371_008.8;
 
 /// The geographic point at the local frame's origin.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -53,8 +53,10 @@ pub fn looks_geographic(points: &[[f64; 2]]) -> bool {
 }
 
 /// Projects a GeoJSON document's coordinates to local metres (x east, y
-/// north, z kept) if they look geographic; returns the origin used.
-pub fn localize_geojson(gj: &mut geojson::GeoJson) -> Option<GeoOrigin> {
+/// north, z kept) if they look geographic; returns the origin used: `frame`
+/// when given (so that several files share one frame), else the centre of
+/// the data.
+pub fn localize_geojson(gj: &mut geojson::GeoJson, frame: Option<GeoOrigin>) -> Option<GeoOrigin> {
     let mut points = Vec::new();
     for_each_position(gj, &mut |p| {
         if p.len() >= 2 {
@@ -65,10 +67,10 @@ pub fn localize_geojson(gj: &mut geojson::GeoJson) -> Option<GeoOrigin> {
         return None;
     }
     let n = points.len() as f64;
-    let origin = GeoOrigin {
+    let origin = frame.unwrap_or(GeoOrigin {
         lon: points.iter().map(|p| p[0]).sum::<f64>() / n,
         lat: points.iter().map(|p| p[1]).sum::<f64>() / n,
-    };
+    });
     for_each_position(gj, &mut |p| {
         if p.len() >= 2 {
             let (x, y) = origin.to_local(p[0], p[1]);

@@ -256,25 +256,29 @@ fn first_edge_frame(mesh: &Mesh) -> (DVec3, DVec3) {
 /// per polygon); holes are kept; feature properties become attribute values.
 /// GeoJSON `[x, y, z]` maps to `(x, z, -y)`: y up, north away from the viewer.
 pub fn from_geojson(path: &std::path::Path) -> Result<Vec<Lot>, String> {
-    from_geojson_georeferenced(path).map(|(lots, _)| lots)
+    from_geojson_georeferenced(path, None).map(|(lots, _)| lots)
 }
 
 /// The lots of a GeoJSON file and, when its coordinates are geographic
 /// (longitude, latitude in degrees, as RFC 7946 specifies), the origin of
 /// the local metric frame they were projected into: x east and -z north in
-/// metres from that origin (see [`crate::geo`]).
+/// metres from that origin (see [`crate::geo`]). `frame`: the origin to
+/// project into (an earlier file's, so that lots of several files share one
+/// frame); `None`: the centre of this file's data.
 pub fn from_geojson_georeferenced(
     path: &std::path::Path,
+    frame: Option<crate::geo::GeoOrigin>,
 ) -> Result<(Vec<Lot>, Option<crate::geo::GeoOrigin>), String> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| format!("cannot read lot file {}: {e}", path.display()))?;
-    lots_from_geojson_text(path, &text)
+    lots_from_geojson_text(path, &text, frame)
 }
 
 /// The lots of a FlatGeobuf file (each polygon one lot, attributes from the
 /// feature properties), like [`from_geojson_georeferenced`].
 pub fn from_flatgeobuf(
     path: &std::path::Path,
+    frame: Option<crate::geo::GeoOrigin>,
 ) -> Result<(Vec<Lot>, Option<crate::geo::GeoOrigin>), String> {
     use geozero::GeozeroDatasource;
     let bad = |e: &dyn std::fmt::Display| format!("cannot read FlatGeobuf {}: {e}", path.display());
@@ -287,17 +291,18 @@ pub fn from_flatgeobuf(
     fgb.process(&mut geozero::geojson::GeoJsonWriter::new(&mut json))
         .map_err(|e| bad(&e))?;
     let text = String::from_utf8(json).map_err(|e| bad(&e))?;
-    lots_from_geojson_text(path, &text)
+    lots_from_geojson_text(path, &text, frame)
 }
 
 fn lots_from_geojson_text(
     path: &std::path::Path,
     text: &str,
+    frame: Option<crate::geo::GeoOrigin>,
 ) -> Result<(Vec<Lot>, Option<crate::geo::GeoOrigin>), String> {
     let mut gj: geojson::GeoJson = text
         .parse()
         .map_err(|e| format!("{} is not valid GeoJSON: {e}", path.display()))?;
-    let origin = crate::geo::localize_geojson(&mut gj);
+    let origin = crate::geo::localize_geojson(&mut gj, frame);
     let features: Vec<geojson::Feature> = match gj {
         geojson::GeoJson::FeatureCollection(fc) => fc.features,
         geojson::GeoJson::Feature(f) => vec![f],

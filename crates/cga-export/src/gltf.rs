@@ -286,6 +286,8 @@ pub(crate) struct GltfWriter {
     binary: bool,
     /// GLB: put images into the binary chunk (else refer to them by URI).
     embed_images: bool,
+    /// `asset.extras` (the georeference of geographic lots).
+    asset_extras: Option<serde_json::Value>,
     /// `.gltf`: file name of the `.bin` beside it.
     bin_name: String,
     buckets: Vec<Bucket>,
@@ -311,6 +313,7 @@ impl GltfWriter {
         path: &Path,
         binary: bool,
         embed_images: bool,
+        asset_extras: Option<serde_json::Value>,
     ) -> Result<GltfWriter, ExportError> {
         let file = File::create(path).map_err(|e| ExportError::io(path, e))?;
         let stem = path
@@ -321,6 +324,7 @@ impl GltfWriter {
             out: BufWriter::with_capacity(1 << 16, file),
             binary,
             embed_images: binary && embed_images,
+            asset_extras,
             bin_name: format!("{stem}.bin"),
             buckets: Vec::new(),
             maps: Vec::new(),
@@ -545,6 +549,10 @@ impl GltfWriter {
         let mut root = json::Root {
             asset: json::Asset {
                 generator: Some("CGA engine (cga-export)".into()),
+                extras: self
+                    .asset_extras
+                    .as_ref()
+                    .and_then(|v| serde_json::value::to_raw_value(v).ok()),
                 ..Default::default()
             },
             ..Default::default()

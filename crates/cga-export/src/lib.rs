@@ -86,6 +86,11 @@ pub struct ExportOptions {
     /// texture files where they were found, by a path relative to the output
     /// folder.
     pub embed_textures: bool,
+    /// Where the model's local frame lies on the globe, when the lots were
+    /// given in longitude/latitude and projected to metres. Written into the
+    /// output (glTF `asset.extras.georeference`, an OBJ header comment) so
+    /// that models can be placed back.
+    pub georeference: Option<Georeference>,
 }
 
 impl Default for ExportOptions {
@@ -93,7 +98,41 @@ impl Default for ExportOptions {
         ExportOptions {
             texture_roots: Vec::new(),
             embed_textures: true,
+            georeference: None,
         }
+    }
+}
+
+/// The geographic origin of a model's local metric frame: x is east, y up
+/// and -z north, in metres, of the point (`longitude`, `latitude`) (WGS84
+/// degrees), by the local equirectangular projection
+/// x = R·cos(lat0)·Δlon, -z = R·Δlat with R = `earth_radius`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Georeference {
+    pub longitude: f64,
+    pub latitude: f64,
+    pub earth_radius: f64,
+}
+
+impl Georeference {
+    /// The record written into glTF `asset.extras`.
+    fn to_json(self) -> serde_json::Value {
+        serde_json::json!({
+            "georeference": {
+                "crs": "EPSG:4326",
+                "origin": { "longitude": self.longitude, "latitude": self.latitude },
+                "projection": "local equirectangular: x = R*cos(latitude)*dLongitude east, -z = R*dLatitude north, y up; metres",
+                "earthRadius": self.earth_radius,
+            }
+        })
+    }
+
+    /// The comment line written at the top of an OBJ file.
+    fn obj_comment(self) -> String {
+        format!(
+            "# georeference: origin longitude {} latitude {} (EPSG:4326); x east, y up, -z north in metres (local equirectangular, R = {})",
+            self.longitude, self.latitude, self.earth_radius
+        )
     }
 }
 
@@ -229,13 +268,20 @@ impl ModelWriter {
         };
         let (sink, reserved) = match format {
             Format::Glb | Format::Gltf => {
-                let w =
-                    gltf::GltfWriter::create(path, format == Format::Glb, options.embed_textures)?;
+                let w = gltf::GltfWriter::create(
+                    path,
+                    format == Format::Glb,
+                    options.embed_textures,
+                    options.georeference.map(Georeference::to_json),
+                )?;
                 let reserved = w.file_names();
                 (Sink::Gltf(w), reserved)
             }
             Format::Obj => {
-                let w = obj::ObjWriter::create(path)?;
+                let w = obj::ObjWriter::create(
+                    path,
+                    options.georeference.map(Georeference::obj_comment),
+                )?;
                 let reserved = w.file_names();
                 (Sink::Obj(w), reserved)
             }

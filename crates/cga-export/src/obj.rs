@@ -72,7 +72,7 @@ pub(crate) struct ObjWriter {
 }
 
 impl ObjWriter {
-    pub(crate) fn create(path: &Path) -> Result<ObjWriter, ExportError> {
+    pub(crate) fn create(path: &Path, header: Option<String>) -> Result<ObjWriter, ExportError> {
         let file = File::create(path).map_err(|e| ExportError::io(path, e))?;
         let stem = path
             .file_stem()
@@ -80,8 +80,11 @@ impl ObjWriter {
         let mtl_name = format!("{stem}.mtl");
         let mut out = BufWriter::with_capacity(1 << 16, file);
         // Material names are tokens (no spaces), the MTL file name may not be.
-        writeln!(out, "# CGA engine model\nmtllib {mtl_name}")
-            .map_err(|e| ExportError::io(path, e))?;
+        writeln!(out, "# CGA engine model").map_err(|e| ExportError::io(path, e))?;
+        if let Some(h) = header {
+            writeln!(out, "{h}").map_err(|e| ExportError::io(path, e))?;
+        }
+        writeln!(out, "mtllib {mtl_name}").map_err(|e| ExportError::io(path, e))?;
         Ok(ObjWriter {
             path: path.to_path_buf(),
             out,

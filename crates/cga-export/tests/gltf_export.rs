@@ -178,6 +178,7 @@ fn embedded_png_texture_and_flipped_uvs() {
     let options = ExportOptions {
         texture_roots: vec![dir.join("elsewhere"), project.clone()],
         embed_textures: true,
+        georeference: None,
     };
 
     let glb = dir.join("out/textured.glb");

@@ -133,6 +133,7 @@ fn textures_uvs_and_maps() {
         ExportOptions {
             texture_roots: vec![project.clone()],
             embed_textures: true,
+            georeference: None,
         },
     );
     assert_eq!(stats.textures, 2);
@@ -170,6 +171,7 @@ fn textures_uvs_and_maps() {
         ExportOptions {
             texture_roots: vec![project],
             embed_textures: false,
+            georeference: None,
         },
     );
     assert_eq!(
@@ -200,6 +202,7 @@ fn textures_with_the_same_file_name_get_distinct_copies() {
         ExportOptions {
             texture_roots: vec![dir.clone()],
             embed_textures: true,
+            georeference: None,
         },
     );
     let obj = read_obj(&path);
@@ -292,6 +295,7 @@ fn quad_summary_matches_the_reference_summary_script() {
         ExportOptions {
             texture_roots: vec![dir.clone()],
             embed_textures: true,
+            georeference: None,
         },
     );
     let out = match Command::new("python3").arg(&script).arg(&path).output() {

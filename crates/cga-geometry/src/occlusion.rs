@@ -288,7 +288,7 @@ impl OcclusionMesh {
                 PointSide::Outside => any_out = true,
                 PointSide::On => {}
             }
-            !((any_in && any_out) || (any_in && stop_at_inside))
+            !(any_in && (any_out || stop_at_inside))
         });
         (any_in, any_out)
     }
@@ -1036,7 +1036,7 @@ mod tests {
             (seed >> 11) as f64 / (1u64 << 53) as f64
         };
         for _ in 0..40 {
-            let mut mk = |rnd: &mut dyn FnMut() -> f64| {
+            let mk = |rnd: &mut dyn FnMut() -> f64| {
                 let rot =
                     DMat3::from_euler(glam::EulerRot::YXZ, rnd() * 6.0, rnd() * 6.0, rnd() * 6.0);
                 let o = DVec3::new(rnd() * 4.0, rnd() * 4.0, rnd() * 4.0);

@@ -214,6 +214,16 @@ impl OcclusionMesh {
         self.volume
     }
 
+    /// The surface area (of the faces that have one).
+    pub fn area(&self) -> f64 {
+        (0..self.tris.len())
+            .map(|k| {
+                let [a, b, c] = self.tri(k);
+                0.5 * (b - a).cross(c - a).length()
+            })
+            .sum()
+    }
+
     /// Axis-aligned bounds `(min, max)`; inverted (min > max) when empty.
     pub fn bounds(&self) -> (DVec3, DVec3) {
         (self.min, self.max)
@@ -763,6 +773,7 @@ mod tests {
         let c = boxed(DVec3::new(5.0, 0.0, 0.0), DVec3::new(2.0, 3.0, 4.0));
         assert!(c.is_closed());
         assert!((c.volume() - 24.0).abs() < 1e-9);
+        assert!((c.area() - 52.0).abs() < 1e-9);
         assert_eq!(
             c.bounds(),
             (DVec3::new(5.0, 0.0, 0.0), DVec3::new(7.0, 3.0, 4.0))

@@ -17,6 +17,7 @@ fuzz_target!(|data: &[u8]| {
         limits: Limits {
             max_depth: 64,
             max_shapes: 2000,
+            max_seconds: 5.0,
         },
         ..GenerateOptions::default()
     };

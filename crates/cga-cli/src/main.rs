@@ -86,6 +86,12 @@ struct GenerateArgs {
     /// Maximum number of shapes per lot.
     #[arg(long, default_value_t = Limits::default().max_shapes)]
     max_shapes: usize,
+    /// Maximum time per lot, in seconds.
+    #[arg(long, default_value_t = Limits::default().max_seconds)]
+    max_seconds: f64,
+    /// Largest asset file (OBJ, tables, texts) that is read, in MiB.
+    #[arg(long, default_value_t = cga_engine::assets::DEFAULT_MAX_ASSET_MIB)]
+    max_asset_mib: u64,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -330,6 +336,7 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
         limits: Limits {
             max_depth: args.max_depth,
             max_shapes: args.max_shapes,
+            max_seconds: args.max_seconds,
         },
         // The writer places each leaf's shared mesh while writing: no leaf
         // is copied into object coordinates first.
@@ -361,7 +368,7 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
         options.attrs.push((id, parse_value(value)));
     }
 
-    let assets = cga_engine::assets::Assets::new(&sources);
+    let assets = cga_engine::assets::Assets::new(&sources).with_max_file_mib(args.max_asset_mib);
     let mut writer = match (&args.output, format) {
         (Some(path), Some(format)) => {
             let root = args

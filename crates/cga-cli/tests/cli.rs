@@ -459,3 +459,50 @@ fn assets_are_found_from_a_relative_rule_path() {
     assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
     assert_eq!(stdout(&out), "1\n");
 }
+
+#[test]
+fn slow_lots_stop_at_the_time_limit() {
+    let dir = temp_dir("time");
+    let rules = rule_file(
+        &dir,
+        "t.cga",
+        "Lot --> split(x) { ~0.01 : A }*\nA --> split(z) { ~0.5 : B. }*\n",
+    );
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--max-seconds",
+        "0.000001",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("time limit (0.000001 s)"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+#[test]
+fn assets_over_the_size_limit_are_a_warning() {
+    let dir = temp_dir("asset-size");
+    std::fs::write(
+        dir.join("big.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".repeat(300),
+    )
+    .unwrap();
+    let rules = rule_file(
+        &dir,
+        "a.cga",
+        "Lot --> i(\"big.obj\") print(geometry.nFaces)\n",
+    );
+    let out = run(&["generate", rules.to_str().unwrap(), "--max-asset-mib", "0"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("larger than the asset size limit (0 MiB"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(stdout(&out), "1\n", "the lot keeps its own geometry");
+    let out = run(&["generate", rules.to_str().unwrap()]);
+    assert_eq!(stdout(&out), "300\n");
+}

@@ -16,9 +16,14 @@ use cga_syntax::{FileId, SourceMap};
 
 use crate::resolve::find_relative;
 
+/// Default largest asset file read, in MiB (`--max-asset-mib`).
+pub const DEFAULT_MAX_ASSET_MIB: u64 = 512;
+
 pub struct Assets {
     /// The rule file of each source file id.
     files: Vec<PathBuf>,
+    /// Larger asset files are not read: a warning, the model goes on.
+    max_file_bytes: u64,
     meshes: Mutex<HashMap<PathBuf, Result<Arc<Mesh>, String>>>,
     texts: Mutex<HashMap<PathBuf, Option<Arc<str>>>>,
     /// Answers by request (rule file, path as written), shared by all lots:
@@ -53,6 +58,7 @@ fn cached<T: Clone>(cache: &Requests<T>, from: FileId, path: &str, make: impl Fn
 impl Assets {
     pub fn new(sources: &SourceMap) -> Assets {
         Assets {
+            max_file_bytes: DEFAULT_MAX_ASSET_MIB << 20,
             // Absolute paths: searching the ancestors of `rules/a.cga` given
             // relative to the working directory must reach the project root.
             files: sources
@@ -76,6 +82,7 @@ impl Assets {
     /// An asset set with no rule files (tests).
     pub fn empty() -> Assets {
         Assets {
+            max_file_bytes: DEFAULT_MAX_ASSET_MIB << 20,
             files: Vec::new(),
             meshes: Mutex::new(HashMap::new()),
             texts: Mutex::new(HashMap::new()),
@@ -128,10 +135,31 @@ impl Assets {
         })
     }
 
+    /// Sets the largest asset file that is read, in MiB.
+    pub fn with_max_file_mib(mut self, mib: u64) -> Assets {
+        self.max_file_bytes = mib.saturating_mul(1 << 20);
+        self
+    }
+
+    /// Refuses files larger than the limit, before reading them.
+    fn check_size(&self, file: &std::path::Path) -> Result<(), String> {
+        let len = std::fs::metadata(file).map(|m| m.len()).unwrap_or(0);
+        if len > self.max_file_bytes {
+            return Err(format!(
+                "{} is {} MiB, larger than the asset size limit ({} MiB; raise it with --max-asset-mib)",
+                file.display(),
+                len >> 20,
+                self.max_file_bytes >> 20
+            ));
+        }
+        Ok(())
+    }
+
     fn load_mesh(&self, from: FileId, path: &str) -> Result<Arc<Mesh>, String> {
         let file = self
             .resolve(from, path)
             .ok_or_else(|| format!("asset \"{path}\" not found"))?;
+        self.check_size(&file)?;
         let mut cache = self.meshes.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(r) = cache.get(&file) {
             return r.clone();
@@ -176,6 +204,7 @@ impl Assets {
     /// with line endings normalised; cached.
     pub fn text(&self, from: FileId, path: &str) -> Option<Arc<str>> {
         let file = self.resolve(from, path)?;
+        self.check_size(&file).ok()?;
         let mut cache = self.texts.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(t) = cache.get(&file) {
             return t.clone();

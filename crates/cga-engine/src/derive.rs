@@ -30,6 +30,9 @@ pub struct Limits {
     pub max_depth: usize,
     /// Maximum number of shapes created for one initial shape.
     pub max_shapes: usize,
+    /// Maximum time for one initial shape, in seconds (checked as shapes
+    /// are created).
+    pub max_seconds: f64,
 }
 
 impl Default for Limits {
@@ -37,6 +40,7 @@ impl Default for Limits {
         Limits {
             max_depth: 1000,
             max_shapes: 5_000_000,
+            max_seconds: 300.0,
         }
     }
 }
@@ -251,6 +255,8 @@ pub struct Interp<'a> {
     /// or what the second pass answers from (`None` in programs without
     /// context queries).
     pub(crate) context: Option<Box<crate::context::ContextState>>,
+    /// When the derivation of this initial shape started (time limit).
+    started: std::time::Instant,
 }
 
 /// The last few (material attributes, geometry materials, rule file) →
@@ -463,6 +469,7 @@ impl<'a> Interp<'a> {
             memo: MeshMemo::default(),
             material_memo: MaterialMemo::default(),
             context: None,
+            started: std::time::Instant::now(),
         }
     }
 
@@ -558,6 +565,18 @@ impl<'a> Interp<'a> {
                 format!(
                     "shape limit ({}) reached for one initial shape: the rules create shapes without end (raise the limit with --max-shapes)",
                     self.limits.max_shapes
+                ),
+                span,
+            ));
+        }
+        // The clock is read every 1024 shapes: cheap, and soon enough.
+        if self.out.shapes % 1024 == 0
+            && self.started.elapsed().as_secs_f64() > self.limits.max_seconds
+        {
+            return Err(RtError::new(
+                format!(
+                    "time limit ({} s) reached for one initial shape (raise the limit with --max-seconds)",
+                    self.limits.max_seconds
                 ),
                 span,
             ));

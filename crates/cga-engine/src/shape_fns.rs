@@ -96,45 +96,27 @@ pub fn lookup(name: &str, arity: usize) -> Option<ShapeFn> {
         _ => None,
     };
     let zero = arity == 0;
-    if let Some(rest) = name.strip_prefix("scope.") {
-        if !zero {
+    // `t`, `r`, `s` (scope) or `p`, `o` (pivot, origin) and an axis: the
+    // index of the component in that attribute's vector list.
+    let component = |rest: &str, kinds: &[&str]| -> Option<u8> {
+        if !zero || rest.len() != 2 {
             return None;
         }
-        if rest == "elevation" {
+        let (kind, ax) = rest.split_at(1);
+        let k = kinds.iter().position(|&x| x == kind)? as u8;
+        axis(ax).map(|a| 3 * k + a)
+    };
+    if let Some(rest) = name.strip_prefix("scope.") {
+        if zero && rest == "elevation" {
             return Some(ShapeFn::ScopeElevation);
         }
-        let (kind, ax) = rest.split_at(1);
-        let base = match kind {
-            "t" => 0,
-            "r" => 3,
-            "s" => 6,
-            _ => return None,
-        };
-        return axis(ax).map(|a| ShapeFn::Scope(base + a));
+        return component(rest, &["t", "r", "s"]).map(ShapeFn::Scope);
     }
     if let Some(rest) = name.strip_prefix("pivot.") {
-        if !zero || rest.len() != 2 {
-            return None;
-        }
-        let (kind, ax) = rest.split_at(1);
-        let base = match kind {
-            "p" => 0,
-            "o" => 3,
-            _ => return None,
-        };
-        return axis(ax).map(|a| ShapeFn::Pivot(base + a));
+        return component(rest, &["p", "o"]).map(ShapeFn::Pivot);
     }
     if let Some(rest) = name.strip_prefix("initialShape.origin.") {
-        if !zero || rest.len() != 2 {
-            return None;
-        }
-        let (kind, ax) = rest.split_at(1);
-        let base = match kind {
-            "p" => 0,
-            "o" => 3,
-            _ => return None,
-        };
-        return axis(ax).map(|a| ShapeFn::InitialShapeOrigin(base + a));
+        return component(rest, &["p", "o"]).map(ShapeFn::InitialShapeOrigin);
     }
     if name.starts_with("material.") {
         return if zero {

@@ -422,10 +422,143 @@ fn minimum_distance_places() {
                Check --> case minimumDistance(intra,\"label\") < 1 : NIL\n          else : primitiveCylinder(16, 0.05, 0.5)\n";
     let outs = run(src, &[lot::rect(20.0, 0.5)]);
     let out = &outs[0];
-    // 40 places; labeled: 0, 10, 20, 30. The labeled cylinders' scopes are
-    // 0.1 wide at the places' corners; a place's scope is 0.5 wide: places
-    // 1 and 2 away from a labeled one are within 1 (gaps 0.4 and 0.9).
+    // 40 places; labeled: 0, 10, 20, 30. A labeled cylinder's scope is
+    // 0.2 wide in the middle of its place (x 0.15..0.35 of place 0); a
+    // place's scope is 0.5 wide: the places 1 and 2 away from a labeled one
+    // are within 1 (gaps 0.15 and 0.65), those 3 away are not (1.15).
     assert_eq!(count(out, RED), 4);
     let plain = out.meshes.len() - 4;
     assert_eq!(plain, 40 - 4 - 4 * 2 - 3 * 2);
+}
+
+/// The scene of func_occlusion's "Labels" examples with the scattered
+/// houses and trees placed by hand (scatter is not run by this engine) and
+/// the trees made boxes (`builtin:cube`, closed like the tree assets):
+///
+/// - house A, 10 x 10 x 10, at x 2..12, z 2..12 of the lot's scope;
+///   house B, 10 x 10 x 5, beside it at x 12..22 (sharing the wall x = 12);
+/// - tree T1 (2 x 4 x 2) standing against A's front (z 12..14, x 3..5);
+/// - tree T2 standing half in A's front (z 11..13, x 8..10);
+/// - trees T3 and T4 overlapping each other (x 30..32 and 31..33);
+/// - tree T5 alone (x 40..42).
+///
+/// Facades are tiles of 5 x 5 (A: 2 x 2 per side, B: 1 x 2); the tile
+/// rule is the example's, with a red wall for `touches` and a green
+/// window for the setback. `{tile}` and `{check}` are the query rules.
+fn labels_scene(tile: &str, check: &str, house_label: bool) -> String {
+    format!(
+        "Field --> [ t(2, 0, 2) s(10, 0, 10) primitiveQuad() House(10) ]\n\
+         [ t(12, 0, 2) s(10, 0, 10) primitiveQuad() House(5) ]\n\
+         [ t(3, 0, 12) PlaceTree ] [ t(8, 0, 11) PlaceTree ]\n\
+         [ t(30, 0, 6) PlaceTree ] [ t(31, 0, 7) PlaceTree ] [ t(40, 0, 6) PlaceTree ]\n\
+         Ground\n\
+         Ground --> color(0, 0, 1)\n\
+         PlaceTree --> s(2, 4, 2) i(\"builtin:cube\") CheckOverlap\n\
+         House(h) --> extrude(h) {label} comp(f) {{ side : Facade | top : Roof. }}\n\
+         Facade --> split(y) {{ ~5 : split(x) {{ ~5 : Tile }}* }}*\n\
+         Tile --> {tile}\n\
+         CheckOverlap --> {check}\n\
+         Wall --> color(1, 0, 0)\n\
+         Window --> color(0, 1, 0)\n\
+         Tree --> color(0.5, 0.25, 0)\n",
+        label = if house_label { "label(\"block\")" } else { "" },
+    )
+}
+
+const BROWN: [u8; 3] = [128, 64, 0];
+
+/// (walls, windows, trees) of a labels scene.
+fn labels_outcome(tile: &str, check: &str, house_label: bool) -> (usize, usize, usize) {
+    let outs = run(
+        &labels_scene(tile, check, house_label),
+        &[lot::rect(50.0, 20.0)],
+    );
+    let out = &outs[0];
+    // The lot (blue) and the two roofs (white) are the other leaves.
+    assert_eq!(count(out, [0, 0, 255]), 1);
+    assert_eq!(count(out, WHITE), 2);
+    (count(out, RED), count(out, GREEN), count(out, BROWN))
+}
+
+const UNLABELED_TILE: &str = "case inside(intra) : NIL\n         \
+                              case touches(intra) : Wall\n         \
+                              else : Window";
+const LABELED_TILE: &str = "case inside(all, \"block\") : NIL\n         \
+                            case touches(all, \"block\") : Wall\n         \
+                            else : Window";
+
+/// func_occlusion, "Labels" 1: the trees are leaves, closed, so automatic
+/// occluders. Of A's 16 tiles the two low ones on the wall shared with B
+/// lie on B's block (inside: none), the low front ones touch T1 and T2
+/// (walls); of B's 8 the two on the shared wall lie on A's block. Every
+/// tree stays.
+#[test]
+fn labels_trees_are_occluders() {
+    assert_eq!(
+        labels_outcome(UNLABELED_TILE, "Tree", false),
+        (2, 12 + 6, 5)
+    );
+}
+
+/// func_occlusion, "Labels" 2: every tree overlapping something goes, T2
+/// (in house A) and both of T3 and T4 (in each other), though removing
+/// one of them would do; T1 only touches A and stays. The front tiles
+/// still become walls: they test against the first pass's trees, T2
+/// included.
+#[test]
+fn labels_overlapping_trees_are_removed() {
+    let check = "case overlaps(intra) : NIL\n                 else : Tree";
+    assert_eq!(labels_outcome(UNLABELED_TILE, check, false), (2, 18, 2));
+}
+
+/// func_occlusion, "Labels" 3: the blocks labeled "block" and the tiles
+/// asking about that label only: the trees no longer turn windows into
+/// walls; the tiles on the shared wall still lie on the other block.
+#[test]
+fn labels_tiles_test_only_blocks() {
+    let check = "case overlaps(intra) : NIL\n                 else : Tree";
+    assert_eq!(labels_outcome(LABELED_TILE, check, true), (0, 20, 2));
+}
+
+/// func_occlusion, "Labels" 4: the trees test against the blocks only, so
+/// T3 and T4 stay; T2 in house A still goes.
+#[test]
+fn labels_trees_test_only_blocks() {
+    let check = "case overlaps(intra, \"block\") : NIL\n                 else : Tree";
+    assert_eq!(labels_outcome(LABELED_TILE, check, true), (0, 20, 4));
+}
+
+/// func_occlusion, "Concrete example": a U-shaped mass of a main block
+/// (30 x 8) and two wings (8 x 12) from a subdivision split, 9 high, with
+/// window openings of 2 x 3. `touches(intra)` turns the openings where a
+/// wing meets the main block into walls: 4 x 3 on each wing's back and on
+/// the main block's front behind each wing (48 in all); the 7 x 3 openings
+/// of the main front between the wings stay windows.
+#[test]
+fn u_shaped_building_windows() {
+    let src = "Lot --> split(z) { 8 : Mass | ~1 : split(x) { 8 : Mass | ~1 : NIL | 8 : Mass } }\n\
+               Mass --> extrude(9) comp(f) { side : Facade | top : Roof. }\n\
+               Facade --> split(y) { 3 : split(x) { 2 : WindowOpening }* }*\n\
+               WindowOpening --> case touches(intra) : color(1, 0, 0) Wall.\n                 \
+               else : color(0, 1, 0) Window.\n";
+    let outs = run(src, &[lot::rect(30.0, 20.0)]);
+    let out = &outs[0];
+    // Openings: main 2 x 15 x 3 + 2 x 4 x 3, wings 2 x (2 x 4 x 3 + 2 x 6 x 3).
+    assert_eq!(out.meshes.len(), 114 + 120 + 3);
+    assert_eq!(count(out, RED), 48);
+    assert_eq!(count(out, GREEN), 234 - 48);
+    // The walls all lie in the plane where the wings meet the main block.
+    let z = -12.0;
+    for (m, c) in out.meshes.iter().zip(colours(out)) {
+        if c == RED {
+            assert!(m.positions.iter().all(|p| (p.z - z).abs() < 1e-9));
+        }
+    }
+    let windows_there = out
+        .meshes
+        .iter()
+        .zip(colours(out))
+        .filter(|(m, c)| *c == GREEN && m.positions.iter().all(|p| (p.z - z).abs() < 1e-9))
+        .count();
+    assert_eq!(windows_there, 21);
 }

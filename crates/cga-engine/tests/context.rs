@@ -273,7 +273,10 @@ fn inter_occlusion_two_houses() {
 /// keeps no tile on the shared wall, and the taller one keeps some.
 #[test]
 fn inter_occlusion_random_heights() {
-    let lots = [rect_at(0.0, 0.0, 10.0, 10.0), rect_at(10.0, 0.0, 10.0, 10.0)];
+    let lots = [
+        rect_at(0.0, 0.0, 10.0, 10.0),
+        rect_at(10.0, 0.0, 10.0, 10.0),
+    ];
     let outs = run(HOUSES, &lots);
     let height = |o: &LotOutput| {
         o.meshes
@@ -302,7 +305,10 @@ fn context_count_tiles() {
     let small = run(src, &[lot::rect(3.0, 3.0)]);
     assert_eq!(colours(&small[0]), vec![GREEN; 9]);
     // Intra counts are per initial shape: both lots at once change nothing.
-    let both = run(src, &[rect_at(0.0, 0.0, 4.0, 4.0), rect_at(10.0, 0.0, 3.0, 3.0)]);
+    let both = run(
+        src,
+        &[rect_at(0.0, 0.0, 4.0, 4.0), rect_at(10.0, 0.0, 3.0, 3.0)],
+    );
     assert_eq!(count(&both[0], RED), 16);
     assert_eq!(count(&both[1], GREEN), 9);
 }
@@ -312,7 +318,11 @@ fn context_count_tiles() {
 #[test]
 fn context_count_targets() {
     let src = "Lot --> label(\"x\") label(\"x\") print(contextCount(intra, \"x\") + \" \" + contextCount(inter, \"x\") + \" \" + contextCount(all, \"x\") + \" \" + contextCount(all, \"\") + \" \" + contextCount(all, \"y\"))\n";
-    let lots = [rect_at(0.0, 0.0, 1.0, 1.0), rect_at(5.0, 0.0, 1.0, 1.0), rect_at(500.0, 0.0, 1.0, 1.0)];
+    let lots = [
+        rect_at(0.0, 0.0, 1.0, 1.0),
+        rect_at(5.0, 0.0, 1.0, 1.0),
+        rect_at(500.0, 0.0, 1.0, 1.0),
+    ];
     assert_eq!(prints(&run(src, &lots)), ["2 4 6 0 0"; 3]);
 }
 
@@ -322,9 +332,14 @@ fn context_count_targets() {
 fn context_compare_highest() {
     let src = "Lot --> extrude(rand(10)) label(\"label\") Color\n\
                Color -->\n    case contextCompare(inter, \"label\", world.highest) == 0 :\n        color(1,0,0)\n    case contextCompare(inter, \"label\", world.lowest) == 0 :\n        color(0,1,0)\n    else :\n        color(0,0,1)\n";
-    let lots: Vec<Lot> = (0..7).map(|i| rect_at(12.0 * i as f64, 0.0, 10.0, 10.0)).collect();
+    let lots: Vec<Lot> = (0..7)
+        .map(|i| rect_at(12.0 * i as f64, 0.0, 10.0, 10.0))
+        .collect();
     let outs = run(src, &lots);
-    let heights: Vec<f64> = outs.iter().map(|o| measure::bounds(&o.meshes[0]).unwrap().1.y).collect();
+    let heights: Vec<f64> = outs
+        .iter()
+        .map(|o| measure::bounds(&o.meshes[0]).unwrap().1.y)
+        .collect();
     let top = heights
         .iter()
         .enumerate()
@@ -397,7 +412,10 @@ fn minimum_distance_grid() {
         assert!((h - e).abs() < 1e-6, "{h} vs {e}");
     }
     // The centre and its eight neighbours reach 1.
-    assert_eq!(heights.iter().filter(|&&h| (h - 1.0).abs() < 1e-9).count(), 9);
+    assert_eq!(
+        heights.iter().filter(|&&h| (h - 1.0).abs() < 1e-9).count(),
+        9
+    );
 }
 
 /// minimumDistance's targets: `inter` measures to other lots' labeled
@@ -405,7 +423,11 @@ fn minimum_distance_grid() {
 #[test]
 fn minimum_distance_targets() {
     let src = "Lot --> label(\"p\") print(minimumDistance(intra, \"p\") + \" \" + minimumDistance(inter, \"p\") + \" \" + minimumDistance(all, \"p\") + \" \" + minimumDistance(all, \"q\"))\n";
-    let lots = [rect_at(0.0, 0.0, 1.0, 1.0), rect_at(4.0, 0.0, 1.0, 1.0), rect_at(4.0, -104.0, 1.0, 1.0)];
+    let lots = [
+        rect_at(0.0, 0.0, 1.0, 1.0),
+        rect_at(4.0, 0.0, 1.0, 1.0),
+        rect_at(4.0, -104.0, 1.0, 1.0),
+    ];
     let outs = run(src, &lots);
     assert_eq!(prints(&outs), ["0 3 0 inf", "0 3 0 inf", "0 103 0 inf"]);
 }

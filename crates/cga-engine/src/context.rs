@@ -31,10 +31,14 @@
 //! from). Shapes are told apart across the two passes by their *address*:
 //! the ordinals of the successors on the way from the initial shape (the
 //! third part of a split of the second shape the initial shape made is
-//! `[1, 2]`). Both passes make the same shapes in the same order until a
-//! query answers differently, so an address names the same shape in both;
-//! an occluder is related to the query shape when one address is a prefix
-//! of the other.
+//! `[1, 2]`). A shape's ordinal counts only its parent's successors, so
+//! its address does not depend on what the rest of the derivation made
+//! before it: lots are derived generation by generation (breadth first),
+//! and a query that answers differently in pass 2 changes how many shapes
+//! are created before every later shape of the lot, but the address of a
+//! shape outside the changed branch stays the one it had in pass 1. An
+//! occluder is related to the query shape when one address is a prefix of
+//! the other.
 //!
 //! # Neighbourhood
 //!
@@ -650,7 +654,7 @@ struct Node {
 
 enum Pass {
     /// Pass 1: queries give defaults; shapes are recorded here.
-    Collect(LotContext),
+    Collect(Box<LotContext>),
     /// Pass 2: queries are answered from the records of pass 1.
     Answer {
         own: Arc<LotContext>,
@@ -701,7 +705,7 @@ impl ContextState {
     pub fn collecting(usage: ContextUse, bounds: Option<(DVec3, DVec3)>) -> Box<ContextState> {
         Box::new(ContextState::new(
             usage,
-            Pass::Collect(LotContext::new(bounds)),
+            Pass::Collect(Box::new(LotContext::new(bounds))),
         ))
     }
 
@@ -721,7 +725,7 @@ impl ContextState {
         match self.pass {
             Pass::Collect(mut lot) => {
                 lot.finish();
-                lot
+                *lot
             }
             Pass::Answer { .. } => LotContext::default(),
         }

@@ -18,7 +18,9 @@ use std::sync::mpsc;
 
 use clap::{Args, Parser, Subcommand};
 
+use cga_engine::context::{LotContext, SceneContext};
 use cga_engine::derive::Leaf;
+use cga_engine::generate::collect_lot;
 use cga_engine::generate::generate_lot_streaming;
 use cga_engine::generate::parse_value;
 use cga_engine::geo::GeoOrigin;
@@ -404,6 +406,20 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
             .map(|n| n.get())
             .unwrap_or(1)
     });
+    // Context queries: found once here rather than for every lot. `inter`
+    // queries need every lot's first pass before any lot's second one.
+    let usage = cga_engine::context::ContextUse::of(&program);
+    options.context_use = Some(usage);
+    if usage.inter && lots.len() > 1 {
+        options.scene = Some(std::sync::Arc::new(collect_scene(
+            &program,
+            &assets,
+            rule,
+            &lots,
+            &options,
+            jobs.max(1),
+        )?));
+    }
     let progress = progress_bar(lots.len());
 
     let mut failed_lots = 0usize;
@@ -514,6 +530,61 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
     } else {
         Ok(())
     }
+}
+
+/// The first pass of every lot (see `cga_engine::context`), for programs
+/// with `inter` context queries, on `jobs` threads. Each lot's records are
+/// put at its index, so the scene, and with it the output, does not depend
+/// on the number of threads.
+fn collect_scene(
+    program: &cga_engine::Program,
+    assets: &cga_engine::assets::Assets,
+    rule: cga_engine::program::RuleId,
+    lots: &[Lot],
+    options: &GenerateOptions,
+    jobs: usize,
+) -> Result<SceneContext, Failure> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let next = AtomicUsize::new(0);
+    let work = || {
+        let mut done = Vec::new();
+        loop {
+            let i = next.fetch_add(1, Ordering::Relaxed);
+            if i >= lots.len() {
+                break;
+            }
+            done.push((i, collect_lot(program, assets, rule, &lots[i], i, options)));
+        }
+        done
+    };
+    let mut slots: Vec<Option<LotContext>> =
+        std::iter::repeat_with(|| None).take(lots.len()).collect();
+    std::thread::scope(|scope| {
+        let mut workers = Vec::new();
+        for _ in 0..jobs.min(lots.len()) {
+            let worker = std::thread::Builder::new()
+                .stack_size(DERIVATION_STACK)
+                .spawn_scoped(scope, work)
+                .map_err(|e| Failure::Usage(format!("cannot start worker threads: {e}")))?;
+            workers.push(worker);
+        }
+        for w in workers {
+            // A worker that panicked leaves its lots empty: their second
+            // pass runs again and reports what went wrong there.
+            for (i, records) in w.join().unwrap_or_default() {
+                slots[i] = Some(records);
+            }
+        }
+        Ok::<(), Failure>(())
+    })?;
+    let records = slots
+        .into_iter()
+        .map(|r| r.unwrap_or_else(|| LotContext::new(None)))
+        .collect();
+    Ok(SceneContext::new(
+        records,
+        options.context_use.unwrap_or_default(),
+    ))
 }
 
 /// What the writing thread is handed for a lot, in order: its leaves as

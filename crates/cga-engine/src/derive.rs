@@ -266,6 +266,10 @@ pub struct Interp<'a> {
     pub(crate) material_memo: MaterialMemo,
     /// The final materials of recently emitted leaves (see `leaf_materials`).
     emitted: EmitCache,
+    /// Context queries: the shape tree and the records of the first pass,
+    /// or what the second pass answers from (`None` in programs without
+    /// context queries).
+    pub(crate) context: Option<Box<crate::context::ContextState>>,
     /// When the derivation of this initial shape started (time limit).
     started: std::time::Instant,
 }
@@ -481,6 +485,7 @@ impl<'a> Interp<'a> {
             frame_pool: Vec::new(),
             memo: MeshMemo::default(),
             material_memo: MaterialMemo::default(),
+            context: None,
             started: std::time::Instant::now(),
         }
     }
@@ -597,10 +602,13 @@ impl<'a> Interp<'a> {
     }
 
     /// [`child`](Interp::child) without counting it.
-    fn successor(&self, parent: &Shape) -> Shape {
+    fn successor(&mut self, parent: &Shape) -> Shape {
         let mut c = parent.clone();
         c.parent_scope = parent.scope;
         c.rng.set(parent.child_rng(parent.next_random().to_bits()));
+        if self.context.is_some() {
+            c.ctx = self.context_child(parent.ctx);
+        }
         c
     }
 
@@ -634,6 +642,14 @@ impl<'a> Interp<'a> {
     pub fn emit(&mut self, shape: &Shape) {
         if shape.geometry.is_empty() {
             return;
+        }
+        if self.context.is_some() {
+            // Leaves are occluders; the first pass of a program with context
+            // queries only records them (its model is not kept).
+            self.context_occluder(shape);
+            if self.context_collecting() {
+                return;
+            }
         }
         let (mesh, _) = shape.geometry.raw();
         let materials = self.leaf_materials(shape, &mesh.materials);

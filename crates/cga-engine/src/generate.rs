@@ -6,6 +6,7 @@ use std::sync::Arc;
 use cga_value::Value;
 
 use crate::assets::Assets;
+use crate::context::{ContextState, ContextUse, LotContext, SceneContext};
 use crate::derive::{InitialInfo, Interp, Leaf, Limits, LotOutput, RtError};
 use crate::expr::RExpr;
 use crate::lot::{initial_shape, Lot};
@@ -23,6 +24,15 @@ pub struct GenerateOptions {
     /// as meshes in object coordinates (`LotOutput::meshes`). Exporters
     /// place the leaves while writing, which saves a copy of every leaf.
     pub leaves: bool,
+    /// The program's context queries ([`ContextUse::of`]); `None`: found
+    /// out from the program on each call. A program with context queries
+    /// derives each lot twice (see `crate::context`).
+    pub context_use: Option<ContextUse>,
+    /// The first-pass records of every lot of the generation, for `inter`
+    /// context queries ([`collect_lot`], [`SceneContext::new`]). Without
+    /// it, a lot's first pass is run by [`generate_lot`] itself and inter
+    /// queries find no other lots.
+    pub scene: Option<Arc<SceneContext>>,
 }
 
 /// Derives one lot with `rule`. The output holds everything generated,
@@ -71,9 +81,6 @@ fn generate<'a>(
     options: &GenerateOptions,
     sink: Option<Box<dyn FnMut(Leaf) + 'a>>,
 ) -> (LotOutput, Option<RtError>) {
-    // Each lot has its own seed: the run's seed for the first lot, then the
-    // following numbers (`--seed 666` on one lot gives `seedian` 666).
-    let seed = options.seed.wrapping_add(lot_index as u64);
     if let Some(why) = crate::lot::degenerate(lot) {
         let mut out = LotOutput::default();
         out.warnings.push(cga_syntax::Diagnostic {
@@ -85,6 +92,112 @@ fn generate<'a>(
         });
         return (out, None);
     }
+    let usage = context_use(program, options);
+    let context = usage.any().then(|| {
+        // Pass 2 answers from pass 1's records: the scene's, or this lot's
+        // own first pass.
+        let own = match &options.scene {
+            Some(scene) => scene.lot(lot_index),
+            None => Arc::new(collect(
+                program, assets, rule, lot, lot_index, options, usage,
+            )),
+        };
+        ContextState::answering(usage, own, options.scene.clone(), lot_index)
+    });
+    let (out, error, _) = derive(
+        program, assets, rule, lot, lot_index, options, sink, context,
+    );
+    (out, error)
+}
+
+fn context_use(program: &Program, options: &GenerateOptions) -> ContextUse {
+    match (&options.scene, options.context_use) {
+        (Some(scene), _) => scene.usage(),
+        (None, Some(u)) => u,
+        (None, None) => ContextUse::of(program),
+    }
+}
+
+/// The first pass of lot `lot_index` for context queries: the lot is
+/// derived with every query giving its default, nothing is emitted, and
+/// the labeled shapes and occluders are recorded. Collect every lot and
+/// make a [`SceneContext`] of them for `inter` queries. Empty for
+/// programs without context queries and for skipped lots.
+pub fn collect_lot(
+    program: &Program,
+    assets: &Assets,
+    rule: RuleId,
+    lot: &Lot,
+    lot_index: usize,
+    options: &GenerateOptions,
+) -> LotContext {
+    let usage = context_use(program, options);
+    if !usage.any() || crate::lot::degenerate(lot).is_some() {
+        return LotContext::new(None);
+    }
+    collect(program, assets, rule, lot, lot_index, options, usage)
+}
+
+/// The scene of `lots` for `inter` context queries: the first pass of each
+/// ([`collect_lot`], one after the other; the `cga` command runs them on
+/// several threads). Give it to [`generate_lot`] in
+/// [`GenerateOptions::scene`] for each lot, with the lot's index in `lots`.
+pub fn collect_scene(
+    program: &Program,
+    assets: &Assets,
+    rule: RuleId,
+    lots: &[Lot],
+    options: &GenerateOptions,
+) -> SceneContext {
+    let usage = context_use(program, options);
+    let records = lots
+        .iter()
+        .enumerate()
+        .map(|(i, lot)| collect_lot(program, assets, rule, lot, i, options))
+        .collect();
+    SceneContext::new(records, usage)
+}
+
+fn collect(
+    program: &Program,
+    assets: &Assets,
+    rule: RuleId,
+    lot: &Lot,
+    lot_index: usize,
+    options: &GenerateOptions,
+    usage: ContextUse,
+) -> LotContext {
+    let state = ContextState::collecting(usage, crate::context::lot_bounds(&lot.mesh));
+    // Whatever the pass made before an error is recorded; the second pass
+    // stops on the same error and reports it.
+    let (_, _, state) = derive(
+        program,
+        assets,
+        rule,
+        lot,
+        lot_index,
+        options,
+        None,
+        Some(state),
+    );
+    state.map_or_else(|| LotContext::new(None), |s| s.into_lot_context())
+}
+
+/// One derivation of a lot (with a context state: one of its two passes).
+#[allow(clippy::too_many_arguments)]
+fn derive<'a>(
+    program: &'a Program,
+    assets: &'a Assets,
+    rule: RuleId,
+    lot: &Lot,
+    lot_index: usize,
+    options: &GenerateOptions,
+    sink: Option<Box<dyn FnMut(Leaf) + 'a>>,
+    context: Option<Box<ContextState>>,
+) -> (LotOutput, Option<RtError>, Option<Box<ContextState>>) {
+    // Each lot has its own seed: the run's seed for the first lot, then the
+    // following numbers (`--seed 666` on one lot gives `seedian` 666).
+    let seed = options.seed.wrapping_add(lot_index as u64);
     let shape = initial_shape(lot, seed, program.rule_symbol(rule));
     let info = InitialInfo {
         name: lot.name.clone(),
@@ -93,6 +206,7 @@ fn generate<'a>(
     let mut interp = Interp::new(program, assets, options.limits, info, shape, &[]);
     interp.keep_leaves = options.leaves || sink.is_some();
     interp.leaf_sink = sink;
+    interp.context = context;
     let mut error = None;
     // Lot attributes (GeoJSON properties) first, command-line values win.
     let lot_attrs = lot
@@ -114,7 +228,8 @@ fn generate<'a>(
             error = Some(e);
         }
     }
-    (std::mem::take(&mut interp.out), error)
+    let context = interp.context.take();
+    (std::mem::take(&mut interp.out), error, context)
 }
 
 /// A value given from outside (command line, GIS properties) in the type of

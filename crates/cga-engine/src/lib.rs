@@ -2,6 +2,7 @@
 //! shapes with it, and hands leaf geometry to the exporters.
 
 pub mod assets;
+pub mod context;
 pub mod derive;
 mod eval;
 pub mod expr;

@@ -225,6 +225,7 @@ pub fn initial_shape(lot: &Lot, seed: u64, name: u32) -> Shape {
         rng: std::cell::Cell::new(seed_stream(seed as f64)),
         seedian: seed as f64,
         name,
+        ctx: 0,
     }
 }
 

@@ -268,6 +268,11 @@ pub struct Shape {
     pub seedian: f64,
     /// The shape's symbol (rule or leaf name), an index into `Program::symbols`.
     pub name: u32,
+    /// The shape's node in the shape tree kept for context queries
+    /// (`crate::context`): its address tells ancestors and descendants
+    /// apart across the two derivation passes. 0 (the root) in programs
+    /// without context queries.
+    pub ctx: u32,
 }
 
 impl Shape {

@@ -52,8 +52,8 @@ pub enum ContextFn {
 /// (`inside(all, "x")`, `convert(x, scope, world, pos, 0, 0, 0)`).
 pub fn arg_is_selector(name: &str, pos: usize) -> bool {
     match name {
-        "inside" | "overlaps" | "touches" | "contextCount" | "contextCompare"
-        | "minimumDistance" => pos == 0,
+        "inside" | "overlaps" | "touches" | "contextCount" | "minimumDistance" => pos == 0,
+        "contextCompare" => pos == 0 || pos == 2,
         "convert" => pos < 4,
         "geometry.area" | "geometry.angle" | "geometry.isOriented" => pos == 0,
         "geometry.du" | "geometry.dv" | "geometry.hasTags" => pos == 1,
@@ -217,7 +217,7 @@ mod eval {
 
     use cga_value::Value;
 
-    use super::{ContextFn, GeometryFn, ShapeFn};
+    use super::{GeometryFn, ShapeFn};
     use crate::derive::{Interp, RtError};
     use crate::expr::RExpr;
     use crate::selectors::{Frames, Selector};
@@ -357,19 +357,7 @@ mod eval {
                 }
                 ShapeFn::Geometry(g) => self.geometry_fn(g, args, shape, at)?,
                 ShapeFn::File(f) => self.file_fn(f, args, shape, at)?,
-                ShapeFn::Context(c) => {
-                    // Without other shapes to query, nothing is occluded.
-                    self.warn_once(at.span, || {
-                        format!(
-                            "context query {c:?} is not supported yet; it finds no other shapes"
-                        )
-                    });
-                    match c {
-                        ContextFn::ContextCount | ContextFn::ContextCompare => fl(0.0),
-                        ContextFn::MinimumDistance => fl(f64::INFINITY),
-                        _ => Value::Bool(false),
-                    }
-                }
+                ShapeFn::Context(c) => self.context_query(c, args, shape, at)?,
             })
         }
 

@@ -21,6 +21,7 @@
 //! | [`primitive`] | `primitive*` and `builtin:cube` |
 //! | [`normals`] | `setNormals`, `softenNormals` |
 //! | [`obj`] | OBJ + MTL assets |
+//! | [`occlusion`] | `inside` / `overlaps` / `touches` between meshes, distance between boxes |
 //! | [`transform`] | affine transforms, reversing, merging |
 //! | [`roof`] | `roofHip`, `roofGable`, `roofPyramid`, `roofShed`, `roofRidge` |
 //! | [`roof_edges`] | `comp(e)`'s roof edge classes of any mesh |
@@ -40,6 +41,7 @@ pub mod measure;
 pub mod mesh;
 pub mod normals;
 pub mod obj;
+pub mod occlusion;
 pub mod perimeter;
 pub mod primitive;
 pub mod roof;

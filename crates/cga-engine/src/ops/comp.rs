@@ -1523,6 +1523,8 @@ pub fn exec(
     let kind = Kind::parse(&args[0])?;
     let align = parse_align(args.get(1))?;
     let entries = entries(block)?;
+    // The shape a component split runs on is an occluder (context queries).
+    cx.context_occluder(&st.shape);
     st.has_successor = true;
     let mesh = st.shape.geometry.local().clone();
     let mut comps = Components::new(mesh, kind, &st.shape, cx.initial.pivot.axes);

@@ -318,6 +318,8 @@ fn offset(
         Some(a) => selector(a, &["all", "inside", "border"])?,
         None => "all",
     };
+    // The shape an offset runs on is an occluder (context queries).
+    cx.context_occluder(&st.shape);
     let mesh = st.shape.geometry.local().clone();
     if mesh.faces.is_empty() {
         return Ok(());

@@ -7,6 +7,7 @@ mod cleanup;
 pub mod comp;
 mod create;
 mod footprint;
+mod label;
 mod roof;
 mod scope_ops;
 pub mod split;
@@ -98,6 +99,7 @@ pub enum Op {
     DeleteUV,
     CopyUV,
     InsertAlongUV,
+    Label,
 }
 
 /// How an operation's arguments are read by the resolver.
@@ -251,6 +253,7 @@ pub fn lookup(name: &str) -> Option<OpInfo> {
         "mirror" => info(Op::Mirror, 3, 3),
         "reduceGeometry" => info(Op::ReduceGeometry, 1, 1),
         "rectify" => info(Op::Rectify, 1, 1),
+        "label" => info(Op::Label, 1, 1),
         _ => None,
     }
 }
@@ -353,6 +356,7 @@ pub fn exec(
         Op::SplitArea => split_area::exec(cx, st, call, args, frame),
         Op::Comp => comp::exec(cx, st, call, args, frame),
         Op::Trim => crate::trim::exec(cx, st, call),
+        Op::Label => label::exec(cx, st, call, args),
         Op::T | Op::Translate | Op::S | Op::R | Op::Rotate | Op::Center => {
             transform::exec(cx, st, call, args)
         }

@@ -253,6 +253,17 @@ pub struct Interp<'a> {
     emitted: EmitCache,
     /// When the derivation of this initial shape started (time limit).
     started: std::time::Instant,
+    /// While `inline` or `modify` derives: the leaf shapes (and the shapes
+    /// ended by `NIL`), collected here instead of emitted (`ops::inline`).
+    pub(crate) collected: Option<Vec<Collected>>,
+}
+
+/// A shape that ended while leaves were being collected (`Interp::collected`).
+pub(crate) struct Collected {
+    pub shape: Shape,
+    /// Ended by `NIL`: its geometry is not part of the result, but shape
+    /// recomposition still follows how it moved its vertices.
+    pub deleted: bool,
 }
 
 /// The last few (material attributes, geometry materials, rule file) →
@@ -465,6 +476,7 @@ impl<'a> Interp<'a> {
             memo: MeshMemo::default(),
             material_memo: MaterialMemo::default(),
             started: std::time::Instant::now(),
+            collected: None,
         }
     }
 
@@ -532,6 +544,13 @@ impl<'a> Interp<'a> {
     pub fn finish(&mut self, st: ShapeState) {
         if !st.deleted && !st.has_successor {
             self.emit(&st.shape);
+        } else if st.deleted && !st.has_successor {
+            if let Some(list) = &mut self.collected {
+                list.push(Collected {
+                    shape: st.shape,
+                    deleted: true,
+                });
+            }
         }
     }
 
@@ -578,6 +597,13 @@ impl<'a> Interp<'a> {
 
     /// Adds a leaf shape's geometry to the model.
     pub fn emit(&mut self, shape: &Shape) {
+        if let Some(list) = &mut self.collected {
+            list.push(Collected {
+                shape: shape.clone(),
+                deleted: false,
+            });
+            return;
+        }
         if shape.geometry.is_empty() {
             return;
         }

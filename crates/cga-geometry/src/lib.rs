@@ -19,6 +19,7 @@
 //! | [`inner_rect`] | `innerRectangle` |
 //! | [`perimeter`] | `splitAndSetbackPerimeter` |
 //! | [`primitive`] | `primitive*` and `builtin:cube` |
+//! | [`recompose`] | shape recomposition (`inline(recompose)`, `modify`) |
 //! | [`normals`] | `setNormals`, `softenNormals` |
 //! | [`obj`] | OBJ + MTL assets |
 //! | [`transform`] | affine transforms, reversing, merging |
@@ -42,6 +43,7 @@ pub mod normals;
 pub mod obj;
 pub mod perimeter;
 pub mod primitive;
+pub mod recompose;
 pub mod roof;
 pub mod roof_edges;
 pub mod setback;

@@ -18,7 +18,31 @@ fn prints_go_to_stdout_in_derivation_order_and_nothing_else() {
     );
     let out = run(&["generate", rules.to_str().unwrap()]);
     assert!(out.status.success(), "{}", stderr(&out));
-    assert_eq!(stdout(&out), "first\n4\nin A 2\nlast\n");
+    // A rule's own operations all run before the rules it calls: CityEngine
+    // derives in generation (breadth-first) order.
+    assert_eq!(stdout(&out), "first\n4\nlast\nin A 2\n");
+}
+
+#[test]
+fn rules_are_derived_generation_by_generation() {
+    // Measured with CityEngine's runtime: every rule of one generation prints
+    // before any rule of the next, in the order the shapes were created.
+    let dir = temp_dir("generations");
+    let rules = rule_file(
+        &dir,
+        "g.cga",
+        "Lot --> print(1) B1 B2\n\
+         B1 --> print(10) C1\n\
+         B2 --> print(11) C2\n\
+         C1 --> print(20) D1 D2\n\
+         C2 --> NIL\n\
+         D1 --> print(100) E\n\
+         D2 --> print(200)\n\
+         E --> print(1000)\n",
+    );
+    let out = run(&["generate", rules.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(stdout(&out), "1\n10\n11\n20\n100\n200\n1000\n");
 }
 
 #[test]

@@ -219,6 +219,16 @@ pub(crate) enum AttrSlot {
     Done(Value),
 }
 
+/// A rule call waiting for its turn.
+pub(crate) struct PendingRule {
+    rule: RuleId,
+    args: Vec<Value>,
+    shape: Shape,
+    span: Span,
+    /// Rule invocations from the initial shape to this one.
+    generation: usize,
+}
+
 /// The interpreter for one initial shape.
 pub struct Interp<'a> {
     pub program: &'a Program,
@@ -229,7 +239,12 @@ pub struct Interp<'a> {
     pub out: LotOutput,
     pub(crate) attr_values: Vec<AttrSlot>,
     pub(crate) const_values: Vec<Option<Value>>,
+    /// Nesting of function calls (the evaluation depth limit).
     pub(crate) depth: usize,
+    /// Rule calls waiting to be derived, oldest first.
+    pub(crate) queue: std::collections::VecDeque<PendingRule>,
+    /// Generation of the rule being applied (the derivation depth limit).
+    pub(crate) generation: usize,
     warned: HashSet<(u32, u32, u32)>,
     /// Texture files found so far (see `ops::texturing`).
     pub(crate) textures: ops::texturing::TextureFiles,
@@ -465,6 +480,8 @@ impl<'a> Interp<'a> {
             attr_values: slots,
             const_values: vec![None; program.functions.len()],
             depth: 0,
+            queue: std::collections::VecDeque::new(),
+            generation: 0,
             warned: HashSet::new(),
             textures: Default::default(),
             current_file: cga_syntax::FileId(0),
@@ -490,12 +507,37 @@ impl<'a> Interp<'a> {
     pub fn run(&mut self, rule: RuleId) -> Result<(), RtError> {
         let shape = self.initial.clone();
         self.out.shapes += 1;
-        self.run_rule(
+        let span = self.program.rules[rule as usize].span;
+        self.derive_now(rule, Vec::new(), shape, span)
+    }
+
+    /// Derives `shape` with `rule` and everything that follows from it,
+    /// before returning. Rule calls met on the way wait in a queue of their
+    /// own, so this also serves a derivation nested in another (`inline`).
+    pub fn derive_now(
+        &mut self,
+        rule: RuleId,
+        args: Vec<Value>,
+        shape: Shape,
+        span: Span,
+    ) -> Result<(), RtError> {
+        let outer = std::mem::take(&mut self.queue);
+        self.queue.push_back(PendingRule {
             rule,
-            Vec::new(),
+            args,
             shape,
-            self.program.rules[rule as usize].span,
-        )
+            span,
+            generation: self.generation + 1,
+        });
+        let mut result = Ok(());
+        while let Some(p) = self.queue.pop_front() {
+            if let Err(e) = self.run_rule(p) {
+                result = Err(e);
+                break;
+            }
+        }
+        self.queue = outer;
+        result
     }
 
     pub fn warn_once(&mut self, span: Span, message: impl FnOnce() -> String) {
@@ -504,17 +546,19 @@ impl<'a> Interp<'a> {
         }
     }
 
-    /// Invokes `rule` with `args` on `shape`.
-    pub fn run_rule(
-        &mut self,
-        rule: RuleId,
-        mut frame: Vec<Value>,
-        mut shape: Shape,
-        call_span: Span,
-    ) -> Result<(), RtError> {
+    /// Applies a rule to its shape: the rule's operations run now, the rule
+    /// calls among them are queued behind everything already waiting.
+    fn run_rule(&mut self, p: PendingRule) -> Result<(), RtError> {
+        let PendingRule {
+            rule,
+            args: mut frame,
+            mut shape,
+            span: call_span,
+            generation,
+        } = p;
         let program = self.program;
         let def = &program.rules[rule as usize];
-        if self.depth >= self.limits.max_depth {
+        if generation > self.limits.max_depth {
             return Err(RtError::new(
                 format!(
                     "derivation depth limit ({}) reached in rule `{}`: the rules recurse without end (raise the limit with --max-depth)",
@@ -523,18 +567,28 @@ impl<'a> Interp<'a> {
                 call_span,
             ));
         }
-        self.depth += 1;
+        let outer_generation = std::mem::replace(&mut self.generation, generation);
         shape.name = program.rule_symbol(rule);
+        let mut r = Ok(());
         for local in &def.locals {
-            let v = self.eval(local, &frame, &shape)?;
-            frame.push(v);
+            match self.eval(local, &frame, &shape) {
+                Ok(v) => frame.push(v),
+                Err(e) => {
+                    r = Err(e);
+                    break;
+                }
+            }
         }
-        let mut st = ShapeState::new(shape);
-        let caller_file = std::mem::replace(&mut self.current_file, def.span.file);
-        let r = self.exec_body(&def.body, &frame, &mut st);
-        self.depth -= 1;
-        let r = r.map(|()| self.finish(st));
-        self.current_file = caller_file;
+        if r.is_ok() {
+            let mut st = ShapeState::new(shape);
+            let caller_file = std::mem::replace(&mut self.current_file, def.span.file);
+            r = self.exec_body(&def.body, &frame, &mut st);
+            if r.is_ok() {
+                self.finish(st);
+            }
+            self.current_file = caller_file;
+        }
+        self.generation = outer_generation;
         frame.clear();
         self.frame_pool.push(frame);
         r
@@ -581,7 +635,7 @@ impl<'a> Interp<'a> {
             ));
         }
         // The clock is read every 1024 shapes: cheap, and soon enough.
-        if self.out.shapes % 1024 == 0
+        if self.out.shapes.is_multiple_of(1024)
             && self.started.elapsed().as_secs_f64() > self.limits.max_seconds
         {
             return Err(RtError::new(
@@ -786,7 +840,17 @@ impl<'a> Interp<'a> {
                     self.reinitialize_import(rc, frame, &st.shape, &mut child)?;
                 }
                 st.has_successor = true;
-                self.run_rule(rc.rule, args, child, rc.span)
+                // As in CityEngine, the successor's rule runs after every
+                // rule already waiting: shapes are derived generation by
+                // generation, in the order they were created.
+                self.queue.push_back(PendingRule {
+                    rule: rc.rule,
+                    args,
+                    shape: child,
+                    span: rc.span,
+                    generation: self.generation + 1,
+                });
+                Ok(())
             }
             RStmt::Leaf(sym) => {
                 let mut child = self.child(&st.shape, Span::default())?;

@@ -84,13 +84,14 @@ fn offset_keep_faces_and_scope() {
     let p = g.prints();
     assert_eq!(p[0], "1");
     assert_eq!(p[1], "336");
+    assert_eq!(p[2], "4");
+    assert_near(p[3].parse::<f64>().unwrap(), 336.0 - 10.0 * 20.0, 1e-9);
+    // The `Scope` rules print a generation later, in the order called.
     // The lot's pivot is at the origin, its scope's z axis along +z.
-    let s = scope_line(&p[2]);
+    let s = scope_line(&p[4]);
     assert_vec_near(s.t, [3.0, 0.0, -27.0], 1e-9);
     assert_vec_near(s.s, [14.0, 0.0, 24.0], 1e-9);
     assert_vec_near(s.r, [0.0, 0.0, 0.0], 1e-9);
-    assert_eq!(p[3], "4");
-    assert_near(p[4].parse::<f64>().unwrap(), 336.0 - 10.0 * 20.0, 1e-9);
     let s = scope_line(&p[5]);
     assert_vec_near(s.s, [14.0, 0.0, 24.0], 1e-9);
 }
@@ -111,7 +112,8 @@ fn setback_street_front() {
     let g = gen(&src).ok();
     assert_all_near(&areas(&g, "G"), &[100.0], 1e-9);
     assert_all_near(&areas(&g, "B"), &[14.0 * 19.0], 1e-9);
-    let s = scope_line(&g.prints()[1]);
+    // Garden and Building print before Garden's `Scope`, a generation later.
+    let s = scope_line(&g.prints()[2]);
     // The strip 0 > z > -5 in the lot's scope orientation.
     assert_vec_near(s.t, [0.0, 0.0, -5.0], 1e-9);
     assert_vec_near(s.s, [20.0, 0.0, 5.0], 1e-9);

@@ -24,7 +24,7 @@ Yellow(h) --> print("Yellow " + scope.tx + " " + scope.sx + " " + geometry.volum
 /// (name, start, size, volume).
 fn parts(length: f64, split: &str) -> Vec<(String, f64, f64, f64)> {
     let src = format!("Lot --> s({length}, 1, 1) primitiveCube() {split}\n{PARTS}");
-    gen(&src)
+    let mut got: Vec<_> = gen(&src)
         .ok()
         .prints()
         .iter()
@@ -34,7 +34,11 @@ fn parts(length: f64, split: &str) -> Vec<(String, f64, f64, f64)> {
             let n: Vec<f64> = it.map(|x| x.parse().unwrap()).collect();
             (name, n[0], n[1], n[2])
         })
-        .collect()
+        .collect();
+    // Rules run generation by generation, so `Z --> Z(1)` prints a
+    // generation later than its siblings: order the parts by position.
+    got.sort_by(|a, b| a.1.total_cmp(&b.1));
+    got
 }
 
 /// Asserts names and sizes; starts must follow each other from 0 (with the

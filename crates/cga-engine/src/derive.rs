@@ -521,19 +521,34 @@ impl<'a> Interp<'a> {
         shape: Shape,
         span: Span,
     ) -> Result<(), RtError> {
+        let generation = self.generation + 1;
+        self.derive_all_now(|cx| {
+            cx.queue.push_back(PendingRule {
+                rule,
+                args,
+                shape,
+                span,
+                generation,
+            });
+            Ok(())
+        })
+    }
+
+    /// Runs `start` (which may queue rule calls) and derives everything it
+    /// queued to completion before returning, with a queue of its own
+    /// (`inline { operations }`, `modify`).
+    pub(crate) fn derive_all_now(
+        &mut self,
+        start: impl FnOnce(&mut Self) -> Result<(), RtError>,
+    ) -> Result<(), RtError> {
         let outer = std::mem::take(&mut self.queue);
-        self.queue.push_back(PendingRule {
-            rule,
-            args,
-            shape,
-            span,
-            generation: self.generation + 1,
-        });
-        let mut result = Ok(());
-        while let Some(p) = self.queue.pop_front() {
-            if let Err(e) = self.run_rule(p) {
-                result = Err(e);
-                break;
+        let mut result = start(self);
+        if result.is_ok() {
+            while let Some(p) = self.queue.pop_front() {
+                if let Err(e) = self.run_rule(p) {
+                    result = Err(e);
+                    break;
+                }
             }
         }
         self.queue = outer;

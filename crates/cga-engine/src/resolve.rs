@@ -1148,9 +1148,10 @@ impl Resolver<'_> {
                 for p in &b.parts {
                     match p {
                         BlockPart::Unlabeled { body, .. } => parts.push(self.body(cx, body)),
-                        BlockPart::Entry(e) => {
-                            self.error("`inline { ... }` takes operations, not `head : ...` entries", e.span)
-                        }
+                        BlockPart::Entry(e) => self.error(
+                            "`inline { ... }` takes operations, not `head : ...` entries",
+                            e.span,
+                        ),
                         BlockPart::Group(g) => {
                             self.error("`inline { ... }` takes operations, not a pattern", g.span)
                         }

@@ -173,7 +173,8 @@ impl PointGrid {
             for dx in -1..=1 {
                 for dy in -1..=1 {
                     for dz in -1..=1 {
-                        if let Some(&(start, n)) = self.cells.get(&[k[0] + dx, k[1] + dy, k[2] + dz])
+                        if let Some(&(start, n)) =
+                            self.cells.get(&[k[0] + dx, k[1] + dy, k[2] + dz])
                         {
                             scratch.extend_from_slice(
                                 &self.order[start as usize..(start + n) as usize],
@@ -191,10 +192,7 @@ impl PointGrid {
             if t <= 0.0 || t >= 1.0 {
                 continue;
             }
-            if (a + d * t - p).length() <= tol
-                && (p - a).length() > tol
-                && (p - b).length() > tol
-            {
+            if (a + d * t - p).length() <= tol && (p - a).length() > tol && (p - b).length() > tol {
                 out.push((t, i));
             }
         }
@@ -203,10 +201,7 @@ impl PointGrid {
 }
 
 /// Per part: the merged vertex (key) of each position, or `NONE`.
-fn part_keys(
-    parts: &[Part],
-    tol: f64,
-) -> (Vec<DVec3>, Vec<Vec<u32>>) {
+fn part_keys(parts: &[Part], tol: f64) -> (Vec<DVec3>, Vec<Vec<u32>>) {
     // Rest position of each position of each part, from its corners.
     let mut pts: Vec<DVec3> = Vec::new();
     let mut owner: Vec<(u32, u32)> = Vec::new();
@@ -363,9 +358,15 @@ pub fn recompose(parts: &[Part]) -> Recomposed {
     out.materials = Vec::<Material>::new().into();
     out.groups = Vec::<String>::new().into();
     let uv_sets: Vec<bool> = (0..out.uvs.len())
-        .map(|s| parts.iter().any(|p| p.keep_faces && p.mesh.uvs[s].is_some()))
+        .map(|s| {
+            parts
+                .iter()
+                .any(|p| p.keep_faces && p.mesh.uvs[s].is_some())
+        })
         .collect();
-    let with_normals = parts.iter().any(|p| p.keep_faces && p.mesh.normals.is_some());
+    let with_normals = parts
+        .iter()
+        .any(|p| p.keep_faces && p.mesh.normals.is_some());
     let mut uvs: Vec<Vec<DVec2>> = vec![Vec::new(); out.uvs.len()];
     let mut normals: Vec<DVec3> = Vec::new();
     // Vertex of each key in the result (only keys some kept face uses).
@@ -557,8 +558,8 @@ pub fn unify_touching(mesh: &Mesh) -> (Mesh, bool) {
         let mut i = 0;
         while i < alive.len() {
             let a = alive[i] as usize;
-            let partner = (i + 1..alive.len())
-                .find(|&j| normals[a].dot(normals[alive[j] as usize]) < 0.0);
+            let partner =
+                (i + 1..alive.len()).find(|&j| normals[a].dot(normals[alive[j] as usize]) < 0.0);
             match partner {
                 Some(j) => {
                     drop[a] = true;
@@ -756,11 +757,15 @@ impl<'a> SurfaceMap<'a> {
     }
 
     fn value(&self, pos: u32) -> Option<DVec3> {
-        self.values.get(pos as usize).copied().flatten().or_else(|| {
-            let v = self.weld.id.get(pos as usize)?;
-            let p = self.valued[*v as usize];
-            (p != NONE).then(|| self.values[p as usize]).flatten()
-        })
+        self.values
+            .get(pos as usize)
+            .copied()
+            .flatten()
+            .or_else(|| {
+                let v = self.weld.id.get(pos as usize)?;
+                let p = self.valued[*v as usize];
+                (p != NONE).then(|| self.values[p as usize]).flatten()
+            })
     }
 
     /// The value at point `q` of the surface, or `None` if `q` is not on it
@@ -872,11 +877,7 @@ mod tests {
         let quarters = split_along_axis(&halves[1], 2, &[-1.0]);
         let pieces = [&halves[0], &quarters[0], &quarters[1]];
         let rests: Vec<_> = pieces.iter().map(|m| rest_here(m)).collect();
-        let parts: Vec<Part> = pieces
-            .iter()
-            .zip(&rests)
-            .map(|(m, r)| part(m, r))
-            .collect();
+        let parts: Vec<Part> = pieces.iter().zip(&rests).map(|(m, r)| part(m, r)).collect();
         let r = recompose(&parts);
         assert_eq!(r.mesh.faces.len(), 3);
         // 4 corners, 3 split points on the square's edges, the middle
@@ -978,11 +979,7 @@ mod tests {
     #[test]
     fn surface_map_interpolates() {
         let sq = square(2.0);
-        let values: Vec<Option<DVec3>> = sq
-            .positions
-            .iter()
-            .map(|p| Some(*p * 10.0))
-            .collect();
+        let values: Vec<Option<DVec3>> = sq.positions.iter().map(|p| Some(*p * 10.0)).collect();
         let map = SurfaceMap::new(&sq, &values);
         let at = |q: DVec3| map.value_at(q).unwrap();
         assert!((at(DVec3::new(2.0, 0.0, 0.0)) - DVec3::new(20.0, 0.0, 0.0)).length() < 1e-9);

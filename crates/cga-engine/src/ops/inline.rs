@@ -79,7 +79,12 @@ pub fn exec(
     };
     let body = match call.block.as_ref().and_then(|b| b.parts.first()) {
         Some(RPart::Unlabeled { body, .. }) => body,
-        _ => return Err(RtError::new("`inline` needs operations to derive", call.span)),
+        _ => {
+            return Err(RtError::new(
+                "`inline` needs operations to derive",
+                call.span,
+            ))
+        }
     };
     let tracking = match strategy {
         Strategy::Append => None,
@@ -87,11 +92,14 @@ pub fn exec(
     };
     let work = cx.child(&st.shape, call.span)?;
     let saved = begin_collect(cx);
-    let mut wst = ShapeState::new(work);
-    let r = cx.exec_body(body, frame, &mut wst);
-    if r.is_ok() {
+    // The inlined operations and every rule they call are derived now, to
+    // the end, before the current shape goes on.
+    let r = cx.derive_all_now(|cx| {
+        let mut wst = ShapeState::new(work);
+        cx.exec_body(body, frame, &mut wst)?;
         cx.finish(wst);
-    }
+        Ok(())
+    });
     let collected = end_collect(cx, saved);
     r?;
     let kept = collected.iter().filter(|c| !c.deleted).count();

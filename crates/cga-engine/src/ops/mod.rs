@@ -2,6 +2,7 @@
 //! arguments are selector keywords) and the dispatcher the interpreter calls.
 //! Each family of operations lives in its own module.
 
+mod align_bbox;
 mod attrs;
 mod cleanup;
 pub mod comp;
@@ -402,8 +403,8 @@ pub fn exec(
         | Op::SetPivot
         | Op::RotateScope
         | Op::MirrorScope
-        | Op::ResetGeometry
-        | Op::AlignScopeToGeometryBBox => scope_ops::exec(cx, st, call, args),
+        | Op::ResetGeometry => scope_ops::exec(cx, st, call, args),
+        Op::AlignScopeToGeometryBBox => align_bbox::exec(st, call, args),
         Op::Inline => inline::exec(cx, st, call, args, frame),
         Op::Modify => modify::exec(cx, st, call, args, frame),
         Op::Scatter => scatter::exec(cx, st, call, args, frame),

@@ -22,7 +22,9 @@ use cga_geometry::recompose::{recompose, Part};
 use cga_geometry::{DVec3, Mesh};
 use cga_value::Value;
 
-use super::inline::{bake_material, begin_collect, end_collect, read_rest, set_object_mesh, Tracking};
+use super::inline::{
+    bake_material, begin_collect, end_collect, read_rest, set_object_mesh, Tracking,
+};
 use crate::derive::{Arg, Interp, RtError, ShapeState};
 use crate::expr::OpCall;
 use crate::material_attr::MaterialOverrides;
@@ -34,18 +36,19 @@ pub fn exec(
     args: &[Arg],
     frame: &[Value],
 ) -> Result<(), RtError> {
-    let whole_faces = !matches!(
-        args.first().map(|a| a.text()),
-        Some(Ok("f" | "g" | "m"))
-    );
+    let whole_faces = !matches!(args.first().map(|a| a.text()), Some(Ok("f" | "g" | "m")));
     let tracking = Tracking::begin(&mut st.shape);
     let start = st.shape.object_mesh();
     // The comp runs on a copy: its `has_successor` is not this shape's.
     let mut wst = ShapeState::new(st.shape.clone());
     let saved = begin_collect(cx);
-    let used = super::comp::run(cx, &mut wst, call, args, frame);
+    let mut used = Vec::new();
+    let r = cx.derive_all_now(|cx| {
+        used = super::comp::run(cx, &mut wst, call, args, frame)?;
+        Ok(())
+    });
     let collected = end_collect(cx, saved);
-    let used = used?;
+    r?;
     st.shape.rng.set(wst.shape.rng.get());
 
     let mut untouched = if whole_faces {
@@ -128,10 +131,7 @@ fn without_faces(mesh: &Mesh, drop: &[bool]) -> Mesh {
                     dst.push(src.get(c).copied().unwrap_or_default());
                 }
             }
-            out.loops.push(cga_geometry::Loop {
-                start,
-                len: l.len,
-            });
+            out.loops.push(cga_geometry::Loop { start, len: l.len });
         }
         let mut face = mesh.faces[f];
         face.first_loop = first_loop;

@@ -528,9 +528,22 @@ pub fn recompose(parts: &[Part]) -> Recomposed {
 /// same orientation one is kept. Returns the mesh and whether closed parts
 /// of it still overlap (a bounding box test between its connected closed
 /// pieces), which this engine cannot unite.
+///
+/// The result's coincident vertices (within the tolerance) are welded into
+/// one, so pieces that touch share their vertices.
 pub fn unify_touching(mesh: &Mesh) -> (Mesh, bool) {
     let tol = tolerance(mesh.positions.iter().copied());
     let weld = weld_points(&mesh.positions, tol);
+    let mut welded = mesh.clone();
+    welded.positions = weld
+        .representative
+        .iter()
+        .map(|&i| mesh.positions[i as usize])
+        .collect();
+    for c in &mut welded.corners {
+        *c = weld.id[*c as usize];
+    }
+    let mesh = &welded;
     let normals: Vec<DVec3> = (0..mesh.faces.len())
         .map(|f| crate::measure::face_normal(mesh, f))
         .collect();

@@ -16,8 +16,8 @@
 //!   are taken, others keep the current shape's value.
 //!
 //! Strategies: `append` puts the meshes side by side; `recompose` reconnects
-//! the pieces (`cga_geometry::recompose`); `unify` recomposes, then removes
-//! the faces where pieces touch (pairs of coincident faces facing each
+//! the pieces (`cga_geometry::recompose`); `unify` appends, welds
+//! coincident vertices and removes the faces where pieces touch (pairs of coincident faces facing each
 //! other: the cut faces between the parts of a split volume). There is no
 //! 3D Boolean union in this engine: pieces that overlap stay overlapping,
 //! with a warning.
@@ -86,9 +86,11 @@ pub fn exec(
             ))
         }
     };
+    // Only recomposition follows the vertices through the derivation; a
+    // union works on where the geometry ends up.
     let tracking = match strategy {
-        Strategy::Append => None,
-        _ => Some(Tracking::begin(&mut st.shape)),
+        Strategy::Recompose => Some(Tracking::begin(&mut st.shape)),
+        _ => None,
     };
     let work = cx.child(&st.shape, call.span)?;
     let saved = begin_collect(cx);
@@ -130,11 +132,10 @@ pub fn exec(
         })
         .collect();
     let mut merged = match strategy {
-        Strategy::Append => {
+        Strategy::Append | Strategy::Unify => {
             let mut out = Mesh::new();
             let mut first = true;
-            for (m, deleted) in meshes.iter_mut().filter(|(_, d)| !*d) {
-                let _ = deleted;
+            for (m, _) in meshes.iter_mut().filter(|(_, deleted)| !*deleted) {
                 if first {
                     out = std::mem::take(m);
                     first = false;
@@ -142,9 +143,18 @@ pub fn exec(
                     cga_geometry::transform::merge(&mut out, m);
                 }
             }
+            if strategy == Strategy::Unify {
+                let (united, overlaps) = cga_geometry::recompose::unify_touching(&out);
+                out = united;
+                if overlaps {
+                    cx.warn_once(call.span, || {
+                        "inline(unify): this engine has no 3D Boolean union; overlapping volumes are kept as they are (only faces where volumes touch are removed)".to_string()
+                    });
+                }
+            }
             out
         }
-        Strategy::Recompose | Strategy::Unify => {
+        Strategy::Recompose => {
             let rests: Vec<Vec<Option<DVec3>>> = meshes.iter().map(|(m, _)| read_rest(m)).collect();
             let parts: Vec<Part> = meshes
                 .iter()
@@ -156,17 +166,7 @@ pub fn exec(
                     keep_points: true,
                 })
                 .collect();
-            let mut out = recompose(&parts).mesh;
-            if strategy == Strategy::Unify {
-                let (united, overlaps) = cga_geometry::recompose::unify_touching(&out);
-                out = united;
-                if overlaps {
-                    cx.warn_once(call.span, || {
-                        "inline(unify): this engine has no 3D Boolean union; overlapping volumes are kept as they are (only faces where volumes touch are removed)".to_string()
-                    });
-                }
-            }
-            out
+            recompose(&parts).mesh
         }
     };
     if let Some(t) = &tracking {

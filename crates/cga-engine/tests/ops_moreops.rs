@@ -1075,10 +1075,8 @@ fn align_scope_to_geometry_bbox_example() {
         o + short * 5.0 + long * 12.0,
         o + long * 12.0,
     ];
-    let src = format!(
-        "Lot --> Before alignScopeToGeometryBBox(xz) After Lot.\nBefore --> print(scope.sx + \" \" + scope.sz) NIL\nAfter --> print([scope.sx, scope.sy, scope.sz, scope.rx, scope.ry, scope.rz, pivot.px, pivot.py, pivot.pz, pivot.ox, pivot.oy, pivot.oz]) NIL\n"
-    );
-    let g = gen_with(&src, &Opts::polygon(&lot)).ok();
+    let src = "Lot --> Before alignScopeToGeometryBBox(xz) After Lot.\nBefore --> print(scope.sx + \" \" + scope.sz) NIL\nAfter --> print([scope.sx, scope.sy, scope.sz, scope.rx, scope.ry, scope.rz, pivot.px, pivot.py, pivot.pz, pivot.ox, pivot.oy, pivot.oz]) NIL\n";
+    let g = gen_with(src, &Opts::polygon(&lot)).ok();
     let p = g.prints();
     // Before: x along the first (short) edge.
     assert_eq!(numbers(&p[0]).len(), 2);

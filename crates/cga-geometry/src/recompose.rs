@@ -156,7 +156,9 @@ impl PointGrid {
         scratch.clear();
         let d = b - a;
         let len2 = d.length_squared();
-        if !(len2 > 4.0 * tol * tol) || !len2.is_finite() {
+        if len2.partial_cmp(&(4.0 * tol * tol)) != Some(std::cmp::Ordering::Greater)
+            || !len2.is_finite()
+        {
             return;
         }
         // Samples a cell apart: a point within `tol` of the segment is
@@ -611,8 +613,8 @@ fn retain_faces(m: &mut Mesh, drop: &[bool]) {
     if let Some(n) = &mut m.normals {
         n.clear();
     }
-    for f in 0..src.faces.len() {
-        if drop[f] {
+    for (f, &dropped) in drop.iter().enumerate().take(src.faces.len()) {
+        if dropped {
             continue;
         }
         let first_loop = m.loops.len() as u32;
@@ -804,7 +806,7 @@ impl<'a> SurfaceMap<'a> {
                     let (pa, pb) = (m.positions[a as usize], m.positions[b as usize]);
                     let d = pb - pa;
                     let len2 = d.length_squared();
-                    if !(len2 > 0.0) {
+                    if len2.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
                         continue;
                     }
                     let t = (q - pa).dot(d) / len2;
@@ -836,7 +838,7 @@ impl<'a> SurfaceMap<'a> {
 fn barycentric(a: DVec3, b: DVec3, c: DVec3, q: DVec3, tol: f64) -> Option<DVec3> {
     let n = (b - a).cross(c - a);
     let n2 = n.length_squared();
-    if !(n2 > 0.0) {
+    if n2.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return None;
     }
     if ((q - a).dot(n)).abs() / n2.sqrt() > tol {

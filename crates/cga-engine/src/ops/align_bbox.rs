@@ -69,7 +69,8 @@ pub fn exec(st: &mut ShapeState, call: &OpCall, args: &[Arg]) -> Result<(), RtEr
 /// a minimum-area rectangle lies on an edge of the convex hull, so every
 /// hull edge is tried (the hull is small next to the geometry).
 pub(crate) fn min_area_rect(points: &[DVec2]) -> Option<DVec2> {
-    let hull = convex_hull(points);
+    let finite: Vec<DVec2> = points.iter().copied().filter(|p| p.is_finite()).collect();
+    let hull = convex_hull(&finite);
     let scale = hull
         .iter()
         .fold(0.0f64, |m, p| m.max(p.abs().max_element()));
@@ -170,6 +171,7 @@ mod tests {
         // A segment: its direction.
         let d = min_area_rect(&[DVec2::ZERO, DVec2::new(0.0, 3.0)]).unwrap();
         assert!((d.y.abs() - 1.0).abs() < 1e-12);
-        assert!(min_area_rect(&[DVec2::NAN, DVec2::ZERO]).is_none_or(|d| d.is_finite()));
+        // Points that are not finite are left out.
+        assert!(min_area_rect(&[DVec2::NAN, DVec2::ZERO]).is_none());
     }
 }

@@ -293,7 +293,7 @@ enum Outer {
     Same,
     /// The outer rest positions of the starting geometry (object
     /// coordinates), per position.
-    Map(Mesh, Vec<Option<DVec3>>),
+    Map(Box<(Mesh, Vec<Option<DVec3>>)>),
 }
 
 /// One recomposition level (see the module docs).
@@ -340,7 +340,7 @@ impl Tracking {
                 start.corners = mesh.corners.clone();
                 start.loops = mesh.loops.clone();
                 start.faces = mesh.faces.clone();
-                Outer::Map(start, values)
+                Outer::Map(Box::new((start, values)))
             }
         };
         let corners = mesh.corners.clone();
@@ -357,7 +357,8 @@ impl Tracking {
                 mesh.uvs[REST_Z] = None;
             }
             Outer::Same => {}
-            Outer::Map(start, values) => {
+            Outer::Map(b) => {
+                let (start, values) = &**b;
                 let map = SurfaceMap::new(start, values);
                 let rest = read_rest(mesh);
                 let mut memo: Vec<Option<Option<DVec3>>> = vec![None; mesh.positions.len()];

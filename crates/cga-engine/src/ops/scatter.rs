@@ -161,7 +161,7 @@ pub fn exec(
         return Ok(());
     }
     let mesh = st.shape.geometry.local().clone();
-    if domain == Domain::Volume && !(is_closed(&mesh) && !mesh.faces.is_empty()) {
+    if domain == Domain::Volume && (mesh.faces.is_empty() || !is_closed(&mesh)) {
         domain = Domain::Surface;
     }
     let surface = Surface::new(&mesh);

@@ -272,6 +272,17 @@ pub struct Interp<'a> {
     pub(crate) context: Option<Box<crate::context::ContextState>>,
     /// When the derivation of this initial shape started (time limit).
     started: std::time::Instant,
+    /// While `inline` or `modify` derives: the leaf shapes (and the shapes
+    /// ended by `NIL`), collected here instead of emitted (`ops::inline`).
+    pub(crate) collected: Option<Vec<Collected>>,
+}
+
+/// A shape that ended while leaves were being collected (`Interp::collected`).
+pub(crate) struct Collected {
+    pub shape: Shape,
+    /// Ended by `NIL`: its geometry is not part of the result, but shape
+    /// recomposition still follows how it moved its vertices.
+    pub deleted: bool,
 }
 
 /// The last few (material attributes, geometry materials, rule file) →
@@ -487,6 +498,7 @@ impl<'a> Interp<'a> {
             material_memo: MaterialMemo::default(),
             context: None,
             started: std::time::Instant::now(),
+            collected: None,
         }
     }
 
@@ -514,19 +526,34 @@ impl<'a> Interp<'a> {
         shape: Shape,
         span: Span,
     ) -> Result<(), RtError> {
+        let generation = self.generation + 1;
+        self.derive_all_now(|cx| {
+            cx.queue.push_back(PendingRule {
+                rule,
+                args,
+                shape,
+                span,
+                generation,
+            });
+            Ok(())
+        })
+    }
+
+    /// Runs `start` (which may queue rule calls) and derives everything it
+    /// queued to completion before returning, with a queue of its own
+    /// (`inline { operations }`, `modify`).
+    pub(crate) fn derive_all_now(
+        &mut self,
+        start: impl FnOnce(&mut Self) -> Result<(), RtError>,
+    ) -> Result<(), RtError> {
         let outer = std::mem::take(&mut self.queue);
-        self.queue.push_back(PendingRule {
-            rule,
-            args,
-            shape,
-            span,
-            generation: self.generation + 1,
-        });
-        let mut result = Ok(());
-        while let Some(p) = self.queue.pop_front() {
-            if let Err(e) = self.run_rule(p) {
-                result = Err(e);
-                break;
+        let mut result = start(self);
+        if result.is_ok() {
+            while let Some(p) = self.queue.pop_front() {
+                if let Err(e) = self.run_rule(p) {
+                    result = Err(e);
+                    break;
+                }
             }
         }
         self.queue = outer;
@@ -591,6 +618,13 @@ impl<'a> Interp<'a> {
     pub fn finish(&mut self, st: ShapeState) {
         if !st.deleted && !st.has_successor {
             self.emit(&st.shape);
+        } else if st.deleted && !st.has_successor {
+            if let Some(list) = &mut self.collected {
+                list.push(Collected {
+                    shape: st.shape,
+                    deleted: true,
+                });
+            }
         }
     }
 
@@ -640,6 +674,13 @@ impl<'a> Interp<'a> {
 
     /// Adds a leaf shape's geometry to the model.
     pub fn emit(&mut self, shape: &Shape) {
+        if let Some(list) = &mut self.collected {
+            list.push(Collected {
+                shape: shape.clone(),
+                deleted: false,
+            });
+            return;
+        }
         if shape.geometry.is_empty() {
             return;
         }

@@ -1031,7 +1031,7 @@ impl Resolver<'_> {
 
     fn body(&mut self, cx: &Cx, b: &Body) -> RBody {
         match b {
-            Body::Ops(stmts) => RBody::Ops(stmts.iter().map(|s| self.stmt(cx, s)).collect()),
+            Body::Ops(stmts) => RBody::Ops(self.stmts(cx, stmts)),
             Body::Case(chain) => RBody::Case {
                 branches: chain
                     .branches
@@ -1083,6 +1083,128 @@ impl Resolver<'_> {
             repeat: b.repeat,
             span: b.span,
         }
+    }
+
+    /// An operation sequence. `inline` takes the statement after it (a rule
+    /// call or a subdivision), unless it has a `{ operations }` block.
+    fn stmts(&mut self, cx: &Cx, stmts: &[Stmt]) -> Vec<RStmt> {
+        let mut out = Vec::with_capacity(stmts.len());
+        let mut i = 0;
+        while i < stmts.len() {
+            match &stmts[i] {
+                Stmt::Call(call) if self.is_inline(cx, call) => {
+                    let (stmt, used) = self.inline_stmt(cx, &stmts[i..]);
+                    out.push(stmt);
+                    i += used;
+                }
+                s => {
+                    out.push(self.stmt(cx, s));
+                    i += 1;
+                }
+            }
+        }
+        out
+    }
+
+    /// `inline` is a keyword unless a rule of that name exists.
+    fn is_inline(&self, cx: &Cx, call: &ast::Call) -> bool {
+        call.name.name == "inline"
+            && call.import_overrides.is_none()
+            && self
+                .find_rule(cx.rs, "inline", call.args.as_ref().map_or(0, |a| a.len()))
+                .is_none()
+    }
+
+    /// `inline Rule`, `inline subdivision`, `inline { operations }`, each
+    /// with an optional `(strategy)`: an `Op::Inline` call whose block has
+    /// one unlabeled part, the operations to derive (`stmts[0]` is the
+    /// `inline` call). Returns the statement and how many statements it took.
+    fn inline_stmt(&mut self, cx: &Cx, stmts: &[Stmt]) -> (RStmt, usize) {
+        let Stmt::Call(call) = &stmts[0] else {
+            return (RStmt::Nil, 1);
+        };
+        let span = call.span;
+        let args_in = call.args.as_deref().unwrap_or(&[]);
+        if args_in.len() > 1 {
+            self.error(
+                format!(
+                    "`inline` takes at most 1 argument (append, unify or recompose), found {}",
+                    args_in.len()
+                ),
+                span,
+            );
+        }
+        let args: Vec<RExpr> = args_in
+            .iter()
+            .take(1)
+            .map(|a| self.selector_arg(cx, a))
+            .collect();
+        if call.remainder_block.is_some() {
+            self.error("`inline` takes one `{ ... }` block", span);
+        }
+        let (body, body_span, used) = match &call.block {
+            Some(b) => {
+                let mut parts = Vec::new();
+                for p in &b.parts {
+                    match p {
+                        BlockPart::Unlabeled { body, .. } => parts.push(self.body(cx, body)),
+                        BlockPart::Entry(e) => self.error(
+                            "`inline { ... }` takes operations, not `head : ...` entries",
+                            e.span,
+                        ),
+                        BlockPart::Group(g) => {
+                            self.error("`inline { ... }` takes operations, not a pattern", g.span)
+                        }
+                    }
+                }
+                if b.repeat {
+                    self.error("`inline { ... }` cannot repeat (`*`)", b.span);
+                }
+                let body = match parts.len() {
+                    1 => parts.pop().unwrap_or(RBody::Ops(Vec::new())),
+                    // `{ A | B }`: each alternative in sequence.
+                    _ => RBody::Ops(parts.into_iter().map(RStmt::Push).collect()),
+                };
+                (body, b.span, 1)
+            }
+            None => match stmts.get(1) {
+                Some(Stmt::Call(next)) if self.is_inline(cx, next) => {
+                    let (s, used) = self.inline_stmt(cx, &stmts[1..]);
+                    (RBody::Ops(vec![s]), next.span, 1 + used)
+                }
+                Some(next) => {
+                    let next_span = match next {
+                        Stmt::Call(c) => c.span,
+                        Stmt::Leaf(i) => i.span,
+                        Stmt::Nil(s) | Stmt::Push(_, s) => *s,
+                    };
+                    (RBody::Ops(vec![self.stmt(cx, next)]), next_span, 2)
+                }
+                None => {
+                    self.error(
+                        "`inline` needs a rule, a subdivision or `{ operations }` after it",
+                        span,
+                    );
+                    (RBody::Ops(Vec::new()), span, 1)
+                }
+            },
+        };
+        let block = RBlock {
+            parts: vec![RPart::Unlabeled {
+                body,
+                span: body_span,
+            }],
+            repeat: false,
+            span: body_span,
+        };
+        let stmt = RStmt::Op(OpCall {
+            op: ops::Op::Inline,
+            args,
+            block: Some(block),
+            remainder_block: None,
+            span,
+        });
+        (stmt, used)
     }
 
     fn stmt(&mut self, cx: &Cx, s: &Stmt) -> RStmt {
@@ -1144,7 +1266,7 @@ impl Resolver<'_> {
                 args.insert(0, per_face_edge(d));
             }
             let heads = match name {
-                "comp" => Heads::Comp,
+                "comp" | "modify" => Heads::Comp,
                 "setback" | "setbackPerEdge" | "setbackToArea" => Heads::Setback,
                 _ => Heads::Plain,
             };

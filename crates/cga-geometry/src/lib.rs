@@ -19,6 +19,7 @@
 //! | [`inner_rect`] | `innerRectangle` |
 //! | [`perimeter`] | `splitAndSetbackPerimeter` |
 //! | [`primitive`] | `primitive*` and `builtin:cube` |
+//! | [`recompose`] | shape recomposition (`inline(recompose)`, `modify`) |
 //! | [`normals`] | `setNormals`, `softenNormals` |
 //! | [`obj`] | OBJ + MTL assets |
 //! | [`occlusion`] | `inside` / `overlaps` / `touches` between meshes, distance between boxes |
@@ -44,6 +45,7 @@ pub mod obj;
 pub mod occlusion;
 pub mod perimeter;
 pub mod primitive;
+pub mod recompose;
 pub mod roof;
 pub mod roof_edges;
 pub mod setback;

@@ -1517,6 +1517,20 @@ pub fn exec(
     args: &[Arg],
     frame: &[Value],
 ) -> Result<(), RtError> {
+    run(cx, st, call, args, frame).map(|_| ())
+}
+
+/// [`exec`], telling for each face of the shape's mesh (in scope-local
+/// coordinates, as `geometry.local()` gives it) whether an entry selected a
+/// face, group or material component made of it: `modify` keeps the other
+/// faces as they are. Edge, vertex and hole components mark no face.
+pub(crate) fn run(
+    cx: &mut Interp,
+    st: &mut ShapeState,
+    call: &OpCall,
+    args: &[Arg],
+    frame: &[Value],
+) -> Result<Vec<bool>, RtError> {
     let Some(block) = &call.block else {
         return Err(RtError::new("`comp` needs a `{ ... }` block", call.span));
     };
@@ -1552,7 +1566,15 @@ pub fn exec(
             cx.finish(cst);
         }
     }
-    Ok(())
+    let mut used = vec![false; comps.mesh.faces.len()];
+    for (k, _) in taken.iter().enumerate().filter(|(_, t)| **t) {
+        if let Item::Faces { start, len } = comps.items[k] {
+            for &f in &comps.face_list[start as usize..(start + len) as usize] {
+                used[f as usize] = true;
+            }
+        }
+    }
+    Ok(used)
 }
 
 // ----- face-edge selection for the setback operations -----

@@ -2,13 +2,17 @@
 //! arguments are selector keywords) and the dispatcher the interpreter calls.
 //! Each family of operations lives in its own module.
 
+mod align_bbox;
 mod attrs;
 mod cleanup;
 pub mod comp;
 mod create;
 mod footprint;
+mod inline;
 mod label;
+mod modify;
 mod roof;
+mod scatter;
 mod scope_ops;
 pub mod split;
 pub mod split_area;
@@ -100,6 +104,12 @@ pub enum Op {
     CopyUV,
     InsertAlongUV,
     Label,
+    /// `inline`: the resolver makes it from `inline X`, `inline(s) split(..)
+    /// {..}` and `inline { .. }` (its block holds the operations to derive).
+    Inline,
+    Modify,
+    Scatter,
+    AlignScopeToGeometryBBox,
 }
 
 /// How an operation's arguments are read by the resolver.
@@ -127,7 +137,14 @@ pub fn arg_mode(name: &str, arity: usize, pos: usize) -> ArgMode {
         // The uv split's uv set is a number: `split(u, uvSpace, set)`.
         ("split", 3, 2) => Expr,
         (
-            "split" | "splitArea" | "comp" | "center" | "alignScopeToAxes" | "resetMaterial",
+            "split"
+            | "splitArea"
+            | "comp"
+            | "modify"
+            | "center"
+            | "alignScopeToAxes"
+            | "alignScopeToGeometryBBox"
+            | "resetMaterial",
             _,
             _,
         ) => Selector,
@@ -226,6 +243,9 @@ pub fn lookup(name: &str) -> Option<OpInfo> {
             max_args: 2,
             block: true,
         }),
+        "modify" => with_block(Op::Modify, 1, 2),
+        "scatter" => with_block(Op::Scatter, 3, 5),
+        "alignScopeToGeometryBBox" => info(Op::AlignScopeToGeometryBBox, 1, 1),
         "trim" => info(Op::Trim, 0, 0),
         "roofHip" => info(Op::RoofHip, 1, 4),
         "roofGable" => info(Op::RoofGable, 1, 5),
@@ -388,6 +408,10 @@ pub fn exec(
         | Op::RotateScope
         | Op::MirrorScope
         | Op::ResetGeometry => scope_ops::exec(cx, st, call, args),
+        Op::AlignScopeToGeometryBBox => align_bbox::exec(st, call, args),
+        Op::Inline => inline::exec(cx, st, call, args, frame),
+        Op::Modify => modify::exec(cx, st, call, args, frame),
+        Op::Scatter => scatter::exec(cx, st, call, args, frame),
         Op::RoofHip | Op::RoofGable | Op::RoofPyramid | Op::RoofShed | Op::RoofRidge => {
             roof::exec(cx, st, call, args)
         }

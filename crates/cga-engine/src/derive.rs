@@ -761,10 +761,11 @@ impl<'a> Interp<'a> {
     ) -> Result<(), RtError> {
         match body {
             RBody::Ops(stmts) => {
+                // `NIL` in the middle of a sequence does not end it: as in
+                // CityEngine, the operations after it still run on the
+                // shape (`comp(f){ top : report(..) NIL report(..) NIL }`
+                // reports twice), which is then not part of the model.
                 for (i, s) in stmts.iter().enumerate() {
-                    if st.deleted {
-                        break;
-                    }
                     self.exec_stmt(s, frame, st, i + 1 == stmts.len())?;
                 }
                 Ok(())

@@ -480,3 +480,15 @@ fn seedian_controls_rand() {
     let other = gen_with(src, &Opts::rect(3.0, 4.0).seed(99)).ok();
     assert_eq!(other.prints()[0..4], p[0..4]);
 }
+
+/// `NIL` in the middle of an operation sequence does not end it: the
+/// operations after it still run (CityEngine's envelope2002 package reports
+/// `report(..) NIL report(..) NIL` twice), and the shape is not part of the
+/// model.
+#[test]
+fn operations_after_nil_still_run() {
+    let g = gen("Lot --> extrude(3) comp(f) { top : print(\"a\" + geometry.area) NIL print(\"b\" + geometry.area) NIL | side : X. }\n").ok();
+    assert_eq!(g.prints(), ["a600", "b600"]);
+    // Only the four sides are in the model.
+    assert_eq!(g.meshes().len(), 4);
+}

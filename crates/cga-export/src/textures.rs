@@ -165,12 +165,16 @@ impl Textures {
     }
 
     /// `wall.jpg`, or `wall_2.jpg` when another texture already took that
-    /// name (two folders can both hold a `wall.jpg`).
+    /// name (two folders can both hold a `wall.jpg`). The extension is
+    /// written in lower case (`1.PNG` becomes `1.png`), as CityEngine's
+    /// exporters name copied textures.
     fn unique_name(&mut self, source: &Path) -> String {
         let stem = source
             .file_stem()
             .map_or("texture".into(), |s| s.to_string_lossy());
-        let ext = source.extension().map(|e| e.to_string_lossy());
+        let ext = source
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
         let with = |suffix: &str| match &ext {
             Some(e) => format!("{stem}{suffix}.{e}"),
             None => format!("{stem}{suffix}"),

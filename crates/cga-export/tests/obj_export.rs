@@ -188,6 +188,8 @@ fn textures_with_the_same_file_name_get_distinct_copies() {
         std::fs::create_dir_all(dir.join(sub)).unwrap();
         std::fs::write(dir.join(sub).join("wall.png"), sub.as_bytes()).unwrap();
     }
+    // An upper-case extension is written in lower case, as CityEngine does.
+    std::fs::write(dir.join("a").join("1.PNG"), b"c").unwrap();
     let textured = |p: &str| {
         let mut m = Material::default();
         m.maps[0].path = p.into();
@@ -198,7 +200,11 @@ fn textures_with_the_same_file_name_get_distinct_copies() {
     let path = out.join("walls.obj");
     write(
         &path,
-        &[textured("a/wall.png"), textured("b/wall.png")],
+        &[
+            textured("a/wall.png"),
+            textured("b/wall.png"),
+            textured("a/1.PNG"),
+        ],
         ExportOptions {
             texture_roots: vec![dir.clone()],
             embed_textures: true,
@@ -210,6 +216,8 @@ fn textures_with_the_same_file_name_get_distinct_copies() {
     assert_eq!(obj.mtl["material_2"]["map_Kd"], "wall_2.png");
     assert_eq!(std::fs::read(out.join("wall.png")).unwrap(), b"a");
     assert_eq!(std::fs::read(out.join("wall_2.png")).unwrap(), b"b");
+    assert_eq!(obj.mtl["material_3"]["map_Kd"], "1.png");
+    assert_eq!(std::fs::read(out.join("1.png")).unwrap(), b"c");
 }
 
 #[test]

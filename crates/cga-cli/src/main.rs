@@ -602,7 +602,7 @@ enum Delivery<L, R> {
 }
 
 /// Leaves per message from a worker to the writing thread.
-const LEAF_BATCH: usize = 64;
+const LEAF_BATCH: usize = 512;
 
 /// Derives lots `0..count` on `jobs` worker threads while the calling
 /// thread hands what they produce to `take` in lot order: the leaves of a

@@ -211,6 +211,8 @@ pub struct LotOutput {
 pub struct InitialInfo {
     pub name: String,
     pub start_rule: String,
+    /// The geographic origin of the lot's frame (`getGeoCoord(lon|lat)`).
+    pub geo_origin: Option<crate::geo::GeoOrigin>,
 }
 
 pub(crate) enum AttrSlot {

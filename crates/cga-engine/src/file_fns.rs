@@ -25,6 +25,18 @@ pub enum FileFn {
     FileSearch,
     FilesSearch,
     FileRandom,
+    /// `edgeAttr.getFloat/getString/getBool(name)`: the lot's edge
+    /// attributes.
+    EdgeAttr(EdgeAttrType),
+    /// `getGeoCoord(X|Y|lon|lat)`.
+    GetGeoCoord,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EdgeAttrType {
+    Float,
+    String,
+    Bool,
 }
 
 pub fn lookup(name: &str, arity: usize) -> Option<FileFn> {
@@ -39,6 +51,10 @@ pub fn lookup(name: &str, arity: usize) -> Option<FileFn> {
         ("fileSearch", 1) => FileFn::FileSearch,
         ("filesSearch", 1) => FileFn::FilesSearch,
         ("fileRandom", 1) => FileFn::FileRandom,
+        ("edgeAttr.getFloat", 1) => FileFn::EdgeAttr(EdgeAttrType::Float),
+        ("edgeAttr.getString", 1) => FileFn::EdgeAttr(EdgeAttrType::String),
+        ("edgeAttr.getBool", 1) => FileFn::EdgeAttr(EdgeAttrType::Bool),
+        ("getGeoCoord", 1) => FileFn::GetGeoCoord,
         _ => return None,
     })
 }
@@ -74,6 +90,45 @@ impl Interp<'_> {
         let file = at.span.file;
         Ok(match f {
             FileFn::Convert => self.convert(args, shape, at)?,
+            // Lots carry no edge attribute arrays (`/edgeattr/NAME`): every
+            // lookup gives the page's default for a missing attribute.
+            FileFn::EdgeAttr(t) => {
+                text(&args[0], at)?;
+                match t {
+                    EdgeAttrType::Float => Value::Float(0.0),
+                    EdgeAttrType::String => Value::str(""),
+                    EdgeAttrType::Bool => Value::Bool(false),
+                }
+            }
+            FileFn::GetGeoCoord => {
+                // The scope origin in scene coordinates: x is east and -z
+                // north (metres); longitude and latitude need a lot given
+                // in geographic coordinates.
+                let o = shape.scope.frame.origin;
+                let (east, north) = (o.x, -o.z);
+                match text(&args[0], at)? {
+                    "X" => Value::Float(east),
+                    "Y" => Value::Float(north),
+                    which @ ("lon" | "lat") => match self.info.geo_origin {
+                        Some(g) => {
+                            let (lon, lat) = g.to_geo(east, north);
+                            Value::Float(if which == "lon" { lon } else { lat })
+                        }
+                        None => {
+                            self.warn_once(at.span, || {
+                                "getGeoCoord: the lot is not georeferenced (give lots in longitude/latitude); it returns nan".to_string()
+                            });
+                            Value::Float(f64::NAN)
+                        }
+                    },
+                    other => {
+                        return Err(RtError::new(
+                            format!("unknown geo coordinate `{other}`: expected X, Y, lon or lat"),
+                            at.span,
+                        ))
+                    }
+                }
+            }
             FileFn::AssetInfo => {
                 let path = text(&args[0], at)?;
                 let which = text(&args[1], at)?;

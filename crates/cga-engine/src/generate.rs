@@ -202,6 +202,7 @@ fn derive<'a>(
     let info = InitialInfo {
         name: lot.name.clone(),
         start_rule: program.rules[rule as usize].name.clone(),
+        geo_origin: lot.geo_origin,
     };
     let mut interp = Interp::new(program, assets, options.limits, info, shape, &[]);
     interp.keep_leaves = options.leaves || sink.is_some();

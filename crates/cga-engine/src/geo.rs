@@ -19,6 +19,16 @@ pub struct GeoOrigin {
 }
 
 impl GeoOrigin {
+    /// The (longitude, latitude) of a point `east`, `north` metres from the
+    /// origin: the inverse of [`to_local`](GeoOrigin::to_local).
+    pub fn to_geo(&self, east: f64, north: f64) -> (f64, f64) {
+        let k = std::f64::consts::PI / 180.0;
+        (
+            self.lon + east / (EARTH_RADIUS * (self.lat * k).cos() * k),
+            self.lat + north / (EARTH_RADIUS * k),
+        )
+    }
+
     /// Metres east and north of the origin of a (lon, lat) point.
     pub fn to_local(&self, lon: f64, lat: f64) -> (f64, f64) {
         let k = std::f64::consts::PI / 180.0;

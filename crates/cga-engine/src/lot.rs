@@ -24,6 +24,9 @@ pub struct Lot {
     pub mesh: Mesh,
     /// Values for rule attributes of the same name (GeoJSON properties).
     pub attrs: Vec<(String, Value)>,
+    /// Where the lot's frame lies on the globe, for lots given in
+    /// longitude/latitude (`getGeoCoord(lon|lat)`).
+    pub geo_origin: Option<crate::geo::GeoOrigin>,
 }
 
 /// The lot `(0,0,0) (W,0,0) (W,0,-D) (0,0,-D)`.
@@ -37,6 +40,7 @@ pub fn rect(w: f64, d: f64) -> Lot {
             DVec3::new(0.0, 0.0, -d),
         ]),
         attrs: Vec::new(),
+        geo_origin: None,
     }
 }
 
@@ -74,6 +78,7 @@ pub fn from_obj(path: &std::path::Path) -> Result<Vec<Lot>, String> {
                 name: format!("{} face {n}", path.display()),
                 mesh: face_mesh(&mesh, &loops, mesh.faces[f].material),
                 attrs: Vec::new(),
+                geo_origin: None,
             }
         })
         .collect();
@@ -374,6 +379,7 @@ fn lots_from_geojson_text(
                 name: if pi == 0 { id } else { format!("{id}.{pi}") },
                 mesh,
                 attrs: attrs.clone(),
+                geo_origin: origin,
             });
         }
     }

@@ -58,6 +58,7 @@ pub fn arg_is_selector(name: &str, pos: usize) -> bool {
         "geometry.area" | "geometry.angle" | "geometry.isOriented" => pos == 0,
         "geometry.du" | "geometry.dv" | "geometry.hasTags" => pos == 1,
         "assetInfo" | "imageInfo" => pos == 1,
+        "getGeoCoord" => pos == 0,
         _ => false,
     }
 }
@@ -85,6 +86,8 @@ pub enum GeometryFn {
     VMax,
     Du,
     Dv,
+    /// `geometry.angle(maxSlope|azimuth|zenith)`.
+    Angle,
 }
 
 /// The shape function called `name` with `arity` arguments, if any.
@@ -148,6 +151,7 @@ pub fn lookup(name: &str, arity: usize) -> Option<ShapeFn> {
             "vMax" => (VMax, &[0, 1]),
             "du" => (Du, &[1, 2]),
             "dv" => (Dv, &[1, 2]),
+            "angle" => (Angle, &[1]),
             _ => return None,
         };
         return arities.contains(&arity).then_some(ShapeFn::Geometry(f));
@@ -449,6 +453,51 @@ mod eval {
                         GeometryFn::VMin => lo.y,
                         _ => hi.y,
                     }))
+                }
+                GeometryFn::Angle => {
+                    let which = match &args[0] {
+                        Value::Str(s) => s.clone(),
+                        other => {
+                            return Err(RtError::new(
+                                format!(
+                                    "expected maxSlope, azimuth or zenith, found {}",
+                                    other.type_name()
+                                ),
+                                at.span,
+                            ))
+                        }
+                    };
+                    // The area-weighted normal of the geometry (the normal
+                    // of a planar shape); its tilt from the y axis is the
+                    // slope, and its horizontal part points down the slope.
+                    let n = (0..mesh.faces.len())
+                        .map(|f| m::face_normal(&mesh, f) * m::face_area(&mesh, f))
+                        .fold(cga_geometry::DVec3::ZERO, |a, b| a + b)
+                        .normalize_or_zero();
+                    let slope = if n == cga_geometry::DVec3::ZERO {
+                        0.0
+                    } else {
+                        n.y.clamp(-1.0, 1.0).acos().to_degrees()
+                    };
+                    match &*which {
+                        "maxSlope" => fl(slope),
+                        "zenith" => fl(90.0 - slope),
+                        "azimuth" => {
+                            // Clockwise from north (-z): east (+x) is 90.
+                            let a = if n.x.abs() < 1e-12 && n.z.abs() < 1e-12 {
+                                0.0
+                            } else {
+                                n.x.atan2(-n.z).to_degrees().rem_euclid(360.0)
+                            };
+                            fl(if a >= 360.0 { 0.0 } else { a })
+                        }
+                        other => {
+                            return Err(RtError::new(
+                                format!("unknown angle type `{other}`: expected maxSlope, azimuth or zenith"),
+                                at.span,
+                            ))
+                        }
+                    }
                 }
                 GeometryFn::Du | GeometryFn::Dv => {
                     let set = uv_set(0)?;

@@ -78,6 +78,7 @@ fn delete_holes_and_convexify_a_ring() {
             name: "ring".into(),
             mesh,
             attrs: Vec::new(),
+            geo_origin: None,
         }],
         ..Opts::default()
     };

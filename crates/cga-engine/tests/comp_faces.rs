@@ -159,6 +159,7 @@ fn colon_equals_and_connected_sets() {
             DVec3::new(0.0, 0.0, -20.0),
         ]),
         attrs: Vec::new(),
+        geo_origin: None,
     };
     let text = r#"Lot --> extrude(5) comp(f) { front : P("sep") | all = P("mass") }
 Eq --> extrude(5) comp(f) { front = P("one") | all = P("mass") }
@@ -389,6 +390,7 @@ fn world_and_object_selectors_on_a_turned_lot() {
             DVec3::new(-30.0, 0.0, 0.0),
         ]),
         attrs: Vec::new(),
+        geo_origin: None,
     };
     let text = r#"Lot --> extrude(5) comp(f) { world.east : P("east") | world.south : P("south") | world.up : P("up") | world.down : P("down") | world.side = P("side") }
 Obj --> extrude(5) comp(f) { object.front : P("ofront") | street.back : P("sback") | object.top : P("otop") | object.side = P("oside") }
@@ -454,6 +456,7 @@ fn holes_and_faces_of_a_lot_with_a_hole() {
         name: "court".into(),
         mesh,
         attrs: Vec::new(),
+        geo_origin: None,
     };
     let text = r#"Lot --> extrude(3) comp(f) { side : P("side") | top : P("top") }
 Holes --> comp(h) { all : P("hole") }

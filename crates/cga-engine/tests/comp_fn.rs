@@ -18,6 +18,7 @@ fn l_lot() -> Lot {
             DVec3::new(0.0, 0.0, -20.0),
         ]),
         attrs: Vec::new(),
+        geo_origin: None,
     }
 }
 

@@ -142,6 +142,7 @@ fn two_face_lot() -> Lot {
         name: "two faces".into(),
         mesh: m,
         attrs: Vec::new(),
+        geo_origin: None,
     }
 }
 

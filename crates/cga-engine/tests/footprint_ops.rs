@@ -168,6 +168,7 @@ fn setback_distances_over_two_faces() {
             name: "two".into(),
             mesh,
             attrs: Vec::new(),
+            geo_origin: None,
         }],
         ..Opts::default()
     };

@@ -67,6 +67,7 @@ fn lot_with_hole() -> Opts {
             name: "holed".into(),
             mesh,
             attrs: Vec::new(),
+            geo_origin: None,
         }],
         ..Opts::default()
     }

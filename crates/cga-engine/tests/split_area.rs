@@ -75,6 +75,7 @@ fn lot(outer: &[(f64, f64)], holes: &[&[(f64, f64)]]) -> Lot {
         name: "test lot".to_string(),
         mesh,
         attrs: Vec::new(),
+        geo_origin: None,
     }
 }
 
@@ -495,6 +496,7 @@ fn multi_face_lot() {
         name: "fan".into(),
         mesh,
         attrs: Vec::new(),
+        geo_origin: None,
     };
     let out = run("repeat.cga", "Lot", &l);
     let fifth = 0.2 * CONCAVE_AREA;

@@ -77,6 +77,7 @@ impl LotSpec {
             name: "random".into(),
             mesh,
             attrs: Vec::new(),
+            geo_origin: None,
         }
     }
 }

@@ -155,6 +155,7 @@ pub fn multi_face_lot(faces: &[&[DVec3]]) -> Lot {
         name: "multi".to_string(),
         mesh,
         attrs: Vec::new(),
+        geo_origin: None,
     }
 }
 

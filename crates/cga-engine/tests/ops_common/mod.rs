@@ -56,6 +56,7 @@ impl Opts {
                 name: "polygon".into(),
                 mesh: Mesh::polygon(points),
                 attrs: Vec::new(),
+                geo_origin: None,
             }],
             ..Opts::default()
         }

@@ -1,0 +1,94 @@
+//! Shape functions that read the geometry's orientation and the lot's
+//! place: `geometry.angle`, `getGeoCoord`, `edgeAttr.*`.
+
+mod ops_common;
+
+use cga_engine::lot::Lot;
+use ops_common::*;
+
+/// func_geometry, geometry.angle: on a gable roof of 30 degrees over
+/// `rect:20,30` (ridge along z), the two roof planes slope 30 degrees and
+/// face east (azimuth 90) and west (270); the gable ends are vertical
+/// (slope 90, zenith 0); zenith is always 90 - maxSlope.
+#[test]
+fn geometry_angle_on_a_gable_roof() {
+    let g = gen("Lot --> roofGable(30) comp(f) { all : print(comp.index + \" \" + geometry.angle(maxSlope) + \" \" + geometry.angle(azimuth) + \" \" + geometry.angle(zenith) + \" \" + geometry.area) }\n").ok();
+    let rows: Vec<Vec<f64>> = g.prints().iter().map(|l| numbers(l)).collect();
+    assert_eq!(rows.len(), 5);
+    let roof: Vec<&Vec<f64>> = rows.iter().filter(|r| (r[1] - 30.0).abs() < 1e-9).collect();
+    assert_eq!(roof.len(), 2);
+    let mut azimuths: Vec<f64> = roof.iter().map(|r| r[2]).collect();
+    azimuths.sort_by(f64::total_cmp);
+    assert_all_near(&azimuths, &[90.0, 270.0], 1e-9);
+    for r in &roof {
+        assert_near(r[3], 60.0, 1e-9);
+        assert_near(r[4], 20.0 * 30.0 / 2.0 / 30f64.to_radians().cos(), 1e-9);
+    }
+    let ends: Vec<&Vec<f64>> = rows.iter().filter(|r| (r[1] - 90.0).abs() < 1e-9).collect();
+    assert_eq!(ends.len(), 2);
+    for r in &ends {
+        assert_near(r[3], 0.0, 1e-9);
+    }
+    // A flat lot faces straight up: no slope, zenith 90.
+    let g = gen("Lot --> print(geometry.angle(maxSlope)) print(geometry.angle(zenith))\n").ok();
+    assert_eq!(g.prints(), ["0", "90"]);
+}
+
+/// Azimuth is clockwise from north (-z): a plane tilted down towards +z
+/// (south) has azimuth 180, towards -x (west) 270.
+#[test]
+fn geometry_angle_azimuth_directions() {
+    let g = gen("Lot --> [ r(20, 0, 0) print(geometry.angle(azimuth)) print(geometry.angle(maxSlope)) ] [ r(0, 0, 45) print(geometry.angle(azimuth)) print(geometry.angle(maxSlope)) ]\n").ok();
+    let p: Vec<f64> = g.prints().iter().map(|l| l.parse().unwrap()).collect();
+    assert_eq!(p.len(), 4);
+    assert_near(p[1], 20.0, 1e-9);
+    assert_near(p[3], 45.0, 1e-9);
+    // r(20,0,0) turns the up normal towards +z (south), r(0,0,45)
+    // towards -x (west).
+    assert_near(p[0], 180.0, 1e-9);
+    assert_near(p[2], 270.0, 1e-9);
+}
+
+/// getGeoCoord: X and Y are the scope origin's easting and northing (x
+/// and -z); lon/lat need a lot given in longitude/latitude and invert the
+/// projection that placed it.
+#[test]
+fn get_geo_coord() {
+    let src = "Lot --> print(getGeoCoord(X)) print(getGeoCoord(Y)) print(getGeoCoord(lon)) print(getGeoCoord(lat))\n";
+    let g = gen(src);
+    let p = g.prints();
+    assert_eq!(p[..2], ["0", "30"]);
+    assert_eq!(p[2..], ["nan", "nan"]);
+    assert!(g.warnings().iter().any(|w| w.contains("not georeferenced")));
+
+    let origin = cga_engine::geo::GeoOrigin {
+        lon: 8.54,
+        lat: 47.37,
+    };
+    let mut lot: Lot = cga_engine::lot::rect(20.0, 30.0);
+    lot.geo_origin = Some(origin);
+    let g = gen_with(
+        src,
+        &Opts {
+            lots: vec![lot],
+            ..Opts::default()
+        },
+    )
+    .ok();
+    let p: Vec<f64> = g.prints().iter().map(|l| l.parse().unwrap()).collect();
+    // The scope origin is 30 m north of the frame's origin.
+    assert_near(p[2], 8.54, 1e-12);
+    let metres_per_degree = 6_371_008.8 * std::f64::consts::PI / 180.0;
+    assert_near(p[3], 47.37 + 30.0 / metres_per_degree, 1e-12);
+    let back = origin.to_local(p[2], p[3]);
+    assert_near(back.0, 0.0, 1e-6);
+    assert_near(back.1, 30.0, 1e-6);
+}
+
+/// func_edgeAttr: without an edge attribute array of that name, each
+/// function returns its type's default (0, "", false).
+#[test]
+fn edge_attributes_default_when_missing() {
+    let g = gen("getColor = edgeAttr.getString(\"colors\")\nLot --> print(\"[\" + getColor + \"]\") print(edgeAttr.getFloat(\"w\")) print(edgeAttr.getBool(\"b\"))\n").ok();
+    assert_eq!(g.prints(), ["[]", "0", "false"]);
+}

@@ -30,6 +30,29 @@ pub enum FileFn {
     EdgeAttr(EdgeAttrType),
     /// `getGeoCoord(X|Y|lon|lat)`.
     GetGeoCoord,
+    /// `assetsSortSize(files, axes, maxScaleError)`.
+    AssetsSortSize,
+    /// `assetsSortRatio(files, axes)`.
+    AssetsSortRatio,
+    /// `imagesSortRatio(files, axes)`.
+    ImagesSortRatio,
+    /// `assetMetadata(file, key, default)`.
+    AssetMetadata,
+    /// `sel(string)`: a selector from a string.
+    Sel,
+    /// Functions of CGA this engine does not compute: a warning and an
+    /// empty result of the function's type, so that rule files using them
+    /// still generate.
+    Unsupported(Unsupported),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Unsupported {
+    /// `getTreeKey()`, `assetNamingInfo(..)`: a string.
+    Str(&'static str),
+    /// `assetNamingInfos(..)`, `getMaterial(..)`, `readMaterial(..)`: a
+    /// string array.
+    StrArray(&'static str),
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -55,6 +78,16 @@ pub fn lookup(name: &str, arity: usize) -> Option<FileFn> {
         ("edgeAttr.getString", 1) => FileFn::EdgeAttr(EdgeAttrType::String),
         ("edgeAttr.getBool", 1) => FileFn::EdgeAttr(EdgeAttrType::Bool),
         ("getGeoCoord", 1) => FileFn::GetGeoCoord,
+        ("assetsSortSize", 3) => FileFn::AssetsSortSize,
+        ("assetsSortRatio", 2) => FileFn::AssetsSortRatio,
+        ("imagesSortRatio", 2) => FileFn::ImagesSortRatio,
+        ("assetMetadata", 3) => FileFn::AssetMetadata,
+        ("sel", 1) => FileFn::Sel,
+        ("getTreeKey", 0) => FileFn::Unsupported(Unsupported::Str("getTreeKey")),
+        ("assetNamingInfo", 2) => FileFn::Unsupported(Unsupported::Str("assetNamingInfo")),
+        ("assetNamingInfos", 2) => FileFn::Unsupported(Unsupported::StrArray("assetNamingInfos")),
+        ("getMaterial", 1 | 2) => FileFn::Unsupported(Unsupported::StrArray("getMaterial")),
+        ("readMaterial", 1) => FileFn::Unsupported(Unsupported::StrArray("readMaterial")),
         _ => return None,
     })
 }
@@ -211,6 +244,29 @@ impl Interp<'_> {
             FileFn::FileExists => {
                 Value::Bool(self.assets.resolve(file, text(&args[0], at)?).is_some())
             }
+            FileFn::AssetsSortSize | FileFn::AssetsSortRatio | FileFn::ImagesSortRatio => {
+                self.sort_files(f, args, shape, at)?
+            }
+            // Only OBJ assets are read, and OBJ carries no metadata: the
+            // default value is the answer.
+            FileFn::AssetMetadata => {
+                text(&args[0], at)?;
+                text(&args[1], at)?;
+                args[2].clone()
+            }
+            FileFn::Sel => Value::Str(Arc::from(text(&args[0], at)?)),
+            FileFn::Unsupported(u) => {
+                let (name, value) = match u {
+                    Unsupported::Str(n) => (n, Value::str("")),
+                    Unsupported::StrArray(n) => {
+                        (n, Value::StrArray(Arc::new(Array::row(Vec::new()))))
+                    }
+                };
+                self.warn_once(at.span, || {
+                    format!("the function `{name}` is not supported yet; it returns an empty value")
+                });
+                value
+            }
             FileFn::FileSearch | FileFn::FilesSearch | FileFn::FileRandom => {
                 let found = self.assets.search(file, text(&args[0], at)?);
                 match f {
@@ -230,6 +286,142 @@ impl Interp<'_> {
                     }
                 }
             }
+        })
+    }
+
+    /// `assetsSortSize`, `assetsSortRatio`, `imagesSortRatio`: the files
+    /// (a `;`-terminated list or a string array, answered in the same form)
+    /// ordered by how well their size or aspect ratio fits the scope's, best
+    /// first; ties keep the given order.
+    fn sort_files(
+        &mut self,
+        f: FileFn,
+        args: &[Value],
+        shape: &Shape,
+        at: &RExpr,
+    ) -> Result<Value, RtError> {
+        let file = at.span.file;
+        let (files, as_list): (Vec<Arc<str>>, bool) = match &args[0] {
+            Value::Str(s) => (
+                s.split(';')
+                    .filter(|p| !p.is_empty())
+                    .map(Arc::from)
+                    .collect(),
+                true,
+            ),
+            Value::StrArray(a) => (a.data.to_vec(), false),
+            other => {
+                return Err(RtError::new(
+                    format!(
+                        "expected a file list or a string array, found {}",
+                        other.type_name()
+                    ),
+                    at.span,
+                ))
+            }
+        };
+        let axes_text = text(&args[1], at)?;
+        let axes: Vec<usize> = axes_text
+            .chars()
+            .map(|c| match c {
+                'x' => Ok(0),
+                'y' => Ok(1),
+                'z' => Ok(2),
+                _ => Err(()),
+            })
+            .collect::<Result<_, _>>()
+            .ok()
+            .filter(|a: &Vec<usize>| !a.is_empty())
+            .ok_or_else(|| {
+                RtError::new(
+                    format!("unknown axes `{axes_text}`: expected x, y, z, xy, xz, yz or xyz"),
+                    at.span,
+                )
+            })?;
+        let scope = shape.scope.size.to_array();
+        // Each file's size along x, y, z (images: width and height as the
+        // two selected axes), or None when it cannot be read.
+        let sizes: Vec<Option<[f64; 3]>> = files
+            .iter()
+            .map(|path| {
+                if f == FileFn::ImagesSortRatio {
+                    let s = self
+                        .assets
+                        .resolve(file, path)
+                        .and_then(|p| imagesize::size(p).ok())?;
+                    let mut v = [0.0; 3];
+                    v[axes[0]] = s.width as f64;
+                    if let Some(&b) = axes.get(1) {
+                        v[b] = s.height as f64;
+                    }
+                    Some(v)
+                } else {
+                    let mesh = self.assets.mesh(file, path).ok()?;
+                    let (lo, hi) = cga_geometry::measure::bounds(&mesh)?;
+                    Some((hi - lo).to_array())
+                }
+            })
+            .collect();
+        let max_error = match f {
+            FileFn::AssetsSortSize => num(&args[2], at)?,
+            _ => 0.0,
+        };
+        // How far a file is from fitting: for sizes, the largest relative
+        // scaling it needs along the axes; for ratios, the largest factor
+        // (as a logarithm) between its axis ratios and the scope's.
+        let misfit = |size: [f64; 3]| -> f64 {
+            if f == FileFn::AssetsSortSize {
+                axes.iter()
+                    .map(|&a| {
+                        if size[a] > 0.0 {
+                            (scope[a] / size[a] - 1.0).abs()
+                        } else {
+                            f64::INFINITY
+                        }
+                    })
+                    .fold(0.0, f64::max)
+            } else {
+                axes.windows(2)
+                    .map(|w| {
+                        let ours = scope[w[0]] / scope[w[1]];
+                        let theirs = size[w[0]] / size[w[1]];
+                        let r = (ours / theirs).ln().abs();
+                        if r.is_nan() {
+                            f64::INFINITY
+                        } else {
+                            r
+                        }
+                    })
+                    .fold(0.0, f64::max)
+            }
+        };
+        let mut ranked: Vec<(f64, usize)> = Vec::with_capacity(files.len());
+        for (i, size) in sizes.iter().enumerate() {
+            match size {
+                // Differences at rounding level (an asset written as
+                // 0.999999999999999 wide) count as a perfect fit.
+                Some(s) => ranked.push((Some(misfit(*s)).filter(|&e| e > 1e-9).unwrap_or(0.0), i)),
+                None => {
+                    let path = files[i].clone();
+                    self.warn_once(at.span, || {
+                        format!("\"{path}\" not found or not readable; it is sorted last")
+                    });
+                    ranked.push((f64::INFINITY, i));
+                }
+            }
+        }
+        ranked.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let kept: Vec<Arc<str>> = ranked
+            .into_iter()
+            .filter(|&(e, _)| max_error <= 0.0 || e <= max_error)
+            .map(|(_, i)| files[i].clone())
+            .collect();
+        Ok(if as_list {
+            Value::Str(Arc::from(
+                kept.iter().map(|s| format!("{s};")).collect::<String>(),
+            ))
+        } else {
+            Value::StrArray(Arc::new(Array::row(kept)))
         })
     }
 

@@ -59,6 +59,7 @@ pub fn arg_is_selector(name: &str, pos: usize) -> bool {
         "geometry.du" | "geometry.dv" | "geometry.hasTags" => pos == 1,
         "assetInfo" | "imageInfo" => pos == 1,
         "getGeoCoord" => pos == 0,
+        "assetsSortSize" | "assetsSortRatio" | "imagesSortRatio" => pos == 1,
         _ => false,
     }
 }

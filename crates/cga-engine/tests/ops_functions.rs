@@ -92,3 +92,56 @@ fn edge_attributes_default_when_missing() {
     let g = gen("getColor = edgeAttr.getString(\"colors\")\nLot --> print(\"[\" + getColor + \"]\") print(edgeAttr.getFloat(\"w\")) print(edgeAttr.getBool(\"b\"))\n").ok();
     assert_eq!(g.prints(), ["[]", "0", "false"]);
 }
+
+/// func_assetsSortSize, func_assetsSortRatio: assets ordered by how well
+/// they fit the scope (box.obj is 2 x 3 x 1, plant.obj 1 x 1 x 0,
+/// flat2.obj 20 x 0 x 10), in the form they were given; a maximum scale
+/// error keeps only the assets within it.
+#[test]
+fn assets_sorted_by_size_and_ratio() {
+    let src = "Lot --> s(2, 3, 1) primitiveCube()\n\
+               print(assetsSortSize(\"plant.obj;box.obj;\", xyz, 0))\n\
+               print(assetsSortSize(\"plant.obj;box.obj;\", xyz, 0.1))\n\
+               print(assetsSortSize([\"plant.obj\", \"box.obj\"], xy, 0))\n\
+               print(assetsSortSize(\"box.obj;plant.obj;\", x, 1))\n\
+               print(assetsSortRatio(\"flat2.obj;plant.obj;box.obj;\", xy))\n\
+               print(assetsSortRatio(\"box.obj;flat2.obj;\", xz))\n\
+               print(assetMetadata(\"box.obj\", \"author\", \"nobody\"))\n\
+               print(sel(\"x\"))\n";
+    let g = gen(src).ok();
+    assert_eq!(
+        g.prints(),
+        [
+            "box.obj;plant.obj;",
+            "box.obj;",
+            "(2)[box.obj,plant.obj]",
+            // x: box fits (0), plant needs twice its size (error 1).
+            "box.obj;plant.obj;",
+            // xy ratio 2/3: box exact, plant 1/1, flat2 has no height.
+            "box.obj;plant.obj;flat2.obj;",
+            // xz ratio 2: both fit; ties keep the given order.
+            "box.obj;flat2.obj;",
+            "nobody",
+            "x",
+        ]
+    );
+}
+
+/// CGA functions this engine does not compute give a warning and an empty
+/// value instead of failing the rule file.
+#[test]
+fn unsupported_functions_warn_and_return_empty_values() {
+    let g = gen("Lot --> print(\"[\" + getTreeKey() + \"]\") print(readMaterial(\"m.mtl\"))\n");
+    assert_eq!(g.prints(), ["[]", "(0)[]"]);
+    let w = g.warnings();
+    assert!(
+        w.iter()
+            .any(|w| w.contains("`getTreeKey` is not supported")),
+        "{w:?}"
+    );
+    assert!(
+        w.iter()
+            .any(|w| w.contains("`readMaterial` is not supported")),
+        "{w:?}"
+    );
+}

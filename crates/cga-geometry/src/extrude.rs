@@ -155,8 +155,7 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
     }
 
     let mut out = Mesh::new();
-    out.materials = mesh.materials.clone();
-    out.groups = mesh.groups.clone();
+    out.share_slots(mesh);
     out.positions = weld
         .representative
         .iter()
@@ -235,6 +234,7 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
                 loop_count: loops.len() as u32,
                 material: src.material,
                 group: src.group,
+                tags: src.tags,
             });
         };
 

@@ -331,7 +331,10 @@ fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {
             .find(|n| n.length_squared() > 0.5)
             .unwrap_or(shape.scope.frame.axes.y_axis),
     };
-    let out = cga_geometry::extrude(&mesh, how, dist);
+    let (mut out, roles) = cga_geometry::extrude_with_roles(&mesh, how, dist);
+    cga_geometry::tags::set_face_auto_tags(&mut out, "extrude", |f| {
+        roles.get(f).map_or("extrude.side.outer", |r| r.tag())
+    });
     // New scope: y along the extrusion, x the old x made orthogonal to it.
     let y = dir;
     let old_x = shape.scope.frame.axes.x_axis;

@@ -10,6 +10,7 @@ mod footprint;
 mod roof;
 mod scope_ops;
 pub mod split;
+mod tags;
 pub mod split_area;
 pub mod texturing;
 mod transform;
@@ -98,6 +99,8 @@ pub enum Op {
     DeleteUV,
     CopyUV,
     InsertAlongUV,
+    Tag,
+    DeleteTags,
 }
 
 /// How an operation's arguments are read by the resolver.
@@ -147,6 +150,7 @@ pub fn arg_mode(name: &str, arity: usize, pos: usize) -> ArgMode {
         ("roofGable" | "roofHip" | "roofShed" | "roofPyramid" | "roofRidge", _, 0) => Maybe,
         ("scatter" | "rectify" | "cleanupGeometry" | "setNormals" | "mirror", _, _) => Maybe,
         ("trim" | "taper" | "reduceGeometry" | "insertAlongUV", _, _) => Maybe,
+        ("tag" | "deleteTags", 2, 1) => Selector,
         _ => Expr,
     }
 }
@@ -251,6 +255,8 @@ pub fn lookup(name: &str) -> Option<OpInfo> {
         "mirror" => info(Op::Mirror, 3, 3),
         "reduceGeometry" => info(Op::ReduceGeometry, 1, 1),
         "rectify" => info(Op::Rectify, 1, 1),
+        "tag" => info(Op::Tag, 1, 2),
+        "deleteTags" => info(Op::DeleteTags, 0, 2),
         _ => None,
     }
 }
@@ -409,5 +415,6 @@ pub fn exec(
         | Op::Mirror
         | Op::ReduceGeometry
         | Op::Rectify => cleanup::exec(cx, st, call, args),
+        Op::Tag | Op::DeleteTags => tags::exec(st, call, args),
     }
 }

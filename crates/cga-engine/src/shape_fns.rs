@@ -282,12 +282,8 @@ mod eval {
                 TagTarget::parse(s).unwrap_or(TagTarget::All)
             }
             Some(other) => {
-                return Err(RtError::new(
-                    format!(
-                        "expected a component selector (all, faces, edges, vertices), found {other:?}"
-                    ),
-                    at.span,
-                ))
+                let msg = format!("expected all, faces, edges or vertices, found {other:?}");
+                return Err(RtError::new(msg, at.span));
             }
         };
         // The stored mesh before its pending transform: tags do not move.

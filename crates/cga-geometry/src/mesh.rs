@@ -259,7 +259,10 @@ impl Mesh {
         if let Some(n) = &mut self.normals {
             n.reserve(corners);
         }
-        for t in [&mut self.edge_tags, &mut self.vertex_tags].into_iter().flatten() {
+        for t in [&mut self.edge_tags, &mut self.vertex_tags]
+            .into_iter()
+            .flatten()
+        {
             t.reserve(corners);
         }
     }
@@ -339,7 +342,10 @@ impl Mesh {
         if let Some(normals) = &mut self.normals {
             normals.resize(n, DVec3::ZERO);
         }
-        for t in [&mut self.edge_tags, &mut self.vertex_tags].into_iter().flatten() {
+        for t in [&mut self.edge_tags, &mut self.vertex_tags]
+            .into_iter()
+            .flatten()
+        {
             t.resize(n, 0);
         }
         self.faces.push(Face {

@@ -386,7 +386,11 @@ pub fn clear_tags(mesh: &mut Mesh) {
 /// Applies an operation's auto-tags to the faces: face `f` loses the tags
 /// under `family` (the same operation's earlier auto-tags, e.g. "extrude")
 /// and gets `role(f)` ("extrude.top"), keeping its other tags.
-pub fn set_face_auto_tags(mesh: &mut Mesh, family: &str, mut role: impl FnMut(usize) -> &'static str) {
+pub fn set_face_auto_tags(
+    mesh: &mut Mesh,
+    family: &str,
+    mut role: impl FnMut(usize) -> &'static str,
+) {
     let q = TagQuery::parse(family);
     let mut memo: Vec<(u32, &'static str, u32)> = Vec::new();
     for f in 0..mesh.faces.len() {
@@ -395,7 +399,10 @@ pub fn set_face_auto_tags(mesh: &mut Mesh, family: &str, mut role: impl FnMut(us
         let new = match memo.iter().find(|m| m.0 == old && m.1 == r) {
             Some(m) => m.2,
             None => {
-                let set = mesh.tag_set(old).without(|t| q.matches(t)).with(&Arc::from(r));
+                let set = mesh
+                    .tag_set(old)
+                    .without(|t| q.matches(t))
+                    .with(&Arc::from(r));
                 let i = mesh.intern_tags(set);
                 memo.push((old, r, i));
                 i
@@ -497,7 +504,10 @@ pub fn import_table(dst: &mut Mesh, src: &Mesh) -> Vec<u32> {
     if crate::mesh::SharedVec::ptr_eq(&dst.tags, &src.tags) {
         return (0..src.tags.len() as u32).collect();
     }
-    src.tags.iter().map(|s| dst.intern_tags(s.clone())).collect()
+    src.tags
+        .iter()
+        .map(|s| dst.intern_tags(s.clone()))
+        .collect()
 }
 
 #[cfg(test)]
@@ -576,7 +586,10 @@ mod tests {
         assert!(m.edge_tags_at(3).contains("E"));
         assert!(m.vertex_tags_at(2).contains("V"));
         let all = collect_tags(&m, &TagQuery::all(), TagTarget::All);
-        assert_eq!(all.iter().map(|t| &**t).collect::<Vec<_>>(), ["E", "V", "Wall.A"]);
+        assert_eq!(
+            all.iter().map(|t| &**t).collect::<Vec<_>>(),
+            ["E", "V", "Wall.A"]
+        );
         let faces = collect_tags(&m, &TagQuery::all(), TagTarget::Faces);
         assert_eq!(faces.len(), 1);
         delete_tags(&mut m, Some(&q("Wall")), TagTarget::All);
@@ -596,7 +609,10 @@ mod tests {
         add_tag(&mut m, "mine", TagTarget::Faces);
         set_face_auto_tags(&mut m, "extrude", |_| "extrude.top");
         set_face_auto_tags(&mut m, "extrude", |_| "extrude.bottom");
-        assert_eq!(m.face_tags(0), &TagSet::from_names(["extrude.bottom", "mine"]));
+        assert_eq!(
+            m.face_tags(0),
+            &TagSet::from_names(["extrude.bottom", "mine"])
+        );
         set_edge_auto_tags(&mut m, "setback", |c| (c == 0).then_some("setback.front"));
         assert!(m.edge_tags_at(0).contains("setback.front"));
         assert!(m.edge_tags_at(1).is_empty());

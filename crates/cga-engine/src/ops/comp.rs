@@ -447,16 +447,17 @@ impl Components {
             let topo = self.topology();
             edge = vec![false; topo.edges.len()];
             for (e, hit) in edge.iter_mut().enumerate() {
-                *hit = topo.edge_uses(e).iter().any(|u| {
-                    face[u.face as usize] || ok(mesh.edge_tag_index(u.corner as usize))
-                });
+                *hit = topo
+                    .edge_uses(e)
+                    .iter()
+                    .any(|u| face[u.face as usize] || ok(mesh.edge_tag_index(u.corner as usize)));
             }
             vertex = vec![false; topo.weld.count];
-            for f in 0..mesh.faces.len() {
+            for (f, &face_ok) in face.iter().enumerate() {
                 for &l in mesh.face_loops(f) {
                     for c in mesh.loop_corners(l) {
                         let v = topo.weld.id[mesh.corners[c] as usize] as usize;
-                        if face[f] || ok(mesh.vertex_tag_index(c)) {
+                        if face_ok || ok(mesh.vertex_tag_index(c)) {
                             vertex[v] = true;
                         }
                     }
@@ -497,7 +498,8 @@ impl Components {
                 .filter(|&e| e != u32::MAX)
                 .map(|e| e as usize)
         };
-        let edge_hit = |e: Option<usize>| e.is_some_and(|e| t.edge.get(e).copied().unwrap_or(false));
+        let edge_hit =
+            |e: Option<usize>| e.is_some_and(|e| t.edge.get(e).copied().unwrap_or(false));
         let vertex_hit =
             |v: Option<usize>| v.is_some_and(|v| t.vertex.get(v).copied().unwrap_or(false));
         // A face by its own tags, or by one of its edges or vertices.

@@ -343,7 +343,6 @@ fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {
         .unwrap_or_else(|| y.any_orthonormal_vector());
     let axes = DMat3::from_cols(x, y, x.cross(y));
     let to_scope = shape.scope.frame.affine().inverse();
-    let mut out = out;
     crate::shape::transform_in_place(&mut out, &to_scope);
     shape.set_local_mesh(out);
     shape.fit_scope(axes);

@@ -10,8 +10,8 @@ mod footprint;
 mod roof;
 mod scope_ops;
 pub mod split;
-mod tags;
 pub mod split_area;
+mod tags;
 pub mod texturing;
 mod transform;
 

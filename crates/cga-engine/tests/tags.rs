@@ -187,7 +187,8 @@ fn envelope_side_inner_on_a_lot_with_a_hole() {
         &holed_lot(),
     );
     assert_eq!(firsts(&m, "bottom"), [500.0]);
-    assert!(count(&m, "inner") >= 4, "{m:?}");
+    // A base wall and a slope on each of the hole's 4 edges.
+    assert_eq!(count(&m, "inner"), 8);
 }
 
 /// The envelope of the isTagged examples of op_comp.md (front base 0).
@@ -231,11 +232,17 @@ fn is_tagged_with_subcomponents() {
         r#"Init --> {COMP_ENVELOPE}
     comp(e) {{ isTagged("envelope.bottom", v) : E("edge") | all : E("other") }}"#
     ));
-    // The bottom's 4 edges, and the edges rising from its 4 corners.
-    let edges = count(&m, "edge");
-    assert!(edges >= 8, "{m:?}");
-    // Edges whose both ends are off the ground are not selected.
-    assert!(count(&m, "other") >= 4, "{m:?}");
+    // The bottom's 4 edges, and the 4 edges rising from its corners: the
+    // front slope's (45 degrees up to the 2 m side walls: 2 sqrt 2 long)
+    // and the back's base walls (2 m).
+    let edges = firsts(&m, "edge");
+    assert_all_near(
+        &edges,
+        &[2.0, 2.0, 8f64.sqrt(), 8f64.sqrt(), 20.0, 20.0, 30.0, 30.0],
+        1e-9,
+    );
+    // Edges with both ends off the ground are not selected.
+    assert_eq!(count(&m, "other"), 19);
     // Default: an edge matches by the tags of its faces only.
     let m = run(&format!(
         r#"Init --> {COMP_ENVELOPE}
@@ -305,7 +312,10 @@ fn roof_ridge_and_shed_auto_tags() {
         &holed_lot(),
     );
     assert_eq!(firsts(&m, "bottom"), [500.0]);
-    assert!(count(&m, "outer") > 0 && count(&m, "inner") > 0, "{m:?}");
+    // Two outer side walls (60 m2 each), one wall per hole edge inside.
+    assert_eq!(firsts(&m, "outer"), [60.0, 60.0]);
+    assert_eq!(count(&m, "inner"), 4);
+    assert_eq!(count(&m, "top"), 2);
     assert_eq!(count(&m, "other"), 0);
 }
 
@@ -398,8 +408,7 @@ VisualizeTags -->
     // Every piece of an original edge keeps its tag: the 4 eaves along z
     // (2 outer pieces, 30 m), the pieces of the 2 front and back eaves
     // and of the 4 gable rakes (one per piece), and the ridge (on the cut
-    // at x = 10: in both middle pieces). Edges along the cuts have none:
-    // per cut 3 edges of the cap triangle... in each piece touching it.
+    // at x = 10: in both middle pieces). Edges along the cuts have none.
     let edges = firsts(&m, "edge");
     assert_eq!(edges.iter().filter(|&&l| l == 30.0).count(), 4, "{edges:?}");
     assert_eq!(edges.iter().filter(|&&l| l == 5.0).count(), 8, "{edges:?}");
@@ -411,7 +420,9 @@ fn new_faces_keep_their_source_face_tags() {
     // roofGable then extrude(1): every face has both roof and extrude tags.
     let m = run(r#"Init --> roofGable(byHeight, 4) extrude(1)
     comp(f) { isTagged("roof") && isTagged("extrude") : P("both") | all : P("other") }"#);
-    assert!(count(&m, "both") >= 5 * 2, "{m:?}");
+    // 5 roof faces (bottom, 2 gables, 2 planes), each extruded into a
+    // bottom, a top and one side per edge (4 + 3 + 3 + 4 + 4 sides): 28.
+    assert_eq!(count(&m, "both"), 28);
     assert_eq!(count(&m, "other"), 0);
 }
 

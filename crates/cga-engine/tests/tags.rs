@@ -405,10 +405,10 @@ VisualizeTags -->
             "{v:?}"
         );
     }
-    // Every piece of an original edge keeps its tag: the 4 eaves along z
-    // (2 outer pieces, 30 m), the pieces of the 2 front and back eaves
-    // and of the 4 gable rakes (one per piece), and the ridge (on the cut
-    // at x = 10: in both middle pieces). Edges along the cuts have none.
+    // Every piece of an original edge keeps its tag: 30 m long, the 2
+    // eaves along z (in the outer pieces) and the ridge (on the cut at
+    // x = 10: in both middle pieces); 5 m long, the pieces of the front
+    // and back eaves. Edges along the cuts have none.
     let edges = firsts(&m, "edge");
     assert_eq!(edges.iter().filter(|&&l| l == 30.0).count(), 4, "{edges:?}");
     assert_eq!(edges.iter().filter(|&&l| l == 5.0).count(), 8, "{edges:?}");

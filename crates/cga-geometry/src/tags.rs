@@ -10,6 +10,24 @@
 //! edge carries the union of its face edges' tags, a welded vertex the
 //! union of its corners' tags.
 //!
+//! Propagation, as implemented (cga_componentTags.md, "Tag propagation"):
+//! - face tags: kept by every derived face that copies its source face's
+//!   material (cut pieces, extrude, offset/setback strips and insides,
+//!   roofs, envelope, taper, convexify, cleanup, comp components, trim,
+//!   innerRectangle, UV splits); cut caps get none; extrude sides also get
+//!   the tags of the edge they rise from; the auto-tags of extrude, taper,
+//!   the roofs and envelope replace that operation's earlier auto-tags;
+//!   i, the primitives, footprint, resetGeometry, splitArea and
+//!   reduceGeometry clear all tags;
+//! - edge and vertex tags (per corner): kept by cut (pieces of tagged edges
+//!   keep their tags; cut edges and new vertices get none), extrude (base
+//!   and top edges keep theirs, vertical edges get their vertex's tags),
+//!   offset/setback (strip fronts and backs and the remainder's edges get
+//!   the tags of the lot edge they come from; setback adds its auto-tags),
+//!   cleanup, merging, comp components, trim, reversing faces. Roofs,
+//!   envelope, taper, convexify, splitAndSetbackPerimeter and UV splits
+//!   drop them.
+//!
 //! Queries (`TagQuery`): "Facade" matches "Facade" and every tag below it
 //! ("Facade.Front", "Facade.A.Left"); "?" matches exactly one subtag, "*"
 //! one or more ("?.Front", "Facade.*.Left").

@@ -56,7 +56,7 @@ pub fn arg_is_selector(name: &str, pos: usize) -> bool {
         "contextCompare" => pos == 0 || pos == 2,
         "convert" => pos < 4,
         "geometry.area" | "geometry.angle" | "geometry.isOriented" => pos == 0,
-        "geometry.du" | "geometry.dv" | "geometry.hasTags" => pos == 1,
+        "geometry.du" | "geometry.dv" | "geometry.hasTags" | "geometry.tags" => pos == 1,
         "assetInfo" | "imageInfo" => pos == 1,
         "getGeoCoord" => pos == 0,
         "assetsSortSize" | "assetsSortRatio" | "imagesSortRatio" => pos == 1,
@@ -89,6 +89,10 @@ pub enum GeometryFn {
     Dv,
     /// `geometry.angle(maxSlope|azimuth|zenith)`.
     Angle,
+    /// `geometry.tags([query [, components]])`: the sorted tags.
+    Tags,
+    /// `geometry.hasTags([query [, components]])`.
+    HasTags,
 }
 
 /// The shape function called `name` with `arity` arguments, if any.
@@ -153,6 +157,8 @@ pub fn lookup(name: &str, arity: usize) -> Option<ShapeFn> {
             "du" => (Du, &[1, 2]),
             "dv" => (Dv, &[1, 2]),
             "angle" => (Angle, &[1]),
+            "tags" => (Tags, &[0, 1, 2]),
+            "hasTags" => (HasTags, &[0, 1, 2]),
             _ => return None,
         };
         return arities.contains(&arity).then_some(ShapeFn::Geometry(f));
@@ -254,6 +260,49 @@ mod eval {
                     )
                 }),
         }
+    }
+
+    /// `geometry.tags([query [, components]])` and
+    /// `geometry.hasTags([query [, components]])` (func_geometry.md): the
+    /// alphabetically sorted tags of the components (all by default) that
+    /// the query matches (all tags without one), or whether there are any.
+    fn tags_fn(g: GeometryFn, args: &[Value], shape: &Shape, at: &RExpr) -> Result<Value, RtError> {
+        use cga_geometry::tags::{collect_tags, TagQuery, TagTarget};
+        let query = match args.first() {
+            Some(Value::Str(q)) => TagQuery::parse(q),
+            Some(other) => {
+                return Err(RtError::new(
+                    format!(
+                        "the tag query must be a string, found {}",
+                        crate::values::type_name(other)
+                    ),
+                    at.span,
+                ))
+            }
+            None => TagQuery::all(),
+        };
+        let target = match args.get(1) {
+            None => TagTarget::All,
+            Some(Value::Str(s)) if matches!(&**s, "all" | "faces" | "edges" | "vertices") => {
+                TagTarget::parse(s).unwrap_or(TagTarget::All)
+            }
+            Some(other) => {
+                let msg = format!("expected all, faces, edges or vertices, found {other:?}");
+                return Err(RtError::new(msg, at.span));
+            }
+        };
+        // The stored mesh before its pending transform: tags do not move.
+        let (mesh, _) = shape.geometry.raw();
+        let tags = if mesh.may_have_tags() {
+            collect_tags(mesh, &query, target)
+        } else {
+            Vec::new()
+        };
+        Ok(if g == GeometryFn::HasTags {
+            Value::Bool(!tags.is_empty())
+        } else {
+            Value::StrArray(Arc::new(cga_value::Array::row(tags)))
+        })
     }
 
     fn num(v: &Value, at: &RExpr) -> Result<f64, RtError> {
@@ -375,6 +424,10 @@ mod eval {
         ) -> Result<Value, RtError> {
             use cga_geometry::measure as m;
             use cga_geometry::Topology;
+            if matches!(g, GeometryFn::Tags | GeometryFn::HasTags) {
+                // Tags need no coordinates: the stored mesh serves.
+                return tags_fn(g, args, shape, at);
+            }
             // Measures are taken in object coordinates: scaling is lazy, so the
             // stored mesh alone would give wrong areas.
             let mesh = shape.object_mesh();
@@ -500,6 +553,7 @@ mod eval {
                         }
                     }
                 }
+                GeometryFn::Tags | GeometryFn::HasTags => tags_fn(g, args, shape, at)?,
                 GeometryFn::Du | GeometryFn::Dv => {
                     let set = uv_set(0)?;
                     let unit = matches!(args.get(1), Some(Value::Str(s)) if &**s == "unitSpace");

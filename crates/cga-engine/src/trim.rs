@@ -176,6 +176,7 @@ fn without_caps(mut mesh: Mesh, n: DVec3, offset: f64) -> Mesh {
     let mut out = Mesh::new();
     out.materials = std::mem::take(&mut mesh.materials);
     out.groups = std::mem::take(&mut mesh.groups);
+    out.tags = mesh.tags.clone();
     let mut src = mesh;
     src.materials = out.materials.clone();
     src.groups = out.groups.clone();
@@ -201,6 +202,13 @@ fn copy_faces(src: &Mesh, faces: &[usize], out: &mut Mesh) {
     if src.normals.is_some() {
         out.normals = Some(Vec::new());
     }
+    // Edge and vertex tags along (the table is `src`'s, shared by the caller).
+    if src.edge_tags.is_some() {
+        out.edge_tags = Some(Vec::new());
+    }
+    if src.vertex_tags.is_some() {
+        out.vertex_tags = Some(Vec::new());
+    }
     for &f in faces {
         let face = src.faces[f];
         let first_loop = out.loops.len() as u32;
@@ -215,6 +223,12 @@ fn copy_faces(src: &Mesh, faces: &[usize], out: &mut Mesh) {
                 }
                 if let (Some(d), Some(s)) = (out.normals.as_mut(), src.normals.as_ref()) {
                     d.push(s[c]);
+                }
+                if let Some(d) = out.edge_tags.as_mut() {
+                    d.push(src.edge_tag_index(c));
+                }
+                if let Some(d) = out.vertex_tags.as_mut() {
+                    d.push(src.vertex_tag_index(c));
                 }
             }
             out.loops.push(cga_geometry::Loop { start, len: l.len });

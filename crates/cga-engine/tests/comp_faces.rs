@@ -490,12 +490,14 @@ P(t) --> print(t + " " + geometry.nFaces + " " + material.color.r + " " + comp.t
 }
 
 #[test]
-fn is_tagged_selects_nothing_without_tags() {
+fn is_tagged_selects_by_auto_tags() {
+    // extrude tags its top "extrude.top"; nothing is tagged "x", and the
+    // top is already taken by the first entry.
     let text = r#"Lot --> extrude(3) comp(f) { isTagged("extrude.top") : P("tagged") | isTagged("x", e) || top : P("top") | all = P("rest") }
 P(t) --> print(t + " " + geometry.nFaces)
 "#;
     let r = run("is_tagged", text).ok();
-    assert_eq!(r.prints, vec!["top 1", "rest 5"]);
+    assert_eq!(r.prints, vec!["tagged 1", "rest 5"]);
     let r = run("is_tagged_bad", "Lot --> comp(f) { isTagged(3) : X }\n");
     assert!(r.error.unwrap().contains("tag query"));
 }

@@ -107,7 +107,37 @@ ChooseLayout --> print(geometry.nFaces + " " + geometry.area) X.
     let m = single(&g);
     assert_eq!(m.faces.len(), 6);
     assert_near(mesh_area(m), 3900.0, 1e-9);
-    assert!(g.warnings().iter().any(|w| w.contains("`tag`")));
+
+    // The whole example: the tagged areas compare 2100 to 1800, so the
+    // ring of LayoutA is extracted and extruded 30 m.
+    let full = r#"
+Init -->
+    inline { LayoutA LayoutB }
+    ChooseLayout
+
+LayoutA --> offset(-15, border) tag("LayoutA")
+LayoutB --> split(x) { 15: tag("LayoutB") Lot.
+                     | ~10: NIL }*
+
+taggedArea(name) =
+    sum(comp(f) { isTagged(name): geometry.area })
+
+ChooseLayout -->
+    case taggedArea("LayoutA") > taggedArea("LayoutB"):
+        inline Extract("LayoutA")
+        Mass
+    else:
+        inline Extract("LayoutB")
+        Mass
+
+Extract(name) -->
+    comp(f, noAlign) { isTagged(name)= Extract. }
+
+Mass --> extrude(30) print(geometry.volume)
+"#;
+    let g = gen_with(full, &Opts::rect(40.0, 60.0).start("Init")).ok();
+    assert_eq!(g.prints().len(), 1);
+    assert_near(numbers(&g.prints()[0])[0], 2100.0 * 30.0, 1e-6);
 }
 
 /// The F-shape rules on `rect:30,40`: a 7 m strip and, behind it, 7 m wide
@@ -463,9 +493,11 @@ fn modify_tapered_mass() {
 }
 
 /// op_modify "Corrugated Facade", first step: the front and house parts are
-/// recomposed into one shape of 2 faces sharing an edge (6 vertices). The
-/// edge modification that follows selects by tags, which this engine does
-/// not have: it selects nothing and leaves the geometry as it was.
+/// recomposed into one shape of 2 faces sharing an edge, which `modify(e)`
+/// selects by the tags of both faces and turns into outsets. On `rect:20,30`
+/// the 30 m edge takes 8 repetitions of 3.75 m; each outset is a trapezoid
+/// 2.02 m wide at the edge (opening and sides), 1 m at depth 0.75, taken
+/// from the house: the front grows by 8 x 1.1325 m².
 #[test]
 fn modify_corrugated_facade_recomposed_footprint() {
     let src = r#"
@@ -488,11 +520,20 @@ CreateOutset -->
 
 Outset --> t(0,-Depth,0) s(InnerL,0,0) center(x)
 "#;
-    let g = gen_with(src, &Opts::rect(20.0, 30.0).start("Init")).ok();
-    let m = single(&g);
-    assert_eq!(m.faces.len(), 2);
-    assert_eq!(m.positions.len(), 6);
-    assert_near(mesh_area(m), 600.0, 1e-9);
+    let src = format!(
+        "{src}\nDone --> comp(f) {{ isTagged(\"Front\") : print(\"front \" + geometry.area) | isTagged(\"House\") : print(\"house \" + geometry.area) }}\n"
+    );
+    let src = src.replace(
+        "split(x) { ~4: CreateOutset }* }",
+        "split(x) { ~4: CreateOutset }* }\n    Done",
+    );
+    let g = gen_with(&src, &Opts::rect(20.0, 30.0).start("Init")).ok();
+    let notch = (2.02 + 1.0) / 2.0 * 0.75;
+    let areas: Vec<f64> = g.prints().iter().map(|l| numbers(l)[0]).collect();
+    assert_eq!(g.prints().len(), 2, "{:?}", g.prints());
+    assert!(g.prints()[0].starts_with("front"), "{:?}", g.prints());
+    assert_near(areas[0], 150.0 + 8.0 * notch, 1e-9);
+    assert_near(areas[1], 450.0 - 8.0 * notch, 1e-9);
 }
 
 /// The Paraboloid rules of op_modify "Hyperbolic Grid".

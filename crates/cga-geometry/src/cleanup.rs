@@ -117,8 +117,13 @@ fn merge_vertices(mesh: &Mesh, dist: f64) -> Mesh {
 /// A mesh with `mesh`'s materials, groups and attribute layout, no faces.
 fn empty_like(mesh: &Mesh) -> Mesh {
     let mut out = Mesh::new();
-    out.materials = mesh.materials.clone();
-    out.groups = mesh.groups.clone();
+    out.share_slots(mesh);
+    if mesh.edge_tags.is_some() {
+        out.edge_tags = Some(Vec::new());
+    }
+    if mesh.vertex_tags.is_some() {
+        out.vertex_tags = Some(Vec::new());
+    }
     for (k, set) in mesh.uvs.iter().enumerate() {
         if set.is_some() {
             out.uvs[k] = Some(Vec::new());
@@ -148,7 +153,20 @@ fn push_face(
     let first = out.corners.len();
     let nf = out.add_face(&refs, src.faces[f].material);
     out.faces[nf].group = src.faces[f].group;
+    out.faces[nf].tags = src.faces[f].tags;
     let corners: Vec<usize> = loops.iter().flatten().copied().collect();
+    // A kept corner keeps its edge's tags (a dropped straight corner only
+    // goes when both its edges carry the same tags) and its vertex's.
+    if let Some(dst) = out.edge_tags.as_mut() {
+        for (i, &c) in corners.iter().enumerate() {
+            dst[first + i] = src.edge_tag_index(c);
+        }
+    }
+    if let Some(dst) = out.vertex_tags.as_mut() {
+        for (i, &c) in corners.iter().enumerate() {
+            dst[first + i] = src.vertex_tag_index(c);
+        }
+    }
     for (k, set) in out.uvs.iter_mut().enumerate() {
         if let (Some(dst), Some(s)) = (set.as_mut(), src.uvs[k].as_ref()) {
             for (i, &c) in corners.iter().enumerate() {
@@ -211,9 +229,16 @@ fn remove_straight_corners(mesh: &Mesh, angle: f64) -> Mesh {
     };
     for f in 0..mesh.faces.len() {
         for &l in mesh.face_loops(f) {
+            let r = mesh.loop_corners(l);
             for (i, &p) in mesh.loop_indices(l).iter().enumerate() {
                 used[p as usize] = true;
-                if !straight(l, i) {
+                // Tagged vertices, and vertices between edges with
+                // different tags, are kept (cga_componentTags.md).
+                let c = r.start + i;
+                let prev = if i == 0 { r.end - 1 } else { c - 1 };
+                let tagged = mesh.vertex_tag_index(c) != 0
+                    || mesh.edge_tags_at(prev) != mesh.edge_tags_at(c);
+                if tagged || !straight(l, i) {
                     removable[p as usize] = false;
                 }
             }
@@ -263,7 +288,11 @@ fn join_coplanar(mesh: &Mesh, angle: f64) -> Mesh {
             continue;
         }
         let (a, b) = (u[0].face as usize, u[1].face as usize);
+        // Tagged edges and edges between faces with different tags stay.
         if mesh.faces[a].material != mesh.faces[b].material
+            || mesh.face_tags(a) != mesh.face_tags(b)
+            || mesh.edge_tag_index(u[0].corner as usize) != 0
+            || mesh.edge_tag_index(u[1].corner as usize) != 0
             || normals[a] == DVec3::ZERO
             || normals[a].dot(normals[b]) < cos
         {

@@ -36,11 +36,11 @@ use crate::triangulate::plane_basis;
 /// keep their material; per-corner attributes are not carried over.
 pub fn convexify(mesh: &Mesh, max_length: Option<f64>) -> Mesh {
     let mut out = Mesh::new();
-    out.materials = mesh.materials.clone();
-    out.groups = mesh.groups.clone();
+    out.share_slots(mesh);
     for f in 0..mesh.faces.len() {
         let material = mesh.faces[f].material;
         let group = mesh.faces[f].group;
+        let tags = mesh.faces[f].tags;
         let first_new = out.faces.len();
         let n = face_normal(mesh, f);
         let pieces = if n == DVec3::ZERO {
@@ -73,8 +73,11 @@ pub fn convexify(mesh: &Mesh, max_length: Option<f64>) -> Mesh {
                 out.add_face(&refs, material);
             }
         }
+        // Pieces keep their face's tags; edge and vertex tags are not
+        // carried (like the other per-corner attributes).
         for face in &mut out.faces[first_new..] {
             face.group = group;
+            face.tags = tags;
         }
     }
     out

@@ -148,6 +148,9 @@ fn empty_like(mesh: &Mesh) -> Mesh {
         normals: None,
         materials: mesh.materials.clone(),
         groups: mesh.groups.clone(),
+        tags: mesh.tags.clone(),
+        edge_tags: None,
+        vertex_tags: None,
     }
 }
 
@@ -1754,12 +1757,15 @@ impl<'m, 'b> Cutter<'m, 'b> {
                 }
                 *r
             };
+            // Pieces keep their face's tags; caps get none (tag propagation
+            // of cga_componentTags.md).
             let push_face = |loops: &Vec<Loop>, faces: &mut Vec<Face>, f: Face, nloops: u32| {
                 faces.push(Face {
                     first_loop: loops.len() as u32 - nloops,
                     loop_count: nloops,
                     material: f.material,
                     group: f.group,
+                    tags: f.tags,
                 });
             };
             let items = self.part_items(part);
@@ -1835,7 +1841,7 @@ impl<'m, 'b> Cutter<'m, 'b> {
                             nloops += 1;
                         }
                         cap_normals.push(outward);
-                        push_face(loops, faces, f, nloops);
+                        push_face(loops, faces, Face { tags: 0, ..f }, nloops);
                     }
                 }
             }
@@ -1885,11 +1891,73 @@ impl<'m, 'b> Cutter<'m, 'b> {
                         .collect(),
                 );
             }
+            carry_corner_tags(mesh, &mut m, sources);
             out.push(m);
         }
         self.bufs.build = bb;
         self.bufs.caps = cb;
         out
+    }
+}
+
+/// Edge and vertex tags of a piece's corners from their sources: a corner
+/// that is an original corner keeps its vertex tags; a corner keeps the
+/// tags of the original edge its outgoing edge runs along (the edge from
+/// an original corner, or through a crossing on it, to a later point of the
+/// same edge); edges along the cut and cap corners get none.
+fn carry_corner_tags(mesh: &Mesh, m: &mut Mesh, sources: &[WCorner]) {
+    if mesh.edge_tags.is_none() && mesh.vertex_tags.is_none() {
+        return;
+    }
+    if mesh.vertex_tags.is_some() {
+        m.vertex_tags = Some(
+            sources
+                .iter()
+                .map(|s| {
+                    if s.a != CAP && s.t == 0.0 {
+                        mesh.vertex_tag_index(s.a as usize)
+                    } else {
+                        0
+                    }
+                })
+                .collect(),
+        );
+    }
+    if mesh.edge_tags.is_some() {
+        // The corner after every corner in its loop of the source mesh.
+        let mut next = vec![0u32; mesh.corners.len()];
+        for l in &mesh.loops {
+            let r = mesh.loop_corners(*l);
+            for c in r.clone() {
+                if let Some(x) = next.get_mut(c) {
+                    *x = if c + 1 == r.end { r.start } else { c + 1 } as u32;
+                }
+            }
+        }
+        let next_of = |c: u32| next.get(c as usize).copied().unwrap_or(c);
+        let mut tags = vec![0u32; sources.len()];
+        for l in &m.loops {
+            let r = m.loop_corners(*l);
+            for i in r.clone() {
+                let j = if i + 1 == r.end { r.start } else { i + 1 };
+                let (si, sj) = (sources[i], sources[j]);
+                if si.a == CAP || sj.a == CAP {
+                    continue;
+                }
+                // The original edge the corner lies at the start of or on.
+                let (start, end) = if si.t == 0.0 {
+                    (si.a, next_of(si.a))
+                } else {
+                    (si.a, si.b)
+                };
+                let along = (sj.t > 0.0 && sj.a == start && sj.b == end && sj.t > si.t)
+                    || (sj.t == 0.0 && sj.a == end);
+                if along {
+                    tags[i] = mesh.edge_tag_index(start as usize);
+                }
+            }
+        }
+        m.edge_tags = Some(tags);
     }
 }
 

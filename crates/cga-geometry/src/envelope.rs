@@ -84,8 +84,10 @@ pub fn envelope(
         ..Default::default()
     };
     out.mesh.materials = mesh.materials.clone();
+    out.mesh.tags = mesh.tags.clone();
     let mut k = 0usize;
     for f in 0..mesh.faces.len() {
+        let first = out.mesh.faces.len();
         let count: usize = mesh.face_loops(f).iter().map(|l| l.len as usize).sum();
         let b = |i: usize| base.get(k + i).copied().unwrap_or(0.0);
         let a = |i: usize| angle.get(k + i).copied().unwrap_or(90.0);
@@ -93,6 +95,12 @@ pub fn envelope(
         let as_: Vec<f64> = (0..count).map(a).collect();
         if let Err(e) = face_envelope(&mut out, mesh, f, direction, max_height, &bs, &as_) {
             out.failed.push((f, e));
+        }
+        // Faces built on a face keep its tags (the caller adds the
+        // envelope's auto-tags).
+        let tags = mesh.faces[f].tags;
+        for face in &mut out.mesh.faces[first..] {
+            face.tags = tags;
         }
         k += count;
     }

@@ -155,8 +155,7 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
     }
 
     let mut out = Mesh::new();
-    out.materials = mesh.materials.clone();
-    out.groups = mesh.groups.clone();
+    out.share_slots(mesh);
     out.positions = weld
         .representative
         .iter()
@@ -210,13 +209,47 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
         .filter(|&k| mesh.uvs[k].is_some())
         .collect();
     let mut uv_out: Vec<Vec<DVec2>> = vec![Vec::new(); mesh.uvs.len()];
+    // Edge and vertex tags (tag propagation of cga_componentTags.md): an
+    // output edge between the corners of one source edge keeps its tags;
+    // an edge between two copies of one source corner (a side's vertical
+    // edge) "emanates" from that vertex and inherits the vertex's tags;
+    // corners keep their source corner's vertex tags; a side face inherits
+    // the tags of the edge it emanates from.
+    let corner_tags = mesh.edge_tags.is_some() || mesh.vertex_tags.is_some();
+    let mut next_src = vec![0u32; if corner_tags { mesh.corners.len() } else { 0 }];
+    if corner_tags {
+        for l in &mesh.loops {
+            let r = mesh.loop_corners(*l);
+            for c in r.clone() {
+                next_src[c] = if c + 1 == r.end { r.start } else { c + 1 } as u32;
+            }
+        }
+    }
+    let mut edge_out: Vec<u32> = Vec::new();
+    let mut vertex_out: Vec<u32> = Vec::new();
     let mut roles = Vec::new();
     let mut loop_buf: Vec<(u32, u32)> = Vec::new(); // (position, source corner)
-    let emit =
+    let mut emit =
         |out: &mut Mesh, uv_out: &mut Vec<Vec<DVec2>>, loops: &[Vec<(u32, u32)>], f: usize| {
             let first_loop = out.loops.len() as u32;
             for l in loops {
                 let start = out.corners.len() as u32;
+                if corner_tags {
+                    for (k, &(_, s)) in l.iter().enumerate() {
+                        let t = l[(k + 1) % l.len()].1;
+                        let e = if next_src.get(s as usize) == Some(&t) {
+                            mesh.edge_tag_index(s as usize)
+                        } else if next_src.get(t as usize) == Some(&s) {
+                            mesh.edge_tag_index(t as usize)
+                        } else if s == t {
+                            mesh.vertex_tag_index(s as usize)
+                        } else {
+                            0
+                        };
+                        edge_out.push(e);
+                        vertex_out.push(mesh.vertex_tag_index(s as usize));
+                    }
+                }
                 for &(p, src) in l {
                     out.corners.push(p);
                     for &k in &has_uv {
@@ -235,6 +268,7 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
                 loop_count: loops.len() as u32,
                 material: src.material,
                 group: src.group,
+                tags: src.tags,
             });
         };
 
@@ -314,6 +348,13 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
                     loop_buf.extend([(a, c as u32), (b, n as u32), (tb, n as u32), (ta, c as u32)]);
                 }
                 emit(&mut out, &mut uv_out, &[loop_buf.clone()], f);
+                let et = mesh.edge_tag_index(c);
+                if et != 0 {
+                    // The side emanates from a tagged edge.
+                    let nf = out.faces.len() - 1;
+                    let set = out.tag_set(out.faces[nf].tags).union(mesh.tag_set(et));
+                    out.faces[nf].tags = out.intern_tags(set);
+                }
                 roles.push(if li == 0 {
                     ExtrudeRole::SideOuter
                 } else {
@@ -324,6 +365,12 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
     }
     for k in has_uv {
         out.uvs[k] = Some(std::mem::take(&mut uv_out[k]));
+    }
+    if edge_out.iter().any(|&t| t != 0) {
+        out.edge_tags = Some(edge_out);
+    }
+    if mesh.vertex_tags.is_some() {
+        out.vertex_tags = Some(vertex_out);
     }
     // Drop welded positions no face uses (duplicates folded by welding).
     compact_positions(&mut out);

@@ -265,9 +265,12 @@ pub fn inner_rectangle(mesh: &Mesh, face: usize, axis: Option<DVec3>) -> Option<
     let lift = |p: DVec2| o + u * p.x + v * p.y;
     let mut shape = Mesh::polygon(&rect.map(lift));
     shape.materials = mesh.materials.clone();
+    shape.tags = mesh.tags.clone();
     shape.faces[0].material = mesh.faces[face].material;
+    shape.faces[0].tags = mesh.faces[face].tags;
     let mut rem = Mesh::new();
     rem.materials = mesh.materials.clone();
+    rem.tags = mesh.tags.clone();
     let mut ids: Vec<Vec<u32>> = Vec::new();
     for &l in mesh.face_loops(face) {
         let s = rem.positions.len() as u32;
@@ -279,7 +282,8 @@ pub fn inner_rectangle(mesh: &Mesh, face: usize, axis: Option<DVec3>) -> Option<
         .extend([rect[0], rect[3], rect[2], rect[1]].map(lift));
     ids.push((s..s + 4).collect());
     let refs: Vec<&[u32]> = ids.iter().map(|x| x.as_slice()).collect();
-    rem.add_face(&refs, mesh.faces[face].material);
+    let nf = rem.add_face(&refs, mesh.faces[face].material);
+    rem.faces[nf].tags = mesh.faces[face].tags;
     Some((shape, rem))
 }
 

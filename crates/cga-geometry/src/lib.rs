@@ -28,6 +28,7 @@
 //! | [`roof_edges`] | `comp(e)`'s roof edge classes of any mesh |
 //! | [`setback`] | `offset`, `setback`, `setbackToArea`, `shapeL/U/O` |
 //! | [`skeleton`] | weighted straight skeletons and wavefront offsets |
+//! | [`tags`] | component tags: tag sets, tag queries, tagging faces, edges, vertices |
 
 pub mod area_split;
 pub mod cleanup;
@@ -50,6 +51,7 @@ pub mod roof;
 pub mod roof_edges;
 pub mod setback;
 pub mod skeleton;
+pub mod tags;
 pub mod topology;
 pub mod transform;
 pub mod triangulate;
@@ -68,5 +70,6 @@ pub use setback::{
     merge_strips, offset, setback, setback_to_area, Offset, OffsetFace, SetbackEdgeTag,
 };
 pub use skeleton::{skeleton, straight_skeleton, Skeleton, SkeletonError, StopAt, WeightChange};
+pub use tags::{TagQuery, TagSet, TagTarget};
 pub use topology::Topology;
 pub use triangulate::triangulate_face;

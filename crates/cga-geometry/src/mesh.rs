@@ -7,13 +7,17 @@
 //!   (counter-clockwise seen from the side its normal points to), the others
 //!   are holes (clockwise);
 //! - `faces`: ranges of `loops`, each with a material slot and a group;
-//! - `uvs[k]`, `normals`: per-corner attributes aligned with `corners`.
+//! - `uvs[k]`, `normals`: per-corner attributes aligned with `corners`;
+//! - `tags`: the component tag sets faces, edges and vertices refer to
+//!   (see [`crate::tags`]): `Face::tags`, and per corner `edge_tags` (the
+//!   edge from that corner to the next of its loop) and `vertex_tags`.
 
 use std::sync::{Arc, LazyLock};
 
 use glam::{DVec2, DVec3};
 
 use crate::material::Material;
+use crate::tags::TagSet;
 
 /// Number of texture coordinate sets a mesh can carry (CGA's UV sets 0..9).
 pub const UV_SETS: usize = 10;
@@ -35,6 +39,8 @@ pub struct Face {
     pub material: u32,
     /// Index into `Mesh::groups`.
     pub group: u32,
+    /// Index into `Mesh::tags` (0: no tags).
+    pub tags: u32,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -52,6 +58,16 @@ pub struct Mesh {
     pub materials: SharedVec<Material>,
     /// Group names referenced by `Face::group` (OBJ `g`); never empty.
     pub groups: SharedVec<String>,
+    /// Component tag sets referenced by `Face::tags`, `edge_tags` and
+    /// `vertex_tags`; entry 0 is the empty set. Shared like `materials`.
+    pub tags: SharedVec<TagSet>,
+    /// Per corner: the tags of the edge from that corner to the next corner
+    /// of its loop (a face edge; an edge shared by two faces has the union
+    /// of both face edges' tags). `None`: no edge tags.
+    pub edge_tags: Option<Vec<u32>>,
+    /// Per corner: the tags of the vertex at that corner (a welded vertex
+    /// has the union of its corners' tags). `None`: no vertex tags.
+    pub vertex_tags: Option<Vec<u32>>,
 }
 
 /// A vector shared between meshes until one of them changes it (copy on
@@ -198,6 +214,12 @@ fn default_slots() -> (SharedVec<Material>, SharedVec<String>) {
     (SLOTS.0.clone(), SLOTS.1.clone())
 }
 
+/// The tag table of an untagged mesh (only the empty set), shared.
+pub fn no_tags() -> SharedVec<TagSet> {
+    static NONE: LazyLock<SharedVec<TagSet>> = LazyLock::new(|| vec![TagSet::default()].into());
+    NONE.clone()
+}
+
 impl Default for Mesh {
     fn default() -> Self {
         Mesh::new()
@@ -217,6 +239,9 @@ impl Mesh {
             normals: None,
             materials,
             groups,
+            tags: no_tags(),
+            edge_tags: None,
+            vertex_tags: None,
         }
     }
 
@@ -233,6 +258,12 @@ impl Mesh {
         }
         if let Some(n) = &mut self.normals {
             n.reserve(corners);
+        }
+        for t in [&mut self.edge_tags, &mut self.vertex_tags]
+            .into_iter()
+            .flatten()
+        {
+            t.reserve(corners);
         }
     }
 
@@ -255,8 +286,27 @@ impl Mesh {
             (_, None) => self.normals = None,
             (None, Some(s)) => self.normals = Some(s.clone()),
         }
+        for (d, s) in [
+            (&mut self.edge_tags, &src.edge_tags),
+            (&mut self.vertex_tags, &src.vertex_tags),
+        ] {
+            match (d.as_mut(), s) {
+                (Some(d), Some(s)) => d.clone_from(s),
+                (_, None) => *d = None,
+                (None, Some(s)) => *d = Some(s.clone()),
+            }
+        }
         self.materials = src.materials.clone();
         self.groups = src.groups.clone();
+        self.tags = src.tags.clone();
+    }
+
+    /// Gives `self` the material slots, groups and tag sets of `src`
+    /// (shared), so that faces copied from `src` keep their indices.
+    pub fn share_slots(&mut self, src: &Mesh) {
+        self.materials = src.materials.clone();
+        self.groups = src.groups.clone();
+        self.tags = src.tags.clone();
     }
 
     /// A mesh of one polygon face (no holes) through `points` in order.
@@ -292,11 +342,18 @@ impl Mesh {
         if let Some(normals) = &mut self.normals {
             normals.resize(n, DVec3::ZERO);
         }
+        for t in [&mut self.edge_tags, &mut self.vertex_tags]
+            .into_iter()
+            .flatten()
+        {
+            t.resize(n, 0);
+        }
         self.faces.push(Face {
             first_loop,
             loop_count: loops.len() as u32,
             material,
             group: 0,
+            tags: 0,
         });
         self.faces.len() - 1
     }

@@ -186,6 +186,7 @@ fn reverse_some(mesh: &mut Mesh, which: &[bool]) {
                     *v = -*v;
                 }
             }
+            crate::tags::reverse_loop_tags(mesh, r);
         }
     }
 }

@@ -236,6 +236,7 @@ fn add_shapes(m: &mut Mesh, shapes: &Shapes, lift: &dyn Fn(DVec2) -> DVec3, mate
 fn face_copy(mesh: &Mesh, f: usize) -> Mesh {
     let mut m = Mesh::new();
     m.materials = mesh.materials.clone();
+    m.tags = mesh.tags.clone();
     let mut ids: Vec<Vec<u32>> = Vec::new();
     for &l in mesh.face_loops(f) {
         let s = m.positions.len() as u32;
@@ -243,7 +244,8 @@ fn face_copy(mesh: &Mesh, f: usize) -> Mesh {
         ids.push((s..s + l.len).collect());
     }
     let refs: Vec<&[u32]> = ids.iter().map(|x| x.as_slice()).collect();
-    m.add_face(&refs, mesh.faces[f].material);
+    let nf = m.add_face(&refs, mesh.faces[f].material);
+    m.faces[nf].tags = mesh.faces[f].tags;
     m
 }
 

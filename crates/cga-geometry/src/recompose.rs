@@ -384,6 +384,9 @@ pub fn recompose(parts: &[Part]) -> Recomposed {
         let mut own_vertex = vec![NONE; m.positions.len()];
         let mat_map = slot_map(&mut out.materials, &m.materials);
         let group_map = slot_map(&mut out.groups, &m.groups);
+        // Face tags are kept; edge and vertex tags of the pieces are not
+        // carried into the recomposed mesh.
+        let tag_map = crate::tags::import_table(&mut out, m);
         for f in 0..m.faces.len() {
             let face = m.faces[f];
             let outer_len = m.outer_loop(f).len;
@@ -501,6 +504,7 @@ pub fn recompose(parts: &[Part]) -> Recomposed {
                 loop_count: nloops,
                 material: mat_map.get(face.material as usize).copied().unwrap_or(0),
                 group: group_map.get(face.group as usize).copied().unwrap_or(0),
+                tags: tag_map.get(face.tags as usize).copied().unwrap_or(0),
             });
         }
     }

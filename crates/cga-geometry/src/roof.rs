@@ -161,9 +161,17 @@ pub fn roof(mesh: &Mesh, slope: RoofSlope, kind: RoofKind) -> Roof {
         failed: Vec::new(),
     };
     b.out.materials = mesh.materials.clone();
+    b.out.tags = mesh.tags.clone();
     for f in 0..mesh.faces.len() {
+        let first = b.out.faces.len();
         if let Err(e) = b.face(mesh, f, slope, kind) {
             b.failed.push((f, e));
+        }
+        // Faces built on a face keep its tags (the caller adds the roof's
+        // auto-tags); edge and vertex tags are not carried into roofs.
+        let tags = mesh.faces[f].tags;
+        for face in &mut b.out.faces[first..] {
+            face.tags = tags;
         }
     }
     let (edge_kinds, edge_ends) = classify_edges(&b.out, &b.roles, &b.up);

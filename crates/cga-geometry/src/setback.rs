@@ -73,6 +73,11 @@ pub struct Offset {
     /// Tag of the edge starting at every corner (aligned with
     /// `mesh.corners`).
     pub corner_tags: Vec<SetbackEdgeTag>,
+    /// The input corner whose edge every corner's edge comes from (a
+    /// strip's front and back edges, the remainder's edges along input
+    /// edges), `u32::MAX` for new edges (sides, grown outlines): the edge
+    /// tags they inherit (aligned with `mesh.corners`).
+    pub corner_source: Vec<u32>,
     /// Input faces that failed (they are missing from the result).
     pub failed: Vec<(usize, SkeletonError)>,
 }
@@ -86,12 +91,64 @@ impl Offset {
     }
 }
 
+const NO_SOURCE: u32 = u32::MAX;
+
+/// Gives the faces of `out` from `first` on the tags of input face `f`.
+fn keep_face_tags(out: &mut Offset, mesh: &Mesh, first: usize, f: usize) {
+    let tags = mesh.faces[f].tags;
+    for face in &mut out.mesh.faces[first..] {
+        face.tags = tags;
+    }
+}
+
+/// The edge tags of the result: every edge inherits the tags of the input
+/// edge it comes from (`corner_source`); with `auto`, the setback's
+/// auto-tags replace earlier setback tags.
+fn finish_edge_tags(out: &mut Offset, mesh: &Mesh, auto: bool) {
+    if !auto && mesh.edge_tags.is_none() {
+        return;
+    }
+    let q = crate::tags::TagQuery::parse("setback");
+    let n = out.mesh.corners.len();
+    let mut list = vec![0u32; n];
+    let mut memo: Vec<(u32, Option<SetbackEdgeTag>, u32)> = Vec::new();
+    for (c, slot) in list.iter_mut().enumerate() {
+        let src = out.corner_source.get(c).copied().unwrap_or(NO_SOURCE);
+        let old = if src == NO_SOURCE {
+            0
+        } else {
+            mesh.edge_tag_index(src as usize)
+        };
+        let role = if auto {
+            out.corner_tags.get(c).copied()
+        } else {
+            None
+        };
+        if let Some(m) = memo.iter().find(|m| m.0 == old && m.1 == role) {
+            *slot = m.2;
+            continue;
+        }
+        let mut set = mesh.tag_set(old).clone();
+        if let Some(r) = role {
+            set = set
+                .without(|t| q.matches(t))
+                .with(&std::sync::Arc::from(r.tag()));
+        }
+        let i = out.mesh.intern_tags(set);
+        memo.push((old, role, i));
+        *slot = i;
+    }
+    out.mesh.edge_tags = (!list.iter().all(|&t| t == 0)).then_some(list);
+}
+
 /// A face projected into its plane.
 struct Flat {
     o: DVec3,
     u: DVec3,
     v: DVec3,
     loops: Vec<Vec<DVec2>>,
+    /// First input corner of every loop.
+    starts: Vec<u32>,
 }
 
 fn flatten(mesh: &Mesh, f: usize) -> Option<Flat> {
@@ -110,10 +167,28 @@ fn flatten(mesh: &Mesh, f: usize) -> Option<Flat> {
                 .collect()
         })
         .collect();
-    Some(Flat { o, u, v, loops })
+    let starts = mesh.face_loops(f).iter().map(|l| l.start).collect();
+    Some(Flat {
+        o,
+        u,
+        v,
+        loops,
+        starts,
+    })
 }
 
 impl Flat {
+    /// The input corner of edge `e` counted over all loops of the face.
+    fn corner_of(&self, mut e: usize) -> u32 {
+        for (l, pts) in self.loops.iter().enumerate() {
+            if e < pts.len() {
+                return self.starts[l] + e as u32;
+            }
+            e -= pts.len();
+        }
+        NO_SOURCE
+    }
+
     fn lift(&self, p: DVec2) -> DVec3 {
         self.o + self.u * p.x + self.v * p.y
     }
@@ -129,6 +204,7 @@ pub fn offset(mesh: &Mesh, distance: f64) -> Offset {
         ..Default::default()
     };
     out.mesh.materials = mesh.materials.clone();
+    out.mesh.tags = mesh.tags.clone();
     if !distance.is_finite() {
         return out;
     }
@@ -136,6 +212,7 @@ pub fn offset(mesh: &Mesh, distance: f64) -> Offset {
         let Some(flat) = flatten(mesh, f) else {
             continue;
         };
+        let first = out.mesh.faces.len();
         let material = mesh.faces[f].material;
         let r = if distance <= 0.0 {
             let w: Vec<Vec<f64>> = flat.loops.iter().map(|l| vec![1.0; l.len()]).collect();
@@ -146,7 +223,9 @@ pub fn offset(mesh: &Mesh, distance: f64) -> Offset {
         if let Err(e) = r {
             out.failed.push((f, e));
         }
+        keep_face_tags(&mut out, mesh, first, f);
     }
+    finish_edge_tags(&mut out, mesh, false);
     out
 }
 
@@ -160,6 +239,7 @@ pub fn setback(mesh: &Mesh, distances: &[f64]) -> Offset {
         ..Default::default()
     };
     out.mesh.materials = mesh.materials.clone();
+    out.mesh.tags = mesh.tags.clone();
     let mut k = 0usize;
     for f in 0..mesh.faces.len() {
         let loops = mesh.face_loops(f);
@@ -178,10 +258,13 @@ pub fn setback(mesh: &Mesh, distances: &[f64]) -> Offset {
             }
             w.push(wl);
         }
+        let first = out.mesh.faces.len();
         if let Err(e) = strips_and_remainder(&mut out, &flat, &w, 1.0, f, mesh.faces[f].material) {
             out.failed.push((f, e));
         }
+        keep_face_tags(&mut out, mesh, first, f);
     }
+    finish_edge_tags(&mut out, mesh, true);
     out
 }
 
@@ -479,6 +562,7 @@ fn add_face_tagged(
     out: &mut Offset,
     pts: &[DVec3],
     tags: &[SetbackEdgeTag],
+    sources: &[u32],
     kind: OffsetFace,
     src: Option<SourceEdge>,
     material: u32,
@@ -488,6 +572,7 @@ fn add_face_tagged(
     let ids: Vec<u32> = (start..start + pts.len() as u32).collect();
     out.mesh.add_face(&[&ids], material);
     out.corner_tags.extend_from_slice(tags);
+    out.corner_source.extend_from_slice(sources);
     out.kinds.push(kind);
     out.source_edge.push(src);
 }
@@ -537,7 +622,15 @@ fn strips_and_remainder(
                 loop_index: l as u32,
                 edge: i as u32,
             });
-            add_face_tagged(out, &p3, &tags, OffsetFace::Strip, src, material);
+            let from = flat.starts[l] + i as u32;
+            let sources: Vec<u32> = tags
+                .iter()
+                .map(|t| match t {
+                    SetbackEdgeTag::Side => NO_SOURCE,
+                    _ => from,
+                })
+                .collect();
+            add_face_tagged(out, &p3, &tags, &sources, OffsetFace::Strip, src, material);
         }
     }
     // The remainder: wavefront loops grouped into faces with holes.
@@ -581,12 +674,18 @@ fn strips_and_remainder(
     for (k, &o) in outers.iter().enumerate() {
         let mut ids: Vec<Vec<u32>> = Vec::new();
         let mut tags = Vec::new();
+        let mut sources = Vec::new();
         for &l in std::iter::once(&o).chain(holes_of[k].iter()) {
             let lp = &sk.wavefront[l];
             let start = out.mesh.positions.len() as u32;
             for (j, &(nd, e)) in lp.iter().enumerate() {
                 out.mesh.positions.push(flat.lift(sk.nodes[nd as usize]));
                 let next = sk.nodes[lp[(j + 1) % lp.len()].0 as usize];
+                sources.push(if (e as usize) < n_in {
+                    flat.corner_of(e as usize)
+                } else {
+                    NO_SOURCE
+                });
                 tags.push(if weight_of(e) > 0.0 {
                     SetbackEdgeTag::Back
                 } else if is_input(sk.nodes[nd as usize]) && is_input(next) {
@@ -600,6 +699,7 @@ fn strips_and_remainder(
         let refs: Vec<&[u32]> = ids.iter().map(|x| x.as_slice()).collect();
         out.mesh.add_face(&refs, material);
         out.corner_tags.extend(tags);
+        out.corner_source.extend(sources);
         out.kinds.push(OffsetFace::Inside);
         out.source_edge.push(None);
     }
@@ -678,7 +778,15 @@ fn grow(
                 loop_index: l as u32,
                 edge: j as u32,
             });
-            add_face_tagged(out, &p3, &tags, OffsetFace::Strip, src, material);
+            let from = flat.starts[l] + j as u32;
+            let sources: Vec<u32> = tags
+                .iter()
+                .map(|t| match t {
+                    SetbackEdgeTag::Side => NO_SOURCE,
+                    _ => from,
+                })
+                .collect();
+            add_face_tagged(out, &p3, &tags, &sources, OffsetFace::Strip, src, material);
         }
         g += k;
     }
@@ -705,6 +813,8 @@ fn grow(
             ids.push((start..start + l.len).collect());
             out.corner_tags
                 .extend(std::iter::repeat_n(SetbackEdgeTag::Back, l.len as usize));
+            out.corner_source
+                .extend(std::iter::repeat_n(NO_SOURCE, l.len as usize));
         }
         let refs: Vec<&[u32]> = ids.iter().map(|x| x.as_slice()).collect();
         out.mesh.add_face(&refs, material);

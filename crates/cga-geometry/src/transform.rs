@@ -48,6 +48,7 @@ pub fn reverse_faces(mesh: &mut Mesh) {
         if let Some(n) = &mut mesh.normals {
             n[tail.clone()].reverse();
         }
+        crate::tags::reverse_loop_tags(mesh, r);
     }
     if let Some(n) = &mut mesh.normals {
         for v in n {
@@ -90,6 +91,8 @@ pub fn merge(dst: &mut Mesh, src: &Mesh) {
             }
         })
         .collect();
+    let tag_map = crate::tags::import_table(dst, src);
+    let tag = |i: u32| tag_map.get(i as usize).copied().unwrap_or(0);
     dst.positions.extend_from_slice(&src.positions);
     dst.corners
         .extend(src.corners.iter().map(|&c| c + base_pos));
@@ -103,6 +106,7 @@ pub fn merge(dst: &mut Mesh, src: &Mesh) {
         loop_count: f.loop_count,
         material: mat_map.get(f.material as usize).copied().unwrap_or(0),
         group: group_map.get(f.group as usize).copied().unwrap_or(0),
+        tags: tag(f.tags),
     }));
     let n = dst.corners.len();
     for (d, s) in dst.uvs.iter_mut().zip(&src.uvs) {
@@ -136,6 +140,29 @@ pub fn merge(dst: &mut Mesh, src: &Mesh) {
             dst.normals = Some(v);
         }
         (None, None) => {}
+    }
+    // Edge and vertex tags: kept on both sides, untagged where absent.
+    for which in 0..2 {
+        let (d, s) = if which == 0 {
+            (&mut dst.edge_tags, &src.edge_tags)
+        } else {
+            (&mut dst.vertex_tags, &src.vertex_tags)
+        };
+        match (d.as_mut(), s) {
+            (Some(d), Some(s)) => {
+                d.resize(dst_corners, 0);
+                d.extend(s.iter().map(|&t| tag(t)));
+                d.resize(n, 0);
+            }
+            (Some(d), None) => d.resize(n, 0),
+            (None, Some(s)) => {
+                let mut v = vec![0; dst_corners];
+                v.extend(s.iter().map(|&t| tag(t)));
+                v.resize(n, 0);
+                *d = Some(v);
+            }
+            (None, None) => {}
+        }
     }
 }
 

@@ -205,6 +205,15 @@ fn reverse_keeping_first_edge(mesh: &mut Mesh) {
         if let Some(n) = &mut mesh.normals {
             reorder(&mut n[r.clone()]);
         }
+        if let Some(t) = &mut mesh.vertex_tags {
+            reorder(&mut t[r.clone()]);
+        }
+        if let Some(t) = &mut mesh.edge_tags {
+            // The edge that started at ci now starts at ci+1: e0 en-1 .. e1.
+            let e = &mut t[r.clone()];
+            e.reverse();
+            e.rotate_left(e.len() - 1);
+        }
     }
     if let Some(n) = &mut mesh.normals {
         for v in n {

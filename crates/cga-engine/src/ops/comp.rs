@@ -149,6 +149,30 @@ pub(crate) struct Components {
     frames: Frames,
     parent: ParentFrames,
     builder: MeshBuilder,
+    /// `isTagged` results per query (see `tag_match`).
+    tag_cache: Vec<TagMatch>,
+}
+
+/// Which faces, edges and vertices `isTagged(query)` matches by their own
+/// tags or inherited ones (op_comp.md): a face by its tags, an edge by its
+/// tags and those of its faces, a vertex by its tags and those of its
+/// edges and faces. Edges and vertices are per unique edge / welded vertex
+/// of the topology (empty when the component kind needs no topology and
+/// no subcomponent is asked for).
+struct TagMatch {
+    query: String,
+    /// Whether `edge` and `vertex` were computed.
+    full: bool,
+    face: Vec<bool>,
+    edge: Vec<bool>,
+    vertex: Vec<bool>,
+}
+
+/// The subcomponent argument of `isTagged(query, e|v)`.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum TagSub {
+    Edges,
+    Vertices,
 }
 
 impl Components {
@@ -179,6 +203,7 @@ impl Components {
                 scope: shape.scope,
                 pivot: shape.pivot,
             },
+            tag_cache: Vec::new(),
         };
         if needs_topology {
             c.topology();
@@ -398,6 +423,138 @@ impl Components {
                     .any(|&f| self.frames.matches(sel, self.face_normals[f as usize])),
                 _ => self.frames.matches(sel, self.item_normals[k]),
             },
+        }
+    }
+
+    /// The index in `tag_cache` of the `TagMatch` of `query` (computed
+    /// once per comp), with edges and vertices if `full`.
+    fn tag_match(&mut self, query: &str, full: bool) -> usize {
+        let found = self
+            .tag_cache
+            .iter()
+            .position(|t| t.query == query && (t.full || !full));
+        if let Some(i) = found {
+            return i;
+        }
+        let q = cga_geometry::TagQuery::parse(query);
+        let mesh = self.mesh.clone();
+        // Per tag set of the table: does it match?
+        let set_ok: Vec<bool> = mesh.tags.iter().map(|s| s.matches(&q)).collect();
+        let ok = |i: u32| set_ok.get(i as usize).copied().unwrap_or(false);
+        let face: Vec<bool> = mesh.faces.iter().map(|f| ok(f.tags)).collect();
+        let (mut edge, mut vertex) = (Vec::new(), Vec::new());
+        if full {
+            let topo = self.topology();
+            edge = vec![false; topo.edges.len()];
+            for (e, hit) in edge.iter_mut().enumerate() {
+                *hit = topo
+                    .edge_uses(e)
+                    .iter()
+                    .any(|u| face[u.face as usize] || ok(mesh.edge_tag_index(u.corner as usize)));
+            }
+            vertex = vec![false; topo.weld.count];
+            for (f, &face_ok) in face.iter().enumerate() {
+                for &l in mesh.face_loops(f) {
+                    for c in mesh.loop_corners(l) {
+                        let v = topo.weld.id[mesh.corners[c] as usize] as usize;
+                        if face_ok || ok(mesh.vertex_tag_index(c)) {
+                            vertex[v] = true;
+                        }
+                    }
+                }
+            }
+            for (e, ed) in topo.edges.iter().enumerate() {
+                if edge[e] {
+                    vertex[ed.v[0] as usize] = true;
+                    vertex[ed.v[1] as usize] = true;
+                }
+            }
+        }
+        self.tag_cache.push(TagMatch {
+            query: query.to_string(),
+            full,
+            face,
+            edge,
+            vertex,
+        });
+        self.tag_cache.len() - 1
+    }
+
+    /// `isTagged(query [, sub])` for component `k` (see `TagMatch`): with
+    /// `sub`, a component matches if one of its edges or vertices does.
+    fn is_tagged(&mut self, k: usize, query: &str, sub: Option<TagSub>) -> bool {
+        if !self.mesh.may_have_tags() {
+            return false;
+        }
+        let item = self.items[k];
+        let full = sub.is_some() || !matches!(item, Item::Faces { .. } | Item::Hole { .. });
+        let i = self.tag_match(query, full);
+        let t = &self.tag_cache[i];
+        let mesh = &*self.mesh;
+        let topo = self.topo.as_ref();
+        let vid = |c: usize| topo.map(|t| t.weld.id[mesh.corners[c] as usize] as usize);
+        let edge_of = |c: usize| {
+            topo.map(|t| t.edge_of_corner[c])
+                .filter(|&e| e != u32::MAX)
+                .map(|e| e as usize)
+        };
+        let edge_hit =
+            |e: Option<usize>| e.is_some_and(|e| t.edge.get(e).copied().unwrap_or(false));
+        let vertex_hit =
+            |v: Option<usize>| v.is_some_and(|v| t.vertex.get(v).copied().unwrap_or(false));
+        // A face by its own tags, or by one of its edges or vertices.
+        let face_hit = |f: usize| match sub {
+            None => t.face[f],
+            Some(TagSub::Edges) => mesh
+                .face_loops(f)
+                .iter()
+                .any(|&l| mesh.loop_corners(l).any(|c| edge_hit(edge_of(c)))),
+            Some(TagSub::Vertices) => mesh
+                .face_loops(f)
+                .iter()
+                .any(|&l| mesh.loop_corners(l).any(|c| vertex_hit(vid(c)))),
+        };
+        match item {
+            Item::Faces { start, len } => self
+                .faces_of(start, len)
+                .iter()
+                .any(|&f| face_hit(f as usize)),
+            Item::Hole { face, lp } => match sub {
+                None => t.face[face as usize],
+                Some(_) => {
+                    let l = mesh.loops[lp as usize];
+                    mesh.loop_corners(l).any(|c| match sub {
+                        Some(TagSub::Edges) => edge_hit(edge_of(c)),
+                        _ => vertex_hit(vid(c)),
+                    })
+                }
+            },
+            Item::Edge(e) => match sub {
+                Some(TagSub::Vertices) => topo.is_some_and(|tp| {
+                    let ed = tp.edges[e as usize];
+                    vertex_hit(Some(ed.v[0] as usize)) || vertex_hit(Some(ed.v[1] as usize))
+                }),
+                _ => edge_hit(Some(e as usize)),
+            },
+            Item::FaceEdge { corner, face } => {
+                let c = corner as usize;
+                match sub {
+                    Some(TagSub::Vertices) => {
+                        let l = loop_of_corner(mesh, face as usize, c);
+                        let r = mesh.loop_corners(l);
+                        let n = if c + 1 == r.end { r.start } else { c + 1 };
+                        vertex_hit(vid(c)) || vertex_hit(vid(n))
+                    }
+                    // A zero-length face edge has no unique edge: its face
+                    // and its own tags decide.
+                    _ => match edge_of(c) {
+                        Some(e) => edge_hit(Some(e)),
+                        None => t.face[face as usize],
+                    },
+                }
+            }
+            Item::Vertex { vid: v, .. } => vertex_hit(Some(v as usize)),
+            Item::FaceVertex { corner, .. } => vertex_hit(vid(corner as usize)),
         }
     }
 
@@ -1078,6 +1235,14 @@ impl MeshBuilder {
         if src.normals.is_some() || self.force_normals {
             m.normals = Some(Vec::new());
         }
+        // Components keep their tags: the source's tag table is shared.
+        m.tags = src.tags.clone();
+        if src.edge_tags.is_some() {
+            m.edge_tags = Some(Vec::new());
+        }
+        if src.vertex_tags.is_some() {
+            m.vertex_tags = Some(Vec::new());
+        }
         m
     }
 
@@ -1125,6 +1290,12 @@ impl MeshBuilder {
                 .unwrap_or(DVec3::ZERO);
             dst.push(n);
         }
+        if let Some(dst) = out.edge_tags.as_mut() {
+            dst.push(src.edge_tag_index(c));
+        }
+        if let Some(dst) = out.vertex_tags.as_mut() {
+            dst.push(src.vertex_tag_index(c));
+        }
     }
 
     fn add_face(&mut self, src: &Mesh, out: &mut Mesh, face: usize) {
@@ -1143,6 +1314,7 @@ impl MeshBuilder {
             loop_count: loops.len() as u32,
             material,
             group,
+            tags: src.faces[face].tags,
         });
     }
 
@@ -1157,12 +1329,20 @@ impl MeshBuilder {
         for c in corners {
             self.corner(src, out, c, None);
         }
+        // Reversed keeping the first corner: the edges run in reverse order.
+        let r = start as usize..out.corners.len();
+        if let Some(e) = out.edge_tags.as_mut() {
+            for (k, c) in src.loop_corners(l).enumerate() {
+                e[r.end - 1 - k] = src.edge_tag_index(c);
+            }
+        }
         out.loops.push(Loop { start, len: l.len });
         out.faces.push(Face {
             first_loop: out.loops.len() as u32 - 1,
             loop_count: 1,
             material,
             group,
+            tags: src.faces[face].tags,
         });
     }
 
@@ -1181,6 +1361,12 @@ impl MeshBuilder {
         for &c in corners {
             self.corner(src, out, c, Some(normal));
         }
+        // Both corners of an edge shape stand for the one edge.
+        if let (Some(e), [c0, _]) = (out.edge_tags.as_mut(), corners) {
+            let t = src.edge_tag_index(*c0);
+            let n = e.len();
+            e[n - 2..].fill(t);
+        }
         out.loops.push(Loop {
             start,
             len: corners.len() as u32,
@@ -1190,6 +1376,7 @@ impl MeshBuilder {
             loop_count: 1,
             material,
             group,
+            tags: src.faces[face].tags,
         });
     }
 
@@ -1436,7 +1623,8 @@ fn eval_selection(
     match &e.kind {
         RExprKind::CompSelector(sel, args) => {
             if *sel == Selector::IsTagged {
-                is_tagged_args(cx, frame, shape, args)?;
+                let (query, sub) = is_tagged_args(cx, frame, shape, args, e)?;
+                return Ok(Value::Bool(comps.is_tagged(k, &query, sub)));
             }
             Ok(Value::Bool(comps.matches(*sel, k)))
         }
@@ -1469,18 +1657,17 @@ fn eval_selection(
     }
 }
 
-/// Checks the arguments of `isTagged(query [, e|v])`. The geometry of this
-/// engine carries no component tags, so nothing is tagged; the query is
-/// still evaluated so that its errors show.
+/// The arguments of `isTagged(query [, e|v])`.
 fn is_tagged_args(
     cx: &mut Interp,
     frame: &[Value],
     shape: &Shape,
     args: &[RExpr],
-) -> Result<(), RtError> {
-    if let Some(q) = args.first() {
-        match cx.eval(q, frame, shape)? {
-            Value::Str(_) => {}
+    call: &RExpr,
+) -> Result<(Arc<str>, Option<TagSub>), RtError> {
+    let query = match args.first() {
+        Some(q) => match cx.eval(q, frame, shape)? {
+            Value::Str(s) => s,
             other => {
                 return Err(RtError::new(
                     format!(
@@ -1490,13 +1677,25 @@ fn is_tagged_args(
                     q.span,
                 ))
             }
+        },
+        None => {
+            return Err(RtError::new(
+                "`isTagged` needs a tag query: isTagged(query [, e|v])",
+                call.span,
+            ))
         }
-    }
-    if let Some(sub) = args.get(1) {
-        let a = cx.eval_arg(sub, frame, shape)?;
-        selector(&a, &["e", "v"])?;
-    }
-    Ok(())
+    };
+    let sub = match args.get(1) {
+        Some(sub) => {
+            let a = cx.eval_arg(sub, frame, shape)?;
+            Some(match selector(&a, &["e", "v"])? {
+                "e" => TagSub::Edges,
+                _ => TagSub::Vertices,
+            })
+        }
+        None => None,
+    };
+    Ok((query, sub))
 }
 
 /// The sets of components an entry makes shapes of.

@@ -331,7 +331,10 @@ fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {
             .find(|n| n.length_squared() > 0.5)
             .unwrap_or(shape.scope.frame.axes.y_axis),
     };
-    let out = cga_geometry::extrude(&mesh, how, dist);
+    let (mut out, roles) = cga_geometry::extrude_with_roles(&mesh, how, dist);
+    cga_geometry::tags::set_face_auto_tags(&mut out, "extrude", |f| {
+        roles.get(f).map_or("extrude.side.outer", |r| r.tag())
+    });
     // New scope: y along the extrusion, x the old x made orthogonal to it.
     let y = dir;
     let old_x = shape.scope.frame.axes.x_axis;
@@ -340,7 +343,6 @@ fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {
         .unwrap_or_else(|| y.any_orthonormal_vector());
     let axes = DMat3::from_cols(x, y, x.cross(y));
     let to_scope = shape.scope.frame.affine().inverse();
-    let mut out = out;
     crate::shape::transform_in_place(&mut out, &to_scope);
     shape.set_local_mesh(out);
     shape.fit_scope(axes);

@@ -127,8 +127,13 @@ pub(crate) fn keyword(head: &RExpr) -> Option<&str> {
 /// attributes.
 pub(crate) fn sub_mesh(src: &Mesh, faces: &[usize]) -> Mesh {
     let mut out = Mesh::new();
-    out.materials = src.materials.clone();
-    out.groups = src.groups.clone();
+    out.share_slots(src);
+    if src.edge_tags.is_some() {
+        out.edge_tags = Some(Vec::new());
+    }
+    if src.vertex_tags.is_some() {
+        out.vertex_tags = Some(Vec::new());
+    }
     for (k, set) in src.uvs.iter().enumerate() {
         if set.is_some() {
             out.uvs[k] = Some(Vec::new());
@@ -148,6 +153,7 @@ pub(crate) fn sub_mesh(src: &Mesh, faces: &[usize]) -> Mesh {
         let refs: Vec<&[u32]> = ids.iter().map(|x| x.as_slice()).collect();
         let nf = out.add_face(&refs, src.faces[f].material);
         out.faces[nf].group = src.faces[f].group;
+        out.faces[nf].tags = src.faces[f].tags;
         let corners = src
             .face_loops(f)
             .iter()
@@ -161,6 +167,12 @@ pub(crate) fn sub_mesh(src: &Mesh, faces: &[usize]) -> Mesh {
             }
             if let (Some(dst), Some(s)) = (out.normals.as_mut(), src.normals.as_ref()) {
                 dst[first + i] = s[c];
+            }
+            if let Some(dst) = out.edge_tags.as_mut() {
+                dst[first + i] = src.edge_tag_index(c);
+            }
+            if let Some(dst) = out.vertex_tags.as_mut() {
+                dst[first + i] = src.vertex_tag_index(c);
             }
         }
     }
@@ -785,6 +797,9 @@ fn envelope(
     let e = cga_geometry::envelope::envelope(&mesh, dir, max_height, &base, &angle);
     warn_failed(cx, call.span, "envelope", &e.failed);
     let mut out = e.mesh;
+    cga_geometry::tags::set_face_auto_tags(&mut out, "envelope", |f| {
+        e.roles.get(f).map_or("envelope.bottom", |r| r.tag())
+    });
     let failed: Vec<usize> = e.failed.iter().map(|(f, _)| *f).collect();
     append_faces(&mut out, &mesh, &failed);
     // The scope keeps its orientation and fits the volume (what CityEngine
@@ -822,6 +837,7 @@ fn taper(st: &mut ShapeState, args: &[Arg]) -> Result<(), RtError> {
     let apex = centroid + n * h;
     let mut out = Mesh::new();
     out.materials = mesh.materials.clone();
+    out.tags = mesh.tags.clone();
     let material = mesh.faces[f].material;
     let k = outer.len() as u32;
     out.positions.extend_from_slice(&outer);
@@ -840,6 +856,17 @@ fn taper(st: &mut ShapeState, args: &[Arg]) -> Result<(), RtError> {
         let side = if up { [i, j, k] } else { [j, i, k] };
         out.add_face(&[&side], material);
     }
+    // The faces keep the tapered face's tags and get taper's auto-tags.
+    for face in &mut out.faces {
+        face.tags = mesh.faces[f].tags;
+    }
+    cga_geometry::tags::set_face_auto_tags(&mut out, "taper", |i| {
+        if i == 0 {
+            "taper.bottom"
+        } else {
+            "taper.side"
+        }
+    });
     super::roof::set_mesh_y_up(&mut st.shape, out, Some(n));
     if h < 0.0 {
         // Downwards: the scope keeps y along the normal with sy < 0 (as a

@@ -16,6 +16,7 @@ mod scatter;
 mod scope_ops;
 pub mod split;
 pub mod split_area;
+mod tags;
 pub mod texturing;
 mod transform;
 
@@ -110,6 +111,8 @@ pub enum Op {
     Modify,
     Scatter,
     AlignScopeToGeometryBBox,
+    Tag,
+    DeleteTags,
 }
 
 /// How an operation's arguments are read by the resolver.
@@ -166,6 +169,7 @@ pub fn arg_mode(name: &str, arity: usize, pos: usize) -> ArgMode {
         ("roofGable" | "roofHip" | "roofShed" | "roofPyramid" | "roofRidge", _, 0) => Maybe,
         ("scatter" | "rectify" | "cleanupGeometry" | "setNormals" | "mirror", _, _) => Maybe,
         ("trim" | "taper" | "reduceGeometry" | "insertAlongUV", _, _) => Maybe,
+        ("tag" | "deleteTags", 2, 1) => Selector,
         _ => Expr,
     }
 }
@@ -274,6 +278,8 @@ pub fn lookup(name: &str) -> Option<OpInfo> {
         "reduceGeometry" => info(Op::ReduceGeometry, 1, 1),
         "rectify" => info(Op::Rectify, 1, 1),
         "label" => info(Op::Label, 1, 1),
+        "tag" => info(Op::Tag, 1, 2),
+        "deleteTags" => info(Op::DeleteTags, 0, 2),
         _ => None,
     }
 }
@@ -437,5 +443,6 @@ pub fn exec(
         | Op::Mirror
         | Op::ReduceGeometry
         | Op::Rectify => cleanup::exec(cx, st, call, args),
+        Op::Tag | Op::DeleteTags => tags::exec(st, call, args),
     }
 }

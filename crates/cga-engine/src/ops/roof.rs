@@ -88,7 +88,11 @@ pub fn exec(
         });
     }
     let up = first_normal(&mesh);
-    set_mesh_y_up(&mut st.shape, r.mesh, up);
+    let mut out = r.mesh;
+    cga_geometry::tags::set_face_auto_tags(&mut out, "roof", |f| {
+        r.roles.get(f).map_or("roof.bottom", |role| role.tag())
+    });
+    set_mesh_y_up(&mut st.shape, out, up);
     Ok(())
 }
 

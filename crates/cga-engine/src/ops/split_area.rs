@@ -112,6 +112,9 @@ pub fn exec(
     // Slab k of the cut lies between `cuts[k - 1]` and `cuts[k]`.
     let cuts = &plan.positions[plan.first_cut..plan.end_cut];
     let mut slabs = split_by_parallel_planes(&mesh, dir, cuts);
+    // splitArea does not support component tags: CityEngine clears them
+    // (cga_componentTags.md, "Operations that clear all tags").
+    slabs.iter_mut().for_each(cga_geometry::tags::clear_tags);
     let total = plan.parts.len() as f64;
     for (index, part) in plan.parts.iter().enumerate() {
         let (start, end) = (plan.positions[part.slab - 1], plan.positions[part.slab]);

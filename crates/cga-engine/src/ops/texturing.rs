@@ -697,6 +697,7 @@ fn empty_like(mesh: &Mesh) -> Mesh {
     let mut m = Mesh::new();
     m.materials = mesh.materials.clone();
     m.groups = mesh.groups.clone();
+    m.tags = mesh.tags.clone();
     for (dst, src) in m.uvs.iter_mut().zip(&mesh.uvs) {
         if src.is_some() {
             *dst = Some(Vec::new());
@@ -756,6 +757,7 @@ fn append_piece(out: &mut Mesh, piece: &Mesh, face: Face) {
         loop_count: pf.loop_count,
         material: face.material,
         group: face.group,
+        tags: face.tags,
     }));
     let n = piece.corners.len();
     for (dst, src) in out.uvs.iter_mut().zip(&piece.uvs) {
@@ -828,6 +830,7 @@ fn cut_face(
         loop_count: scratch.loops.len() as u32,
         material: 0,
         group: 0,
+        tags: 0,
     });
     let values: Vec<f64> = src_corners
         .iter()

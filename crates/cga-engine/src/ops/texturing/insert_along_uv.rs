@@ -354,6 +354,7 @@ fn place_polygon(
         loop_count: loops.len() as u32,
         material: poly.material,
         group: 0,
+        tags: 0,
     });
 }
 

@@ -1,0 +1,58 @@
+//! The component tag operations: `tag(name [, auto|faces|edges|vertices])`
+//! and `deleteTags([query [, all|faces|edges|vertices]])`
+//! (cga_componentTags.md; storage and queries in `cga_geometry::tags`).
+
+use cga_geometry::tags::{self, TagQuery, TagTarget};
+use cga_geometry::Mesh;
+
+use super::transform::selector;
+use super::Op;
+use crate::derive::{Arg, RtError, ShapeState};
+use crate::expr::OpCall;
+
+pub fn exec(st: &mut ShapeState, call: &OpCall, args: &[Arg]) -> Result<(), RtError> {
+    match call.op {
+        Op::Tag => {
+            let name = args[0].text()?;
+            let target = match args.get(1) {
+                Some(a) => target(a, &["auto", "faces", "edges", "vertices"])?,
+                None => TagTarget::Auto,
+            };
+            if tags::clean_name(name).is_empty() {
+                return Ok(());
+            }
+            edit(st, |m| tags::add_tag(m, name, target));
+        }
+        Op::DeleteTags => {
+            let query = match args.first() {
+                Some(a) => Some(TagQuery::parse(a.text()?)),
+                None => None,
+            };
+            let target = match args.get(1) {
+                Some(a) => target(a, &["all", "faces", "edges", "vertices"])?,
+                None => TagTarget::All,
+            };
+            if !st.shape.geometry.local().may_have_tags() {
+                return Ok(());
+            }
+            edit(st, |m| tags::delete_tags(m, query.as_ref(), target));
+        }
+        _ => unreachable!("not a tag operation"),
+    }
+    Ok(())
+}
+
+fn target(a: &Arg, allowed: &[&str]) -> Result<TagTarget, RtError> {
+    let s = selector(a, allowed)?;
+    Ok(TagTarget::parse(s).unwrap_or(TagTarget::All))
+}
+
+/// Changes the tags of the shape's geometry (positions untouched).
+fn edit(st: &mut ShapeState, f: impl FnOnce(&mut Mesh)) {
+    if st.shape.geometry.is_empty() {
+        return;
+    }
+    let mut mesh = (**st.shape.geometry.local()).clone();
+    f(&mut mesh);
+    st.shape.set_local_mesh(mesh);
+}

@@ -60,6 +60,8 @@ pub fn arg_is_selector(name: &str, pos: usize) -> bool {
         "assetInfo" | "imageInfo" => pos == 1,
         "getGeoCoord" => pos == 0,
         "assetsSortSize" | "assetsSortRatio" | "imagesSortRatio" => pos == 1,
+        "assetNamingInfo" | "assetNamingInfos" => pos == 1,
+        "getMaterial" => pos < 2,
         _ => false,
     }
 }
@@ -89,6 +91,9 @@ pub enum GeometryFn {
     Dv,
     /// `geometry.angle(maxSlope|azimuth|zenith)`.
     Angle,
+    /// `geometry.materials()`: the names of the materials, in the order of
+    /// `comp(m)`.
+    Materials,
     /// `geometry.tags([query [, components]])`: the sorted tags.
     Tags,
     /// `geometry.hasTags([query [, components]])`.
@@ -157,6 +162,7 @@ pub fn lookup(name: &str, arity: usize) -> Option<ShapeFn> {
             "du" => (Du, &[1, 2]),
             "dv" => (Dv, &[1, 2]),
             "angle" => (Angle, &[1]),
+            "materials" => (Materials, &[0]),
             "tags" => (Tags, &[0, 1, 2]),
             "hasTags" => (HasTags, &[0, 1, 2]),
             _ => return None,
@@ -507,6 +513,24 @@ mod eval {
                         GeometryFn::VMin => lo.y,
                         _ => hi.y,
                     }))
+                }
+                GeometryFn::Materials => {
+                    // Material slots that faces use, in slot order, as
+                    // comp(m) makes its components.
+                    let mut used = vec![false; mesh.materials.len()];
+                    for f in &mesh.faces {
+                        if let Some(u) = used.get_mut(f.material as usize) {
+                            *u = true;
+                        }
+                    }
+                    let names: Vec<std::sync::Arc<str>> = mesh
+                        .materials
+                        .iter()
+                        .zip(&used)
+                        .filter(|(_, &u)| u)
+                        .map(|(m, _)| m.name.clone())
+                        .collect();
+                    Value::StrArray(std::sync::Arc::new(cga_value::Array::row(names)))
                 }
                 GeometryFn::Angle => {
                     let which = match &args[0] {

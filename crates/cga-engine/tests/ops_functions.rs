@@ -145,3 +145,48 @@ fn unsupported_functions_warn_and_return_empty_values() {
         "{w:?}"
     );
 }
+
+/// func_geometry, geometry.materials: the material names in the order of
+/// `comp(m)`; op_comp's example selects the component whose index
+/// `findFirst` gives.
+#[test]
+fn geometry_materials_in_component_order() {
+    let dir = std::env::temp_dir().join(format!("cga-materials-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("tree.obj"),
+        "mtllib tree.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 2 0\nusemtl Leaves\nf 1 2 3\nusemtl Bark\nf 1 3 4\nusemtl Leaves\nf 4 3 5\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("tree.mtl"),
+        "newmtl Leaves\nKd 0 1 0\nnewmtl Bark\nKd 0.5 0.3 0.1\n",
+    )
+    .unwrap();
+    let rules = dir.join("m.cga");
+    std::fs::write(
+        &rules,
+        "Lot --> i(\"tree.obj\") print(geometry.materials)\n    comp(m) { findFirst(geometry.materials, \"Bark\") : print(\"trunk \" + geometry.area) | all = print(\"foliage \" + geometry.area) }\n",
+    )
+    .unwrap();
+    let g = gen_file(&rules, &Opts::default()).ok();
+    let prints = g.prints();
+    assert_eq!(prints[0], "(2)[Leaves,Bark]");
+    let mut rest: Vec<&str> = prints[1..].iter().map(String::as_str).collect();
+    rest.sort();
+    // The asset is fitted to the lot's scope; the leaves have twice the
+    // bark's area.
+    assert_eq!(rest.len(), 2);
+    assert!(rest[0].starts_with("foliage ") && rest[1].starts_with("trunk "));
+    assert_near(numbers(rest[0])[0], 2.0 * numbers(rest[1])[0], 1e-9);
+}
+
+/// A colour string that is not a colour (here an empty edge attribute)
+/// leaves the colour unchanged with a warning; the lot is still generated.
+#[test]
+fn invalid_colour_strings_warn() {
+    let g = gen("Lot --> color(\"#ff0000\") color(edgeAttr.getString(\"colors\")) X.\n");
+    let g = g.ok();
+    assert_eq!(rgb255(g.face_materials()[0]), [255, 0, 0]);
+    assert!(g.warnings().iter().any(|w| w.contains("is not a colour")));
+}

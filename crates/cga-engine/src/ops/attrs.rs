@@ -24,6 +24,15 @@ pub fn exec(
         Op::Color => match args {
             [hex] => {
                 let s = hex.text()?;
+                if parse_hex_color(s).is_none() {
+                    // A colour that is not one (often an empty attribute
+                    // value) leaves the colour as it was, with a warning,
+                    // rather than stopping the lot.
+                    cx.warn_once(hex.span, || {
+                        format!("\"{s}\" is not a colour (expected \"#rrggbb\" or \"#rrggbboo\"); the colour is left unchanged")
+                    });
+                    return Ok(());
+                }
                 let edit = MaterialEdit::ColorHex(match &hex.value {
                     Value::Str(s) => s.clone(),
                     _ => Arc::from(s),

@@ -44,12 +44,15 @@ fn color_clamps_and_reads_back() {
     assert_eq!(m.opacity, 0.25);
 }
 
-/// op_color: a colour that is not "#rrggbb" is an error.
+/// op_color: a colour that is not "#rrggbb" or "#rrggbboo" is refused
+/// with a warning; the colour stays as it was and the model is generated.
 #[test]
 fn color_rejects_bad_hex() {
-    let g = gen("Lot --> color(\"red\") X\n");
-    assert_eq!(g.errors.len(), 1);
-    assert!(g.errors[0].message.contains("not a colour"));
+    let g = gen("Lot --> color(\"#0000ff\") color(\"red\") X\n");
+    assert!(g.errors.is_empty());
+    assert!(g.warnings().iter().any(|w| w.contains("\"red\" is not a colour")));
+    let g = g.ok();
+    assert_eq!(rgb255(g.face_materials()[0]), [0, 0, 255]);
 }
 
 /// op_set, "Builtin Shape Attributes": the four one-liners, read back.

@@ -229,6 +229,8 @@ pub(crate) struct PendingRule {
     span: Span,
     /// Rule invocations from the initial shape to this one.
     generation: usize,
+    /// The shape's tree key (`getTreeKey`), when the program asks for it.
+    key: Option<Arc<str>>,
 }
 
 /// The interpreter for one initial shape.
@@ -277,6 +279,11 @@ pub struct Interp<'a> {
     /// While `inline` or `modify` derives: the leaf shapes (and the shapes
     /// ended by `NIL`), collected here instead of emitted (`ops::inline`).
     pub(crate) collected: Option<Vec<Collected>>,
+    /// The tree key of the rule being applied (`getTreeKey`: "0;0;1;"),
+    /// and how many shapes it has created so far (the next child's index).
+    /// Kept only when the program calls `getTreeKey`.
+    pub(crate) tree_key: Arc<str>,
+    tree_children: u32,
 }
 
 /// A shape that ended while leaves were being collected (`Interp::collected`).
@@ -501,6 +508,8 @@ impl<'a> Interp<'a> {
             context: None,
             started: std::time::Instant::now(),
             collected: None,
+            tree_key: Arc::from(""),
+            tree_children: 0,
         }
     }
 
@@ -529,6 +538,7 @@ impl<'a> Interp<'a> {
         span: Span,
     ) -> Result<(), RtError> {
         let generation = self.generation + 1;
+        let key = self.next_tree_key();
         self.derive_all_now(|cx| {
             cx.queue.push_back(PendingRule {
                 rule,
@@ -536,9 +546,21 @@ impl<'a> Interp<'a> {
                 shape,
                 span,
                 generation,
+                key,
             });
             Ok(())
         })
+    }
+
+    /// The tree key of the next shape the current rule creates (its
+    /// children are numbered from 0 in the order they are created).
+    fn next_tree_key(&mut self) -> Option<Arc<str>> {
+        if !self.program.uses_tree_key {
+            return None;
+        }
+        let key = format!("{}{};", self.tree_key, self.tree_children);
+        self.tree_children += 1;
+        Some(Arc::from(key))
     }
 
     /// Runs `start` (which may queue rule calls) and derives everything it
@@ -577,6 +599,7 @@ impl<'a> Interp<'a> {
             mut shape,
             span: call_span,
             generation,
+            key,
         } = p;
         let program = self.program;
         let def = &program.rules[rule as usize];
@@ -590,6 +613,12 @@ impl<'a> Interp<'a> {
             ));
         }
         let outer_generation = std::mem::replace(&mut self.generation, generation);
+        let outer_key = key.map(|k| {
+            (
+                std::mem::replace(&mut self.tree_key, k),
+                std::mem::replace(&mut self.tree_children, 0),
+            )
+        });
         shape.name = program.rule_symbol(rule);
         let mut r = Ok(());
         for local in &def.locals {
@@ -611,6 +640,10 @@ impl<'a> Interp<'a> {
             self.current_file = caller_file;
         }
         self.generation = outer_generation;
+        if let Some((k, n)) = outer_key {
+            self.tree_key = k;
+            self.tree_children = n;
+        }
         frame.clear();
         self.frame_pool.push(frame);
         r
@@ -874,6 +907,7 @@ impl<'a> Interp<'a> {
                     self.reinitialize_import(rc, frame, &st.shape, &mut child)?;
                 }
                 st.has_successor = true;
+                let key = self.next_tree_key();
                 // As in CityEngine, the successor's rule runs after every
                 // rule already waiting: shapes are derived generation by
                 // generation, in the order they were created.
@@ -883,10 +917,13 @@ impl<'a> Interp<'a> {
                     shape: child,
                     span: rc.span,
                     generation: self.generation + 1,
+                    key,
                 });
                 Ok(())
             }
             RStmt::Leaf(sym) => {
+                // A leaf is a shape of the tree too: it takes a child index.
+                self.next_tree_key();
                 let mut child = self.child(&st.shape, Span::default())?;
                 child.name = *sym;
                 st.has_successor = true;

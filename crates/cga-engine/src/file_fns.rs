@@ -40,6 +40,8 @@ pub enum FileFn {
     AssetMetadata,
     /// `sel(string)`: a selector from a string.
     Sel,
+    /// `getTreeKey()`: the shape's path in the shape tree.
+    TreeKey,
     /// Functions of CGA this engine does not compute: a warning and an
     /// empty result of the function's type, so that rule files using them
     /// still generate.
@@ -48,7 +50,7 @@ pub enum FileFn {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Unsupported {
-    /// `getTreeKey()`, `assetNamingInfo(..)`: a string.
+    /// `assetNamingInfo(..)`: a string.
     Str(&'static str),
     /// `assetNamingInfos(..)`, `getMaterial(..)`, `readMaterial(..)`: a
     /// string array.
@@ -83,7 +85,7 @@ pub fn lookup(name: &str, arity: usize) -> Option<FileFn> {
         ("imagesSortRatio", 2) => FileFn::ImagesSortRatio,
         ("assetMetadata", 3) => FileFn::AssetMetadata,
         ("sel", 1) => FileFn::Sel,
-        ("getTreeKey", 0) => FileFn::Unsupported(Unsupported::Str("getTreeKey")),
+        ("getTreeKey", 0) => FileFn::TreeKey,
         ("assetNamingInfo", 2) => FileFn::Unsupported(Unsupported::Str("assetNamingInfo")),
         ("assetNamingInfos", 2) => FileFn::Unsupported(Unsupported::StrArray("assetNamingInfos")),
         ("getMaterial", 1 | 2) => FileFn::Unsupported(Unsupported::StrArray("getMaterial")),
@@ -255,6 +257,7 @@ impl Interp<'_> {
                 args[2].clone()
             }
             FileFn::Sel => Value::Str(Arc::from(text(&args[0], at)?)),
+            FileFn::TreeKey => Value::Str(self.tree_key.clone()),
             FileFn::Unsupported(u) => {
                 let (name, value) = match u {
                     Unsupported::Str(n) => (n, Value::str("")),

@@ -97,6 +97,9 @@ pub struct Program {
     pub main_rules: Vec<(String, RuleId)>,
     /// Leaf and rule names, interned: shapes carry a `u32` name.
     pub symbols: Vec<Arc<str>>,
+    /// Whether a rule calls `getTreeKey`: only then are the shapes' tree
+    /// keys kept during derivation.
+    pub uses_tree_key: bool,
 }
 
 impl Program {

@@ -888,6 +888,7 @@ impl Resolver<'_> {
         } else if let Some(f) = self.find_func(cx.rs, name, 0) {
             RExprKind::Func(f, Vec::new())
         } else if let Some(f) = shape_fns::lookup(name, 0) {
+            self.note_shape_fn(f);
             RExprKind::Shape(f, Vec::new())
         } else if let Some(b) = values::lookup(name, 0) {
             RExprKind::Pure(b, Vec::new())
@@ -900,11 +901,19 @@ impl Resolver<'_> {
         RExpr { kind, span }
     }
 
+    /// Records what the derivation must keep for a shape function.
+    fn note_shape_fn(&mut self, f: shape_fns::ShapeFn) {
+        if f == shape_fns::ShapeFn::File(crate::file_fns::FileFn::TreeKey) {
+            self.program.uses_tree_key = true;
+        }
+    }
+
     fn call(&mut self, cx: &Cx, name: &ast::Ident, args: Vec<RExpr>, span: Span) -> RExpr {
         let n = args.len();
         let kind = if let Some(f) = self.find_func(cx.rs, &name.name, n) {
             RExprKind::Func(f, args)
         } else if let Some(f) = shape_fns::lookup(&name.name, n) {
+            self.note_shape_fn(f);
             RExprKind::Shape(f, args)
         } else if let Some(b) = values::lookup(&name.name, n) {
             RExprKind::Pure(b, args)

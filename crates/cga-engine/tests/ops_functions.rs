@@ -131,12 +131,12 @@ fn assets_sorted_by_size_and_ratio() {
 /// value instead of failing the rule file.
 #[test]
 fn unsupported_functions_warn_and_return_empty_values() {
-    let g = gen("Lot --> print(\"[\" + getTreeKey() + \"]\") print(readMaterial(\"m.mtl\"))\n");
+    let g = gen("Lot --> print(\"[\" + assetNamingInfo(\"a.obj\", m) + \"]\") print(readMaterial(\"m.mtl\"))\n");
     assert_eq!(g.prints(), ["[]", "(0)[]"]);
     let w = g.warnings();
     assert!(
         w.iter()
-            .any(|w| w.contains("`getTreeKey` is not supported")),
+            .any(|w| w.contains("`assetNamingInfo` is not supported")),
         "{w:?}"
     );
     assert!(
@@ -189,4 +189,59 @@ fn invalid_colour_strings_warn() {
     let g = g.ok();
     assert_eq!(rgb255(g.face_materials()[0]), [255, 0, 0]);
     assert!(g.warnings().iter().any(|w| w.contains("is not a colour")));
+}
+
+/// func_getTreeKey, "Simple Example": the path of child indices from the
+/// initial shape, printed generation by generation as CityEngine does.
+#[test]
+fn tree_keys_of_the_simple_example() {
+    let src = r#"
+Init-->
+    print(getTreeKey() + " - Init")
+    center(xz)
+    extrude(10)
+    comp(f) { front: Facade}
+
+Facade-->
+    print(getTreeKey() + " - Facade")
+    split(y) {'0.5 : Floor }*
+
+Floor-->
+    print(getTreeKey() + " - Floor")
+    split(x) { '0.1 : Wall | '0.3 : Window | '0.1 : Wall }*
+
+Wall-->
+    print(getTreeKey() + " - Wall")
+
+Window-->
+    print(getTreeKey() + " - Window")
+"#;
+    let g = gen_with(src, &Opts::default().start("Init")).ok();
+    let expected = [
+        "0; - Init",
+        "0;0; - Facade",
+        "0;0;0; - Floor",
+        "0;0;1; - Floor",
+        "0;0;0;0; - Wall",
+        "0;0;0;1; - Window",
+        "0;0;0;2; - Wall",
+        "0;0;0;3; - Wall",
+        "0;0;0;4; - Window",
+        "0;0;0;5; - Wall",
+        "0;0;1;0; - Wall",
+        "0;0;1;1; - Window",
+        "0;0;1;2; - Wall",
+        "0;0;1;3; - Wall",
+        "0;0;1;4; - Window",
+        "0;0;1;5; - Wall",
+    ];
+    assert_eq!(g.prints(), expected);
+}
+
+/// func_getTreeKey: the key stays the same while a rule is derived, also
+/// in the operations of split parts.
+#[test]
+fn tree_key_is_the_rules_during_its_derivation() {
+    let g = gen("Lot --> extrude(5) ShapeA\nShapeA -->\n    print(getTreeKey)\n    split(x){ 2: ShapeB print(getTreeKey) | 3: ShapeC print(getTreeKey) }\n").ok();
+    assert_eq!(g.prints(), ["0;0;", "0;0;", "0;0;"]);
 }

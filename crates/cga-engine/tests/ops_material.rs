@@ -50,7 +50,10 @@ fn color_clamps_and_reads_back() {
 fn color_rejects_bad_hex() {
     let g = gen("Lot --> color(\"#0000ff\") color(\"red\") X\n");
     assert!(g.errors.is_empty());
-    assert!(g.warnings().iter().any(|w| w.contains("\"red\" is not a colour")));
+    assert!(g
+        .warnings()
+        .iter()
+        .any(|w| w.contains("\"red\" is not a colour")));
     let g = g.ok();
     assert_eq!(rgb255(g.face_materials()[0]), [0, 0, 255]);
 }

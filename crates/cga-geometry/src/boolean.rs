@@ -567,17 +567,7 @@ fn boolean_3d(a: &Mesh, b: &Mesh, op: BoolOp, tol: &Tol) -> BoolResult {
         // orientation (all fragments of a face have the same).
         let n = if flipped { -sf.normal } else { sf.normal };
         let (u, v) = plane_basis(n);
-        scratch.snap.clear();
-        let loops: Vec<Vec<DVec2>> = group
-            .iter()
-            .map(|p| {
-                scratch.snap.extend_from_slice(&p.pts);
-                p.pts
-                    .iter()
-                    .map(|q| DVec2::new(q.dot(u), q.dot(v)))
-                    .collect()
-            })
-            .collect();
+        let loops = fragment_loops(group, u, v, tol.weld, &mut scratch.snap);
         let shapes = union_2d(&loops);
         let w = if flipped { -sf.w } else { sf.w };
         emit_shapes(
@@ -592,6 +582,72 @@ fn boolean_3d(a: &Mesh, b: &Mesh, op: BoolOp, tol: &Tol) -> BoolResult {
         );
     }
     finish(out, tol, Vec::new())
+}
+
+/// The fragments of one face as 2D loops ready for their union: vertices
+/// closer than `tol` welded (into `snap`, in 3D) and the vertices of other
+/// fragments that lie on an edge inserted into it. Fragments meet at
+/// T-junctions (one was split where its neighbour was not); the 2D union
+/// rounds coordinates to integers, which would leave slivers between
+/// edges that only nearly share their points.
+fn fragment_loops(
+    group: &[Poly],
+    u: DVec3,
+    v: DVec3,
+    tol: f64,
+    snap: &mut Vec<DVec3>,
+) -> Vec<Vec<DVec2>> {
+    let pts: Vec<DVec3> = group.iter().flat_map(|p| p.pts.iter().copied()).collect();
+    let weld = weld_points(&pts, tol);
+    snap.clear();
+    snap.extend(weld.representative.iter().map(|&r| pts[r as usize]));
+    let flat: Vec<DVec2> = snap
+        .iter()
+        .map(|q| DVec2::new(q.dot(u), q.dot(v)))
+        .collect();
+    let mut loops = Vec::with_capacity(group.len());
+    let mut ids: Vec<u32> = Vec::new();
+    let mut on_edge: Vec<(f64, u32)> = Vec::new();
+    let mut k = 0;
+    for p in group {
+        ids.clear();
+        for _ in 0..p.pts.len() {
+            let id = weld.id[k];
+            k += 1;
+            if ids.last() != Some(&id) {
+                ids.push(id);
+            }
+        }
+        while ids.len() > 1 && ids.first() == ids.last() {
+            ids.pop();
+        }
+        if ids.len() < 3 {
+            continue;
+        }
+        let mut lp = Vec::with_capacity(ids.len() + 2);
+        for i in 0..ids.len() {
+            let (a, b) = (ids[i], ids[(i + 1) % ids.len()]);
+            lp.push(flat[a as usize]);
+            let (pa, pb) = (snap[a as usize], snap[b as usize]);
+            let d = pb - pa;
+            let len2 = d.length_squared();
+            on_edge.clear();
+            for (id, &q) in snap.iter().enumerate() {
+                let id = id as u32;
+                if id == a || id == b {
+                    continue;
+                }
+                let t = (q - pa).dot(d) / len2;
+                if t > 0.0 && t < 1.0 && (pa + d * t - q).abs().max_element() <= tol {
+                    on_edge.push((t, id));
+                }
+            }
+            on_edge.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+            lp.extend(on_edge.iter().map(|&(_, id)| flat[id as usize]));
+        }
+        loops.push(lp);
+    }
+    loops
 }
 
 /// Appends B's result to A's and stitches; `sources` names the faces of
@@ -1417,6 +1473,37 @@ mod tests {
         rot.map_positions(|p| m.transform_point3(p));
         identities(&cube, &rot);
         identities(&rot, &sphere);
+    }
+
+    /// A cube minus a cylinder through its corner: the cube's cut faces
+    /// come back as one polygon each (not the BSP's fragments).
+    #[test]
+    fn cut_faces_are_merged_into_one_polygon() {
+        let a = primitive::cube(DVec3::splat(10.0));
+        let mut b = primitive::cylinder(16, DVec3::splat(10.0));
+        b.map_positions(|p| p + DVec3::splat(3.0));
+        let r = boolean(&a, &b, BoolOp::Subtract);
+        // A: bottom, top, 2 cut sides, 2 whole sides... the top and the
+        // sides x = 10 and z = 10 are cut, the bottom and the two other
+        // sides are whole. B: the bottom cap and 8 side quads inside.
+        let from_a = r.sources.iter().filter(|s| **s == FaceSource::A).count();
+        assert_eq!(from_a, 6);
+        assert_eq!(r.mesh.faces.len() - from_a, 9);
+        assert!(is_closed(&r.mesh));
+        let top = (0..r.mesh.faces.len())
+            .find(|&f| r.sources[f] == FaceSource::A && face_normal(&r.mesh, f).y > 0.5)
+            .expect("top");
+        let cap = (0..r.mesh.faces.len())
+            .find(|&f| r.sources[f] == FaceSource::B && face_normal(&r.mesh, f).y > 0.5)
+            .expect("cap");
+        assert!(close(
+            face_area(&r.mesh, top) + face_area(&r.mesh, cap),
+            100.0
+        ));
+        assert!(close(
+            volume(&r.mesh),
+            1000.0 - 7.0 * face_area(&r.mesh, cap)
+        ));
     }
 
     proptest! {

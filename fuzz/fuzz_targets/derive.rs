@@ -18,6 +18,7 @@ fuzz_target!(|data: &[u8]| {
             max_depth: 64,
             max_shapes: 2000,
             max_seconds: 5.0,
+            max_faces: 20_000,
         },
         ..GenerateOptions::default()
     };

@@ -92,6 +92,9 @@ struct GenerateArgs {
     /// Maximum time per lot, in seconds.
     #[arg(long, default_value_t = Limits::default().max_seconds)]
     max_seconds: f64,
+    /// Stop a lot whose shape's geometry exceeds this many faces.
+    #[arg(long, default_value_t = Limits::default().max_faces)]
+    max_faces: usize,
     /// Largest asset file (OBJ, tables, texts) that is read, in MiB.
     #[arg(long, default_value_t = cga_engine::assets::DEFAULT_MAX_ASSET_MIB)]
     max_asset_mib: u64,
@@ -345,6 +348,7 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
             max_depth: args.max_depth,
             max_shapes: args.max_shapes,
             max_seconds: args.max_seconds,
+            max_faces: args.max_faces,
         },
         // The writer places each leaf's shared mesh while writing: no leaf
         // is copied into object coordinates first.

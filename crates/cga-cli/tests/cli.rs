@@ -236,6 +236,26 @@ fn shape_explosions_stop_at_the_shape_limit() {
     );
 }
 
+/// Found by fuzzing: a rule body runs on to the next line, so
+/// `Lot --> extrude(5)` followed by a stray `Lot` makes the rule call
+/// itself; each extrusion extrudes every face of the last one, so the
+/// geometry grows sixfold per generation while the shape count stays
+/// small. The geometry limit stops it.
+#[test]
+fn geometry_explosions_stop_at_the_face_limit() {
+    let dir = temp_dir("faces");
+    let rules = rule_file(
+        &dir,
+        "f.cga",
+        "Lot --> extrude(5) color(1,1,1,0.75)\n\nLot // a comment -->",
+    );
+    let out = run(&["generate", rules.to_str().unwrap(), "--max-faces", "20000"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert!(err.contains("geometry limit (20000 faces)"), "{err}");
+    assert!(err.contains("f.cga:1:9"), "{err}");
+}
+
 #[test]
 fn reports_are_aggregated_per_key() {
     let dir = temp_dir("report");

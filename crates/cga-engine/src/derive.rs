@@ -31,8 +31,12 @@ pub struct Limits {
     /// Maximum number of shapes created for one initial shape.
     pub max_shapes: usize,
     /// Maximum time for one initial shape, in seconds (checked as shapes
-    /// are created).
+    /// are created and rules applied).
     pub max_seconds: f64,
+    /// Maximum number of faces of one shape's geometry: a grammar that
+    /// multiplies geometry (`Lot --> extrude(5) Lot` extrudes every face of
+    /// the last extrusion again) stops here instead of exhausting memory.
+    pub max_faces: usize,
 }
 
 impl Default for Limits {
@@ -41,6 +45,7 @@ impl Default for Limits {
             max_depth: 1000,
             max_shapes: 5_000_000,
             max_seconds: 300.0,
+            max_faces: 5_000_000,
         }
     }
 }
@@ -284,6 +289,8 @@ pub struct Interp<'a> {
     /// Kept only when the program calls `getTreeKey`.
     pub(crate) tree_key: Arc<str>,
     tree_children: u32,
+    /// Rule applications so far (the time limit is checked every 64).
+    rules_applied: u64,
 }
 
 /// A shape that ended while leaves were being collected (`Interp::collected`).
@@ -510,6 +517,7 @@ impl<'a> Interp<'a> {
             collected: None,
             tree_key: Arc::from(""),
             tree_children: 0,
+            rules_applied: 0,
         }
     }
 
@@ -608,6 +616,20 @@ impl<'a> Interp<'a> {
                 format!(
                     "derivation depth limit ({}) reached in rule `{}`: the rules recurse without end (raise the limit with --max-depth)",
                     self.limits.max_depth, def.name
+                ),
+                call_span,
+            ));
+        }
+        // Few shapes can still take long (each rule multiplying the
+        // geometry): the clock is also read every 64 rule applications.
+        self.rules_applied += 1;
+        if self.rules_applied.is_multiple_of(64)
+            && self.started.elapsed().as_secs_f64() > self.limits.max_seconds
+        {
+            return Err(RtError::new(
+                format!(
+                    "time limit ({} s) reached for one initial shape (raise the limit with --max-seconds)",
+                    self.limits.max_seconds
                 ),
                 call_span,
             ));
@@ -884,7 +906,18 @@ impl<'a> Interp<'a> {
                 let r = ops::exec(self, st, call, &args, frame);
                 args.clear();
                 self.arg_pool.push(args);
-                r
+                r?;
+                let faces = st.shape.geometry.raw().0.faces.len();
+                if faces > self.limits.max_faces {
+                    return Err(RtError::new(
+                        format!(
+                            "geometry limit ({} faces) reached: this operation made {faces} faces (raise the limit with --max-faces)",
+                            self.limits.max_faces
+                        ),
+                        call.span,
+                    ));
+                }
+                Ok(())
             }
             RStmt::Rule(rc) => {
                 let mut args = self.frame_pool.pop().unwrap_or_default();

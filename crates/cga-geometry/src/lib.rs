@@ -12,6 +12,7 @@
 //! | [`cleanup`] | `cleanupGeometry`, `reduceGeometry`, `rectify` |
 //! | [`convexify`] | `convexify` |
 //! | [`cut`] | plane cuts with caps: `split`, trim planes |
+//! | [`boolean`] | `union`, `subtract`, `intersect` (BSP CSG; 2D overlay for planar operands) |
 //! | [`area_split`] | the area left of a moving plane and its inverse: `splitArea` |
 //! | [`extrude`] | `extrude` |
 //! | [`envelope`] | `envelope` |
@@ -31,6 +32,7 @@
 //! | [`tags`] | component tags: tag sets, tag queries, tagging faces, edges, vertices |
 
 pub mod area_split;
+pub mod boolean;
 pub mod cleanup;
 pub mod convexify;
 pub mod cut;

@@ -4,6 +4,7 @@
 
 mod align_bbox;
 mod attrs;
+mod boolean;
 mod cleanup;
 pub mod comp;
 mod create;
@@ -113,6 +114,11 @@ pub enum Op {
     AlignScopeToGeometryBBox,
     Tag,
     DeleteTags,
+    /// `union`, `subtract`, `intersect` (op_boolOp.md): the block holds the
+    /// operands' operation sequences.
+    Union,
+    Subtract,
+    Intersect,
 }
 
 /// How an operation's arguments are read by the resolver.
@@ -249,6 +255,9 @@ pub fn lookup(name: &str) -> Option<OpInfo> {
         }),
         "modify" => with_block(Op::Modify, 1, 2),
         "scatter" => with_block(Op::Scatter, 3, 5),
+        "union" => with_block(Op::Union, 0, 0),
+        "subtract" => with_block(Op::Subtract, 0, 0),
+        "intersect" => with_block(Op::Intersect, 0, 0),
         "alignScopeToGeometryBBox" => info(Op::AlignScopeToGeometryBBox, 1, 1),
         "trim" => info(Op::Trim, 0, 0),
         "roofHip" => info(Op::RoofHip, 1, 4),
@@ -418,6 +427,15 @@ pub fn exec(
         Op::Inline => inline::exec(cx, st, call, args, frame),
         Op::Modify => modify::exec(cx, st, call, args, frame),
         Op::Scatter => scatter::exec(cx, st, call, args, frame),
+        Op::Union => boolean::exec(cx, st, call, cga_geometry::boolean::BoolOp::Union, frame),
+        Op::Subtract => boolean::exec(cx, st, call, cga_geometry::boolean::BoolOp::Subtract, frame),
+        Op::Intersect => boolean::exec(
+            cx,
+            st,
+            call,
+            cga_geometry::boolean::BoolOp::Intersect,
+            frame,
+        ),
         Op::RoofHip | Op::RoofGable | Op::RoofPyramid | Op::RoofShed | Op::RoofRidge => {
             roof::exec(cx, st, call, args)
         }

@@ -132,6 +132,24 @@ pub fn exec(
         })
         .collect();
     let mut merged = match strategy {
+        // Closed volumes are united with the 3D Boolean union; other
+        // pieces (surfaces) are appended, welded and freed of the faces
+        // where they touch.
+        Strategy::Unify
+            if meshes.iter().filter(|(_, d)| !*d).count() > 1
+                && meshes
+                    .iter()
+                    .filter(|(_, d)| !*d)
+                    .all(|(m, _)| cga_geometry::measure::is_closed(m)) =>
+        {
+            let mut pieces = meshes.iter_mut().filter(|(_, d)| !*d).map(|(m, _)| m);
+            let mut out = pieces.next().map(std::mem::take).unwrap_or_default();
+            for m in pieces {
+                out = cga_geometry::boolean::boolean(&out, m, cga_geometry::boolean::BoolOp::Union)
+                    .mesh;
+            }
+            out
+        }
         Strategy::Append | Strategy::Unify => {
             let mut out = Mesh::new();
             let mut first = true;
@@ -148,7 +166,7 @@ pub fn exec(
                 out = united;
                 if overlaps {
                     cx.warn_once(call.span, || {
-                        "inline(unify): this engine has no 3D Boolean union; overlapping volumes are kept as they are (only faces where volumes touch are removed)".to_string()
+                        "inline(unify): open surfaces are not united by a Boolean union; overlapping pieces are kept as they are (only faces where they touch are removed)".to_string()
                     });
                 }
             }

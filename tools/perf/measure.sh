@@ -59,3 +59,9 @@ for jobs in 1 2; do
     rate=$(awk -v w="$w" 'BEGIN { printf "%.0f lots/s, %.0f shapes/s", 900 / w, 3802500 / w }')
     echo "City of 900 lots (examples/building.cga, grid:30x30), --jobs $jobs: wall $w s ($rate), CPU $c s, peak $((m / 1024)) MiB"
 done
+
+# The city of 10,000 lots, once (about a minute; the GLB is 1.4 GB).
+/usr/bin/time -o "$out/time" -f "%e %U %S %M" "$cga" generate examples/building.cga \
+    --lot grid:100x100 --jobs 2 -o "$out/city.glb" --stats 2>&1 | grep '^stats' || true
+read -r w u s m <"$out/time"
+echo "City of 10,000 lots (grid:100x100), --jobs 2: wall $w s, CPU $(awk -v a="$u" -v b="$s" 'BEGIN { print a + b }') s, peak $((m / 1024)) MiB"

@@ -256,6 +256,44 @@ fn geometry_explosions_stop_at_the_face_limit() {
     assert!(err.contains("f.cga:1:9"), "{err}");
 }
 
+/// An error in one lot does not stop the city: the lot is named with the
+/// error's place, the other lots are generated and written, a summary
+/// closes the run, and the exit status is 1.
+#[test]
+fn an_error_in_one_lot_does_not_stop_the_others() {
+    let dir = temp_dir("perlot");
+    let rules = rule_file(
+        &dir,
+        "p.cga",
+        "Lot --> case scope.sx > 15 : A(1) else : extrude(3) X.\nA(n) --> print(n) B(n - \"x\")\nB(m) --> X.\n",
+    );
+    let obj = dir.join("city.obj");
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--lot",
+        "rect:20,30",
+        "--lot",
+        "rect:10,10",
+        "--lot",
+        "rect:5,5",
+        "-o",
+        obj.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert!(err.contains("p.cga:2:21"), "{err}");
+    assert!(err.contains("in lot `rect 20x30`"), "{err}");
+    assert!(
+        err.contains("1 of 3 lots stopped on an error; the others were generated"),
+        "{err}"
+    );
+    // The two boxes of the other lots: 6 quads each.
+    let text = std::fs::read_to_string(&obj).unwrap();
+    assert_eq!(text.lines().filter(|l| l.starts_with("f ")).count(), 12);
+    assert_eq!(stdout(&out), "1\n");
+}
+
 #[test]
 fn reports_are_aggregated_per_key() {
     let dir = temp_dir("report");

@@ -19,6 +19,14 @@ use std::sync::mpsc;
 use clap::{Args, Parser, Subcommand};
 
 use cga_engine::context::{LotContext, SceneContext};
+/// Shapes are many small allocations, and leaves made on the deriving
+/// threads are freed on the writing one: mimalloc's thread-local heaps do
+/// both with fewer instructions than the system allocator (Candler: 227 M
+/// to 202 M instructions for the derivation) at the price of more memory
+/// held (a 10,000-lot city: 2.1 GB peak instead of 1.3 GB).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 use cga_engine::derive::Leaf;
 use cga_engine::generate::collect_lot;
 use cga_engine::generate::generate_lot_streaming;

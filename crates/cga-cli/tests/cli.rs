@@ -294,6 +294,36 @@ fn an_error_in_one_lot_does_not_stop_the_others() {
     assert_eq!(stdout(&out), "1\n");
 }
 
+/// Found by fuzzing: `extrude(888884) split(y) { 2 : X. }*` asks for
+/// 444,442 slabs; with a small shape limit it stops before cutting them.
+/// A split beyond a million parts is refused whatever the limits.
+#[test]
+fn huge_splits_stop_before_cutting() {
+    let dir = temp_dir("slabs");
+    let rules = rule_file(
+        &dir,
+        "s.cga",
+        "Lot --> extrude(888884) split(y) { 2 : X. }*\n",
+    );
+    let out = run(&["generate", rules.to_str().unwrap(), "--max-shapes", "2000"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert!(err.contains("shape limit (2000)"), "{err}");
+    assert!(err.contains("s.cga:1:25"), "{err}");
+    let rules = rule_file(
+        &dir,
+        "b.cga",
+        "Lot --> extrude(1e12) split(y) { 1 : X. }*\n",
+    );
+    let out = run(&["generate", rules.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert!(
+        err.contains("split would create 1000000001000 parts, more than the limit of 1048576"),
+        "{err}"
+    );
+}
+
 #[test]
 fn reports_are_aggregated_per_key() {
     let dir = temp_dir("report");

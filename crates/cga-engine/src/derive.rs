@@ -703,6 +703,22 @@ impl<'a> Interp<'a> {
         c
     }
 
+    /// Fails with the shape limit's error if `n` more shapes would exceed
+    /// it: an operation about to create that many parts (a split into
+    /// hundreds of thousands of slabs) stops before doing the work.
+    pub fn check_shape_budget(&self, n: usize, span: Span) -> Result<(), RtError> {
+        if self.out.shapes.saturating_add(n) > self.limits.max_shapes {
+            return Err(RtError::new(
+                format!(
+                    "shape limit ({}) reached for one initial shape: the rules create shapes without end (raise the limit with --max-shapes)",
+                    self.limits.max_shapes
+                ),
+                span,
+            ));
+        }
+        Ok(())
+    }
+
     pub fn count_shape(&mut self, span: Span) -> Result<(), RtError> {
         self.out.shapes += 1;
         if self.out.shapes > self.limits.max_shapes {

@@ -301,10 +301,15 @@ mod tests {
             let outer: Vec<u32> = (0..n as u32).collect();
             let mut hole_idx = Vec::new();
             if let Some(h) = hole {
+                // Every edge of the outline is at least min(r) cos(pi/n)
+                // from the centre: a hole within 0.9 of that stays inside
+                // (a fixed 0.3 would cross a triangle of radius 0.5).
+                let min_r = radii.iter().copied().fold(f64::INFINITY, f64::min);
+                let hr = 0.9 * min_r * (std::f64::consts::PI / n as f64).cos();
                 for i in 0..h {
                     let a = -std::f64::consts::TAU * i as f64 / h as f64;
                     hole_idx.push(m.positions.len() as u32);
-                    m.positions.push(frame(0.3 * a.cos(), -0.3 * a.sin()));
+                    m.positions.push(frame(hr * a.cos(), -hr * a.sin()));
                 }
             }
             if hole_idx.is_empty() {

@@ -930,7 +930,7 @@ fn perimeter_parts<'b>(
                 perimeter_parts(cx, frame, shape, g, pattern, parts)?;
                 pattern
                     .close(g.repeat)
-                    .map_err(|e| RtError::new(format!("splitAndSetbackPerimeter: {e:?}"), g.span))?;
+                    .map_err(|e| RtError::new(format!("splitAndSetbackPerimeter: {e}"), g.span))?;
             }
             RPart::Unlabeled { span, .. } => {
                 return Err(RtError::new(
@@ -1021,7 +1021,7 @@ fn perimeter(
     perimeter_parts(cx, frame, &st.shape, block, &mut pattern, &mut parts)?;
     let placed: Vec<Placed> = if total > 0.0 {
         crate::split_layout::layout(&pattern, total)
-            .map_err(|e| RtError::new(format!("splitAndSetbackPerimeter: {e:?}"), call.span))?
+            .map_err(|e| RtError::new(format!("splitAndSetbackPerimeter: {e}"), call.span))?
             .into_iter()
             .filter(|p| p.size >= super::split::MIN_PART_SIZE)
             .collect()

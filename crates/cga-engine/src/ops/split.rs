@@ -56,7 +56,7 @@ pub fn exec(
     add_parts(cx, frame, &st.shape, block, &mut pattern, &mut bodies)?;
     let size = st.shape.scope.size[axis];
     let placed: Vec<Placed> = crate::split_layout::layout(&pattern, size.abs())
-        .map_err(|e| RtError::new(format!("split: {e:?}"), call.span))?
+        .map_err(|e| RtError::new(format!("split: {e}"), call.span))?
         .into_iter()
         .filter(|p| p.end - p.start >= MIN_PART_SIZE)
         .collect();
@@ -64,6 +64,7 @@ pub fn exec(
     if placed.is_empty() {
         return Ok(());
     }
+    cx.check_shape_budget(placed.len(), call.span)?;
 
     let sign = if size < 0.0 { -1.0 } else { 1.0 };
     let pieces = cut_parts(st.shape.geometry.local(), axis, sign, &placed);
@@ -114,7 +115,7 @@ pub(crate) fn add_parts<'b>(
                 add_parts(cx, frame, shape, g, pattern, bodies)?;
                 pattern
                     .close(g.repeat)
-                    .map_err(|e| RtError::new(format!("split: {e:?}"), g.span))?;
+                    .map_err(|e| RtError::new(format!("split: {e}"), g.span))?;
             }
             RPart::Unlabeled { span, .. } => {
                 return Err(RtError::new(
@@ -258,7 +259,7 @@ fn uv_split(
     let mut bodies: Vec<&RBody> = Vec::new();
     add_parts(cx, frame, &st.shape, block, &mut pattern, &mut bodies)?;
     let placed: Vec<Placed> = crate::split_layout::layout(&pattern, (end - start) * scale)
-        .map_err(|e| RtError::new(format!("split: {e:?}"), call.span))?
+        .map_err(|e| RtError::new(format!("split: {e}"), call.span))?
         .into_iter()
         .filter(|p| p.end - p.start >= MIN_PART_SIZE)
         .collect();
@@ -266,6 +267,7 @@ fn uv_split(
     if placed.is_empty() {
         return Ok(());
     }
+    cx.check_shape_budget(placed.len(), call.span)?;
 
     let coord = |d: f64| start + d / scale;
     let mut cuts: Vec<f64> = placed

@@ -324,6 +324,24 @@ fn huge_splits_stop_before_cutting() {
     );
 }
 
+/// Found by fuzzing: a shape attribute name with a two-byte letter where
+/// a component is expected (`scope.ь`) was cut inside the letter (a
+/// panic). It is an ordinary error now.
+#[test]
+fn non_ascii_attribute_names_are_errors_not_crashes() {
+    let dir = temp_dir("non-ascii");
+    let rules = rule_file(
+        &dir,
+        "n.cga",
+        "Lot --> print(scope.\u{44c}) print(assetInfo(\"a.obj\", \"\u{44c}x\"))\n",
+    );
+    let out = run(&["check", rules.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert!(err.contains("n.cga:1:15"), "{err}");
+    assert!(!err.contains("internal error"), "{err}");
+}
+
 #[test]
 fn reports_are_aggregated_per_key() {
     let dir = temp_dir("report");

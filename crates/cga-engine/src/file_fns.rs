@@ -180,7 +180,12 @@ impl Interp<'_> {
                     "y" => 1,
                     _ => 2,
                 };
-                match which.split_at(1) {
+                let split = if which.is_char_boundary(1) {
+                    which.split_at(1)
+                } else {
+                    ("", which)
+                };
+                match split {
                     ("s", c) => Value::Float((hi - lo)[k(c)]),
                     ("t", c) => Value::Float(lo[k(c)]),
                     _ => {

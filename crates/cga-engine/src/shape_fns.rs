@@ -112,7 +112,9 @@ pub fn lookup(name: &str, arity: usize) -> Option<ShapeFn> {
     // `t`, `r`, `s` (scope) or `p`, `o` (pivot, origin) and an axis: the
     // index of the component in that attribute's vector list.
     let component = |rest: &str, kinds: &[&str]| -> Option<u8> {
-        if !zero || rest.len() != 2 {
+        // Two ASCII letters: a name such as `scope.ь` (two bytes, one
+        // letter) is no component and must not be cut inside a letter.
+        if !zero || rest.len() != 2 || !rest.is_ascii() {
             return None;
         }
         let (kind, ax) = rest.split_at(1);

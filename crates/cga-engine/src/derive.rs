@@ -623,16 +623,8 @@ impl<'a> Interp<'a> {
         // Few shapes can still take long (each rule multiplying the
         // geometry): the clock is also read every 64 rule applications.
         self.rules_applied += 1;
-        if self.rules_applied.is_multiple_of(64)
-            && self.started.elapsed().as_secs_f64() > self.limits.max_seconds
-        {
-            return Err(RtError::new(
-                format!(
-                    "time limit ({} s) reached for one initial shape (raise the limit with --max-seconds)",
-                    self.limits.max_seconds
-                ),
-                call_span,
-            ));
+        if self.rules_applied.is_multiple_of(64) {
+            self.check_time(call_span)?;
         }
         let outer_generation = std::mem::replace(&mut self.generation, generation);
         let outer_key = key.map(|k| {
@@ -719,21 +711,10 @@ impl<'a> Interp<'a> {
         Ok(())
     }
 
-    pub fn count_shape(&mut self, span: Span) -> Result<(), RtError> {
-        self.out.shapes += 1;
-        if self.out.shapes > self.limits.max_shapes {
-            return Err(RtError::new(
-                format!(
-                    "shape limit ({}) reached for one initial shape: the rules create shapes without end (raise the limit with --max-shapes)",
-                    self.limits.max_shapes
-                ),
-                span,
-            ));
-        }
-        // The clock is read every 1024 shapes: cheap, and soon enough.
-        if self.out.shapes.is_multiple_of(1024)
-            && self.started.elapsed().as_secs_f64() > self.limits.max_seconds
-        {
+    /// Fails with the time limit's error once the initial shape has taken
+    /// longer than allowed.
+    fn check_time(&self, span: Span) -> Result<(), RtError> {
+        if self.started.elapsed().as_secs_f64() > self.limits.max_seconds {
             return Err(RtError::new(
                 format!(
                     "time limit ({} s) reached for one initial shape (raise the limit with --max-seconds)",
@@ -741,6 +722,16 @@ impl<'a> Interp<'a> {
                 ),
                 span,
             ));
+        }
+        Ok(())
+    }
+
+    pub fn count_shape(&mut self, span: Span) -> Result<(), RtError> {
+        self.out.shapes += 1;
+        self.check_shape_budget(0, span)?;
+        // The clock is read every 1024 shapes: cheap, and soon enough.
+        if self.out.shapes.is_multiple_of(1024) {
+            self.check_time(span)?;
         }
         Ok(())
     }

@@ -8,21 +8,6 @@ use cga_engine::lot::Lot;
 use cga_geometry::{measure, DVec3, Mesh};
 use ops_common::*;
 
-fn pts(p: &[(f64, f64)]) -> Vec<DVec3> {
-    p.iter().map(|&(x, z)| DVec3::new(x, 0.0, z)).collect()
-}
-
-fn l_lot() -> Vec<DVec3> {
-    pts(&[
-        (0.0, 0.0),
-        (12.0, 0.0),
-        (12.0, -5.0),
-        (5.0, -5.0),
-        (5.0, -12.0),
-        (0.0, -12.0),
-    ])
-}
-
 /// The test assets of these operations (absolute, for `i()`).
 fn asset(name: &str) -> String {
     format!("{}/tests/rules/roofs/{name}", env!("CARGO_MANIFEST_DIR"))

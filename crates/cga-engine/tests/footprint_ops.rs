@@ -7,23 +7,8 @@
 mod ops_common;
 
 use cga_engine::lot::Lot;
-use cga_geometry::{measure, DVec3, Mesh};
+use cga_geometry::{measure, Mesh};
 use ops_common::*;
-
-fn pts(p: &[(f64, f64)]) -> Vec<DVec3> {
-    p.iter().map(|&(x, z)| DVec3::new(x, 0.0, z)).collect()
-}
-
-fn l_lot() -> Vec<DVec3> {
-    pts(&[
-        (0.0, 0.0),
-        (12.0, 0.0),
-        (12.0, -5.0),
-        (5.0, -5.0),
-        (5.0, -12.0),
-        (0.0, -12.0),
-    ])
-}
 
 /// The areas printed as `label area` lines, in order.
 fn areas(g: &Gen, label: &str) -> Vec<f64> {

@@ -9,22 +9,6 @@ use cga_geometry::roof::{roof, RoofEdgeKind, RoofKind, RoofSlope};
 use cga_geometry::{measure, DVec3, Mesh};
 use ops_common::*;
 
-/// The L-shaped lot of the examples: a 12 x 5 wing along x and a 5 x 12
-/// wing along z, counter-clockwise seen from above, first edge the front.
-fn l_lot() -> Vec<DVec3> {
-    [
-        (0.0, 0.0),
-        (12.0, 0.0),
-        (12.0, -5.0),
-        (5.0, -5.0),
-        (5.0, -12.0),
-        (0.0, -12.0),
-    ]
-    .iter()
-    .map(|&(x, z)| DVec3::new(x, 0.0, z))
-    .collect()
-}
-
 /// A U: two 5 m wide wings joined by a 15 x 5 front.
 fn u_lot() -> Vec<DVec3> {
     [

@@ -34,11 +34,11 @@ use cga_value::Value;
 use super::comp::FaceEdgeSelection;
 use super::transform::selector;
 use super::Op;
-use crate::derive::{Arg, Interp, RtError, ShapeState, SizeKind};
+use crate::derive::{Arg, Interp, RtError, ShapeState};
 use crate::expr::{OpCall, RBlock, RBody, RExpr, RExprKind, RPart};
 use crate::selectors::{quadrant_of, Frames, Quadrant};
 use crate::shape::Shape;
-use crate::split_layout::{Placed, Size, SplitPattern};
+use crate::split_layout::{Placed, SplitPattern};
 use cga_geometry::perimeter;
 
 pub fn exec(
@@ -901,48 +901,6 @@ fn footprint(st: &mut ShapeState) -> Result<(), RtError> {
 
 // ----- splitAndSetbackPerimeter -----
 
-/// Evaluates the sizes of a perimeter block into `pattern` (as `split`
-/// does); `parts[k]` is entry `k`'s depth expression and operations.
-fn perimeter_parts<'b>(
-    cx: &mut Interp,
-    frame: &[Value],
-    shape: &Shape,
-    block: &'b RBlock<RBody>,
-    pattern: &mut SplitPattern,
-    parts: &mut Vec<(Option<&'b RExpr>, &'b RBody)>,
-) -> Result<(), RtError> {
-    for part in &block.parts {
-        match part {
-            RPart::Entry {
-                head, depth, body, ..
-            } => {
-                let arg = cx.eval_arg(head, frame, shape)?;
-                let x = arg.num()?;
-                pattern.push(match arg.kind {
-                    SizeKind::Absolute => Size::Absolute(x),
-                    SizeKind::Relative => Size::Relative(x),
-                    SizeKind::Floating => Size::Floating(x),
-                });
-                parts.push((depth.as_ref(), body));
-            }
-            RPart::Group(g) => {
-                pattern.open();
-                perimeter_parts(cx, frame, shape, g, pattern, parts)?;
-                pattern
-                    .close(g.repeat)
-                    .map_err(|e| RtError::new(format!("splitAndSetbackPerimeter: {e}"), g.span))?;
-            }
-            RPart::Unlabeled { span, .. } => {
-                return Err(RtError::new(
-                    "a splitAndSetbackPerimeter part needs a length and a depth: `length : depth : operations`",
-                    *span,
-                ))
-            }
-        }
-    }
-    Ok(())
-}
-
 /// `splitAndSetbackPerimeter(offset [, firstEdgeIndex, selectedEdgesMask])
 /// { length : depth : operations | ... } { remainder : operations }`: the
 /// chain of selected face edges (from `firstEdgeIndex`, in face-edge order,
@@ -1018,7 +976,12 @@ fn perimeter(
     let offset = args[0].size(total)?;
     let mut pattern = SplitPattern::new(block.repeat);
     let mut parts = Vec::new();
-    perimeter_parts(cx, frame, &st.shape, block, &mut pattern, &mut parts)?;
+    let kind = super::split::PartsOf {
+        op: "splitAndSetbackPerimeter",
+        unlabeled: "a splitAndSetbackPerimeter part needs a length and a depth: `length : depth : operations`",
+        part: |depth, body| (depth, body),
+    };
+    super::split::collect_parts(cx, frame, &st.shape, block, &mut pattern, &mut parts, &kind)?;
     let placed: Vec<Placed> = if total > 0.0 {
         crate::split_layout::layout(&pattern, total)
             .map_err(|e| RtError::new(format!("splitAndSetbackPerimeter: {e}"), call.span))?

@@ -18,7 +18,7 @@ use cga_value::Value;
 
 use super::transform::selector;
 use crate::derive::{Arg, Interp, RtError, ShapeState, SizeKind};
-use crate::expr::{OpCall, RBlock, RBody, RPart};
+use crate::expr::{OpCall, RBlock, RBody, RExpr, RPart};
 use crate::shape::{Geometry, Shape};
 use crate::split_layout::{Placed, Size, SplitPattern};
 
@@ -98,9 +98,41 @@ pub(crate) fn add_parts<'b>(
     pattern: &mut SplitPattern,
     bodies: &mut Vec<&'b RBody>,
 ) -> Result<(), RtError> {
-    for part in &block.parts {
-        match part {
-            RPart::Entry { head, body, .. } => {
+    let kind = PartsOf {
+        op: "split",
+        unlabeled: "a split part needs a size: `size : operations`",
+        part: |_, body| body,
+    };
+    collect_parts(cx, frame, shape, block, pattern, bodies, &kind)
+}
+
+/// How [`collect_parts`] reads a block: the operation (for its errors) and
+/// what it keeps of each entry, `part(depth, body)`.
+pub(crate) struct PartsOf<F> {
+    pub op: &'static str,
+    /// The error for a part without a size.
+    pub unlabeled: &'static str,
+    pub part: F,
+}
+
+/// Evaluates the sizes of a split-like block (its groups and repeats
+/// included) into `pattern`, in source order, and collects what `kind`
+/// keeps of each entry: `split`, `splitArea` and `splitAndSetbackPerimeter`
+/// read their blocks alike.
+pub(crate) fn collect_parts<'b, T, F: Fn(Option<&'b RExpr>, &'b RBody) -> T>(
+    cx: &mut Interp,
+    frame: &[Value],
+    shape: &Shape,
+    block: &'b RBlock<RBody>,
+    pattern: &mut SplitPattern,
+    parts: &mut Vec<T>,
+    kind: &PartsOf<F>,
+) -> Result<(), RtError> {
+    for p in &block.parts {
+        match p {
+            RPart::Entry {
+                head, depth, body, ..
+            } => {
                 let arg = cx.eval_arg(head, frame, shape)?;
                 let x = arg.num()?;
                 pattern.push(match arg.kind {
@@ -108,21 +140,16 @@ pub(crate) fn add_parts<'b>(
                     SizeKind::Relative => Size::Relative(x),
                     SizeKind::Floating => Size::Floating(x),
                 });
-                bodies.push(body);
+                parts.push((kind.part)(depth.as_ref(), body));
             }
             RPart::Group(g) => {
                 pattern.open();
-                add_parts(cx, frame, shape, g, pattern, bodies)?;
+                collect_parts(cx, frame, shape, g, pattern, parts, kind)?;
                 pattern
                     .close(g.repeat)
-                    .map_err(|e| RtError::new(format!("split: {e}"), g.span))?;
+                    .map_err(|e| RtError::new(format!("{}: {e}", kind.op), g.span))?;
             }
-            RPart::Unlabeled { span, .. } => {
-                return Err(RtError::new(
-                    "a split part needs a size: `size : operations`",
-                    *span,
-                ))
-            }
+            RPart::Unlabeled { span, .. } => return Err(RtError::new(kind.unlabeled, *span)),
         }
     }
     Ok(())

@@ -386,3 +386,22 @@ pub fn mat_mul(m: &[[f64; 3]; 3], v: DVec3) -> DVec3 {
 pub fn rgb255(m: &Material) -> [u8; 3] {
     m.color.map(|c| (c * 255.0).round() as u8)
 }
+
+/// Points `(x, z)` of a lot in the ground plane.
+pub fn pts(p: &[(f64, f64)]) -> Vec<DVec3> {
+    p.iter().map(|&(x, z)| DVec3::new(x, 0.0, z)).collect()
+}
+
+/// The L-shaped lot of the reference examples: a 12 x 5 wing along x and a
+/// 5 x 12 wing along z, counter-clockwise seen from above, first edge the
+/// front.
+pub fn l_lot() -> Vec<DVec3> {
+    pts(&[
+        (0.0, 0.0),
+        (12.0, 0.0),
+        (12.0, -5.0),
+        (5.0, -5.0),
+        (5.0, -12.0),
+        (0.0, -12.0),
+    ])
+}

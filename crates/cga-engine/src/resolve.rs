@@ -739,17 +739,19 @@ impl Resolver<'_> {
                 candidates.extend(ops::ALL_OPERATIONS);
             }
         }
+        let len = name.chars().count();
+        let allowed = match len {
+            0..=3 => 1,
+            4..=6 => 2,
+            _ => 3,
+        };
         candidates
             .into_iter()
+            // The edit distance is at least the difference in length: skip the
+            // candidates that cannot be close before computing it.
+            .filter(|c| c.chars().count().abs_diff(len) <= allowed)
             .map(|c| (strsim::damerau_levenshtein(name, c), c))
-            .filter(|&(d, c)| {
-                let allowed = match name.chars().count() {
-                    0..=3 => 1,
-                    4..=6 => 2,
-                    _ => 3,
-                };
-                d <= allowed && d < c.len()
-            })
+            .filter(|&(d, c)| d <= allowed && d < c.len())
             .min()
             .map(|(_, c)| c.to_string())
     }

@@ -1151,6 +1151,25 @@ fn scatter_counts_and_errors() {
     }
 }
 
+/// More points than the shape limit allows (5 million by default) stop at
+/// the limit. 10^25 was found by fuzzing: it used to abort while making
+/// room for the points.
+#[test]
+fn scatter_beyond_the_shape_limit_is_an_error() {
+    for n in ["9644444444444444444444444", "6000000"] {
+        let src = format!("Init --> scatter(surface, {n}, uniform) {{ X. }}\n");
+        let g = gen_with(&src, &Opts::rect(2.0, 2.0).start("Init"));
+        assert!(
+            g.errors
+                .first()
+                .is_some_and(|e| e.message.contains("shape limit")),
+            "{n}: {:?}",
+            g.errors.iter().map(|e| &e.message).collect::<Vec<_>>()
+        );
+        assert_eq!(g.meshes().len(), 0);
+    }
+}
+
 // ---------------------------------------------------------------------------
 // alignScopeToGeometryBBox
 // ---------------------------------------------------------------------------

@@ -160,6 +160,9 @@ pub fn exec(
     if n == 0 {
         return Ok(());
     }
+    // Every point is a shape: more than the limit allows fails here, before
+    // room for them is made.
+    cx.check_shape_budget(n, call.span)?;
     let mesh = st.shape.geometry.local().clone();
     if domain == Domain::Volume && (mesh.faces.is_empty() || !is_closed(&mesh)) {
         domain = Domain::Surface;

@@ -32,6 +32,9 @@ pub struct Assets {
     found: Requests<Option<PathBuf>>,
     mesh_requests: Requests<Result<Arc<Mesh>, String>>,
     texture_files: Requests<Option<Arc<str>>>,
+    /// Whether a texture file has an alpha channel, by file: reading the
+    /// image's header once for all lots (a city reads it once, not per lot).
+    alpha: Mutex<FxHashMap<Arc<str>, bool>>,
 }
 
 /// A cache by rule file and path as written.
@@ -76,6 +79,7 @@ impl Assets {
             found: Default::default(),
             mesh_requests: Default::default(),
             texture_files: Default::default(),
+            alpha: Default::default(),
         }
     }
 
@@ -89,6 +93,7 @@ impl Assets {
             found: Default::default(),
             mesh_requests: Default::default(),
             texture_files: Default::default(),
+            alpha: Default::default(),
         }
     }
 
@@ -200,6 +205,19 @@ fn load_obj(path: &std::path::Path) -> Result<Mesh, String> {
 }
 
 impl Assets {
+    /// Whether the texture `file` (as [`Assets::texture_file`] found it) has
+    /// an alpha channel, asking `read` the first time for each file.
+    pub fn texture_alpha(&self, file: &Arc<str>, read: impl FnOnce(&str) -> bool) -> bool {
+        let lock = || self.alpha.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(&a) = lock().get(file) {
+            return a;
+        }
+        // Not under the lock: reading may take a while.
+        let a = read(file);
+        lock().insert(file.clone(), a);
+        a
+    }
+
     /// The text of a file found like an asset (`readTextFile`, tables),
     /// with line endings normalised; cached.
     pub fn text(&self, from: FileId, path: &str) -> Option<Arc<str>> {

@@ -531,7 +531,7 @@ impl TextureFiles {
         if let Some(&a) = self.alpha.get(&file) {
             return a;
         }
-        let a = image_has_alpha(std::path::Path::new(&*file));
+        let a = assets.texture_alpha(&file, |f| image_has_alpha(std::path::Path::new(f)));
         self.alpha.insert(file, a);
         a
     }

@@ -1,15 +1,27 @@
 //! GLB and glTF (+ `.bin`) output.
 //!
-//! One glTF mesh with one triangle primitive per material, each referenced by
-//! its own node of the default scene. Per material the writer keeps the
-//! vertex attributes as `f32` (that is the output itself: nothing of the
-//! input meshes is kept) and writes the JSON and the binary data at the end,
-//! when every accessor's size is known.
+//! One glTF mesh per material, each referenced by its own node of the
+//! default scene. Per material the writer keeps the vertex attributes as
+//! `f32` (that is the output itself: nothing of the input meshes is kept)
+//! and writes the JSON at the end, when every accessor's size is known.
 //!
-//! Binary layout: for each material in order of first appearance, positions,
-//! normals, texture coordinates (when present: one array per distinct UV set
-//! its textures read), tangents (normal-mapped materials) and `u32` indices,
-//! each in its own buffer view; then the embedded images (GLB only).
+//! Memory stays bounded for large models: once the vertex data held
+//! exceeds [`ExportOptions::flush_mib`](crate::ExportOptions), every
+//! material's data so far is written out as a primitive of its own and the
+//! arrays start again empty (between two input meshes). A material's mesh
+//! then has several primitives. The `.bin` of glTF is written as it comes;
+//! GLB, whose JSON chunk comes first, leaves room for it at the start of
+//! the file and fills the room with the JSON and spaces at the end (moving
+//! the binary data up if the JSON does not fit). A model that fits in
+//! memory is written at the end, in one primitive per material.
+//!
+//! Binary layout: for each primitive in the order written (those written
+//! early first, then one per material in order of first appearance),
+//! positions, normals, texture coordinates (when present: one array per
+//! distinct UV set its textures read; per UV set once anything was written
+//! early, so that all primitives of a material read the same sets),
+//! tangents (normal-mapped materials) and `u32` indices, each in its own
+//! buffer view; then the embedded images (GLB only).
 //!
 //! Textures: the colour map is the base colour texture (with the alpha when
 //! the opacity map is the same image), the normal, emissive and occlusion
@@ -21,7 +33,7 @@
 
 use std::collections::HashMap;
 use std::fs::File;
-use std::io::{BufWriter, Read, Write};
+use std::io::{BufWriter, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
 use std::sync::Arc;
@@ -62,6 +74,30 @@ struct Bucket {
     min: [f32; 3],
     max: [f32; 3],
 }
+
+/// The sizes (in bytes) of a primitive's arrays, in the order of the binary
+/// layout, with its material and bounds: what its accessors need.
+struct PrimitiveLayout {
+    material: u32,
+    vertices: u64,
+    positions: usize,
+    normals: usize,
+    coords: Vec<usize>,
+    tangents: Option<usize>,
+    indices: usize,
+    min: [f32; 3],
+    max: [f32; 3],
+}
+
+/// Vertex data held before it is written out, by default (see the module
+/// docs).
+pub const DEFAULT_FLUSH_MIB: usize = 64;
+
+/// GLB: bytes left at the start of the file for the header and the JSON
+/// when data is written before the end (most models' JSON needs a few
+/// kilobytes; one with thousands of materials may need more, and then the
+/// binary data is moved up).
+const GLB_JSON_ROOM: u64 = 1 << 20;
 
 /// Appends the little-endian bytes of `x`.
 #[inline(always)]
@@ -124,6 +160,63 @@ impl Bucket {
             max: [f32::NEG_INFINITY; 3],
             ..Bucket::default()
         }
+    }
+
+    /// Bytes of vertex data held.
+    fn bytes(&self) -> usize {
+        self.positions.len()
+            + self.normals.len()
+            + self.coords.iter().map(Vec::len).sum::<usize>()
+            + self.tangents.as_ref().map_or(0, Vec::len)
+            + self.indices.len()
+    }
+
+    /// Each UV set in an array of its own (no merging), as once anything
+    /// was written early.
+    fn unmerged_coords(&mut self) {
+        self.tex_coords = (0..self.coords.len() as u32).collect();
+    }
+
+    /// What the accessors of this bucket's data as a primitive need.
+    fn primitive(&self, material: u32) -> PrimitiveLayout {
+        PrimitiveLayout {
+            material,
+            vertices: self.vertices as u64,
+            positions: self.positions.len(),
+            normals: self.normals.len(),
+            coords: self.coords.iter().map(Vec::len).collect(),
+            tangents: self.tangents.as_ref().map(Vec::len),
+            indices: self.indices.len(),
+            min: self.min,
+            max: self.max,
+        }
+    }
+
+    /// The arrays in the order of the binary layout.
+    fn write_arrays(&self, w: &mut impl Write) -> std::io::Result<()> {
+        w.write_all(&self.positions)?;
+        w.write_all(&self.normals)?;
+        for coords in &self.coords {
+            w.write_all(coords)?;
+        }
+        if let Some(tangents) = &self.tangents {
+            w.write_all(tangents)?;
+        }
+        w.write_all(&self.indices)
+    }
+
+    /// Empties the arrays (keeping their room), as for a new primitive.
+    fn clear(&mut self) {
+        self.vertices = 0;
+        self.positions.clear();
+        self.normals.clear();
+        self.coords.iter_mut().for_each(Vec::clear);
+        if let Some(t) = &mut self.tangents {
+            t.clear();
+        }
+        self.indices.clear();
+        self.min = [f32::INFINITY; 3];
+        self.max = [f32::NEG_INFINITY; 3];
     }
 
     /// Room for `n` more vertices.
@@ -306,6 +399,15 @@ pub(crate) struct GltfWriter {
     /// instead of hashing every corner.
     first_shared: Vec<u32>,
     shared: Vec<SharedVertex>,
+    /// Vertex data held by all buckets, in bytes, and how much may be held
+    /// before it is written out.
+    held: usize,
+    flush_bytes: usize,
+    /// Primitives already written, in the order written, and their bytes.
+    written: Vec<PrimitiveLayout>,
+    written_bytes: u64,
+    /// glTF: the `.bin` file, once data is written before the end.
+    bin_out: Option<BufWriter<File>>,
 }
 
 impl GltfWriter {
@@ -314,8 +416,17 @@ impl GltfWriter {
         binary: bool,
         embed_images: bool,
         asset_extras: Option<serde_json::Value>,
+        flush_mib: usize,
     ) -> Result<GltfWriter, ExportError> {
-        let file = File::create(path).map_err(|e| ExportError::io(path, e))?;
+        // Readable too: a GLB's binary data may have to be moved up (see
+        // `finish_early_glb`).
+        let file = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(true)
+            .open(path)
+            .map_err(|e| ExportError::io(path, e))?;
         let stem = path
             .file_stem()
             .map_or("model".into(), |s| s.to_string_lossy());
@@ -333,6 +444,11 @@ impl GltfWriter {
             corner_vertex: Vec::new(),
             first_shared: Vec::new(),
             shared: Vec::new(),
+            held: 0,
+            flush_bytes: flush_mib.saturating_mul(1 << 20),
+            written: Vec::new(),
+            written_bytes: 0,
+            bin_out: None,
         })
     }
 
@@ -432,7 +548,49 @@ impl GltfWriter {
         self.alpha_maps.push(alpha);
     }
 
-    pub(crate) fn begin_mesh(&mut self, mesh: &Mesh) {
+    /// Starts a new input mesh; writes out the data held if it is more
+    /// than allowed (between meshes, as vertex sharing is per mesh).
+    pub(crate) fn begin_mesh(&mut self, mesh: &Mesh) -> Result<(), ExportError> {
+        if self.held > self.flush_bytes {
+            self.flush()?;
+        }
+        self.begin_mesh_data(mesh);
+        Ok(())
+    }
+
+    /// Writes every bucket's data as a primitive and empties the buckets.
+    fn flush(&mut self) -> Result<(), ExportError> {
+        let path = self.path.clone();
+        let io = |e| ExportError::io(&path, e);
+        let out: &mut BufWriter<File> = if self.binary {
+            if self.written_bytes == 0 {
+                self.out.seek(SeekFrom::Start(GLB_JSON_ROOM)).map_err(io)?;
+            }
+            &mut self.out
+        } else {
+            if self.bin_out.is_none() {
+                let bin_path = self.path.with_file_name(&self.bin_name);
+                let file = File::create(&bin_path).map_err(|e| ExportError::io(&bin_path, e))?;
+                self.bin_out = Some(BufWriter::with_capacity(1 << 16, file));
+            }
+            self.bin_out.as_mut().expect("created above")
+        };
+        for (id, b) in self.buckets.iter_mut().enumerate() {
+            if b.indices.is_empty() {
+                continue;
+            }
+            b.unmerged_coords();
+            b.write_arrays(out).map_err(io)?;
+            let p = b.primitive(id as u32);
+            self.written_bytes += b.bytes() as u64;
+            self.written.push(p);
+            b.clear();
+        }
+        self.held = 0;
+        Ok(())
+    }
+
+    fn begin_mesh_data(&mut self, mesh: &Mesh) {
         self.corner_vertex.clear();
         self.corner_vertex.resize(mesh.corners.len(), 0);
         self.first_shared.clear();
@@ -448,10 +606,12 @@ impl GltfWriter {
             corner_vertex,
             first_shared,
             shared: made,
+            held,
             ..
         } = self;
         let mesh = f.mesh;
         let bucket = &mut buckets[f.material as usize];
+        let before = bucket.bytes();
         let uvs = mesh.uvs[0].as_deref();
         if uvs.is_some() && bucket.sets.is_empty() {
             bucket.sets.push(0);
@@ -537,6 +697,7 @@ impl GltfWriter {
             bytes[8..].copy_from_slice(&c);
             bucket.indices.extend_from_slice(&bytes);
         }
+        *held += bucket.bytes() - before;
         Ok(())
     }
 
@@ -563,69 +724,38 @@ impl GltfWriter {
         let mut images: Vec<u32> = Vec::new();
         let mut nodes = Vec::new();
 
+        // Once anything was written early, every primitive of a material
+        // carries each of its UV sets (the material names the set to read).
+        let early = !self.written.is_empty();
         for b in &mut self.buckets {
-            b.merge_equal_coords();
+            if early {
+                b.unmerged_coords();
+            } else {
+                b.merge_equal_coords();
+            }
         }
-        for (id, bucket) in self.buckets.iter().enumerate() {
-            if bucket.indices.is_empty() {
+        let held: Vec<PrimitiveLayout> = self
+            .buckets
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| !b.indices.is_empty())
+            .map(|(id, b)| b.primitive(id as u32))
+            .collect();
+        // Accessors in the order of the binary data; primitives by material.
+        let mut primitives: Vec<Vec<json::mesh::Primitive>> = Vec::new();
+        primitives.resize_with(self.buckets.len(), Vec::new);
+        for p in self.written.iter().chain(&held) {
+            let prim = primitive_accessors(&mut root, &mut layout, p);
+            primitives[p.material as usize].push(prim);
+            stats.vertices += p.vertices;
+        }
+        for (id, prims) in primitives.into_iter().enumerate() {
+            if prims.is_empty() {
                 continue;
             }
+            let bucket = &self.buckets[id];
             let id = id as u32;
             let name = table.name(id).to_string();
-            let count = bucket.vertices as u64;
-            let mut attributes = std::collections::BTreeMap::new();
-            let positions = layout.accessor(
-                &mut root,
-                bucket.positions.len() / 4,
-                count,
-                json::accessor::Type::Vec3,
-                json::accessor::ComponentType::F32,
-                Some(json::buffer::Target::ArrayBuffer),
-            );
-            let accessor = &mut root.accessors[positions.value()];
-            accessor.min = Some(bucket.min.to_vec().into());
-            accessor.max = Some(bucket.max.to_vec().into());
-            attributes.insert(Valid(json::mesh::Semantic::Positions), positions);
-            let normals = layout.accessor(
-                &mut root,
-                bucket.normals.len() / 4,
-                count,
-                json::accessor::Type::Vec3,
-                json::accessor::ComponentType::F32,
-                Some(json::buffer::Target::ArrayBuffer),
-            );
-            attributes.insert(Valid(json::mesh::Semantic::Normals), normals);
-            for (n, coords) in bucket.coords.iter().enumerate() {
-                let tex = layout.accessor(
-                    &mut root,
-                    coords.len() / 4,
-                    count,
-                    json::accessor::Type::Vec2,
-                    json::accessor::ComponentType::F32,
-                    Some(json::buffer::Target::ArrayBuffer),
-                );
-                attributes.insert(Valid(json::mesh::Semantic::TexCoords(n as u32)), tex);
-            }
-            if let Some(tangents) = &bucket.tangents {
-                let acc = layout.accessor(
-                    &mut root,
-                    tangents.len() / 4,
-                    count,
-                    json::accessor::Type::Vec4,
-                    json::accessor::ComponentType::F32,
-                    Some(json::buffer::Target::ArrayBuffer),
-                );
-                attributes.insert(Valid(json::mesh::Semantic::Tangents), acc);
-            }
-            let indices = layout.accessor(
-                &mut root,
-                bucket.indices.len() / 4,
-                bucket.indices.len() as u64 / 4,
-                json::accessor::Type::Scalar,
-                json::accessor::ComponentType::U32,
-                Some(json::buffer::Target::ElementArrayBuffer),
-            );
-
             let material = table.get(id);
             let mut infos: Vec<(Slot, json::texture::Info)> = Vec::new();
             for m in &self.maps[id as usize] {
@@ -659,19 +789,18 @@ impl GltfWriter {
                 infos,
                 self.alpha_maps[id as usize],
             ));
+            let primitives = prims
+                .into_iter()
+                .map(|p| json::mesh::Primitive {
+                    material: Some(material),
+                    ..p
+                })
+                .collect();
             let mesh = root.push(json::Mesh {
                 extensions: None,
                 extras: Default::default(),
                 name: Some(name.clone()),
-                primitives: vec![json::mesh::Primitive {
-                    attributes,
-                    extensions: None,
-                    extras: Default::default(),
-                    indices: Some(indices),
-                    material: Some(material),
-                    mode: Valid(json::mesh::Mode::Triangles),
-                    targets: None,
-                }],
+                primitives,
                 weights: None,
             });
             nodes.push(root.push(json::Node {
@@ -679,7 +808,6 @@ impl GltfWriter {
                 name: Some(name),
                 ..Default::default()
             }));
-            stats.vertices += count;
             stats.materials += 1;
         }
         stats.textures = images.len() as u64;
@@ -732,8 +860,15 @@ impl GltfWriter {
                 .map_err(|e| ExportError::io(&self.path, e))?;
             if bin_len > 0 {
                 let bin_path = self.path.with_file_name(&self.bin_name);
-                let file = File::create(&bin_path).map_err(|e| ExportError::io(&bin_path, e))?;
-                let mut w = BufWriter::with_capacity(1 << 16, file);
+                // Appended to what was written early, if anything.
+                let mut w = match self.bin_out.take() {
+                    Some(w) => w,
+                    None => {
+                        let file =
+                            File::create(&bin_path).map_err(|e| ExportError::io(&bin_path, e))?;
+                        BufWriter::with_capacity(1 << 16, file)
+                    }
+                };
                 write_bin(&mut w, &self.buckets, &[], textures, &bin_path)?;
                 w.flush().map_err(|e| ExportError::io(&bin_path, e))?;
             }
@@ -758,25 +893,93 @@ impl GltfWriter {
         while json.len() % 4 != 0 {
             json.push(b' ');
         }
+        if self.written_bytes > 0 {
+            return self.finish_early_glb(json, bin_len, images, textures);
+        }
         let bin_chunk = if bin_len > 0 { 8 + bin_len } else { 0 };
-        let total = 12 + 8 + json.len() as u64 + bin_chunk;
-        let total = u32::try_from(total)
-            .map_err(|_| ExportError::TooLarge(format!("GLB of {total} bytes exceeds 4 GiB")))?;
+        let total = glb_length(12 + 8 + json.len() as u64 + bin_chunk)?;
         let out = &mut self.out;
-        out.write_all(b"glTF").map_err(io)?;
-        out.write_all(&2u32.to_le_bytes()).map_err(io)?;
-        out.write_all(&total.to_le_bytes()).map_err(io)?;
-        out.write_all(&(json.len() as u32).to_le_bytes())
-            .map_err(io)?;
-        out.write_all(b"JSON").map_err(io)?;
-        out.write_all(&json).map_err(io)?;
+        write_glb_head(out, total, &json, bin_len).map_err(io)?;
         if bin_len > 0 {
-            out.write_all(&(bin_len as u32).to_le_bytes()).map_err(io)?;
-            out.write_all(b"BIN\0").map_err(io)?;
             write_bin(out, &self.buckets, images, textures, &path)?;
         }
         out.flush().map_err(io)
     }
+
+    /// GLB whose binary data was partly written early, from `GLB_JSON_ROOM` on:
+    /// the rest of it follows, then the header and the JSON (padded with
+    /// spaces to the room, or, if it does not fit, with the binary data
+    /// moved up to make room) go before it.
+    fn finish_early_glb(
+        &mut self,
+        mut json: Vec<u8>,
+        bin_len: u64,
+        images: &[u32],
+        textures: &Textures,
+    ) -> Result<(), ExportError> {
+        let path = self.path.clone();
+        let io = |e| ExportError::io(&path, e);
+        write_bin(&mut self.out, &self.buckets, images, textures, &path)?;
+        self.out.flush().map_err(io)?;
+        // Header (12), JSON chunk header (8), JSON, BIN chunk header (8).
+        let head = 12 + 8 + json.len() as u64 + 8;
+        let start = if head <= GLB_JSON_ROOM {
+            GLB_JSON_ROOM
+        } else {
+            let file = self.out.get_mut();
+            move_up(file, GLB_JSON_ROOM, bin_len, head - GLB_JSON_ROOM).map_err(io)?;
+            head
+        };
+        json.resize((start - 28) as usize, b' ');
+        let total = glb_length(start + bin_len)?;
+        self.out.seek(SeekFrom::Start(0)).map_err(io)?;
+        write_glb_head(&mut self.out, total, &json, bin_len).map_err(io)?;
+        self.out.flush().map_err(io)
+    }
+}
+
+/// A GLB's total length, which the header holds as `u32`.
+fn glb_length(total: u64) -> Result<u32, ExportError> {
+    u32::try_from(total)
+        .map_err(|_| ExportError::TooLarge(format!("GLB of {total} bytes exceeds 4 GiB")))
+}
+
+/// The GLB header, the JSON chunk and the BIN chunk's header (if there is
+/// binary data).
+fn write_glb_head(
+    out: &mut impl Write,
+    total: u32,
+    json: &[u8],
+    bin_len: u64,
+) -> std::io::Result<()> {
+    out.write_all(b"glTF")?;
+    out.write_all(&2u32.to_le_bytes())?;
+    out.write_all(&total.to_le_bytes())?;
+    out.write_all(&(json.len() as u32).to_le_bytes())?;
+    out.write_all(b"JSON")?;
+    out.write_all(json)?;
+    if bin_len > 0 {
+        out.write_all(&(bin_len as u32).to_le_bytes())?;
+        out.write_all(b"BIN\0")?;
+    }
+    Ok(())
+}
+
+/// Moves the `len` bytes of `file` at `start` up by `by` bytes, from the
+/// end backwards so that nothing is overwritten before it is moved.
+fn move_up(file: &mut File, start: u64, len: u64, by: u64) -> std::io::Result<()> {
+    let mut buf = vec![0u8; 1 << 20];
+    let mut end = start + len;
+    while end > start {
+        let n = (end - start).min(buf.len() as u64);
+        let from = end - n;
+        file.seek(SeekFrom::Start(from))?;
+        file.read_exact(&mut buf[..n as usize])?;
+        file.seek(SeekFrom::Start(from + by))?;
+        file.write_all(&buf[..n as usize])?;
+        end = from;
+    }
+    Ok(())
 }
 
 /// Appends one vertex per corner of face `f` (`corners`, in order) to
@@ -890,6 +1093,79 @@ impl Layout {
             normalized: false,
             sparse: None,
         })
+    }
+}
+
+/// The accessors (and buffer views) of a primitive's arrays, laid out next
+/// in the binary buffer, and the primitive reading them (its material is
+/// set by the caller).
+fn primitive_accessors(
+    root: &mut json::Root,
+    layout: &mut Layout,
+    p: &PrimitiveLayout,
+) -> json::mesh::Primitive {
+    use json::accessor::{ComponentType, Type};
+    let vertex_data = Some(json::buffer::Target::ArrayBuffer);
+    let mut attributes = std::collections::BTreeMap::new();
+    let positions = layout.accessor(
+        root,
+        p.positions / 4,
+        p.vertices,
+        Type::Vec3,
+        ComponentType::F32,
+        vertex_data,
+    );
+    let accessor = &mut root.accessors[positions.value()];
+    accessor.min = Some(p.min.to_vec().into());
+    accessor.max = Some(p.max.to_vec().into());
+    attributes.insert(Valid(json::mesh::Semantic::Positions), positions);
+    let normals = layout.accessor(
+        root,
+        p.normals / 4,
+        p.vertices,
+        Type::Vec3,
+        ComponentType::F32,
+        vertex_data,
+    );
+    attributes.insert(Valid(json::mesh::Semantic::Normals), normals);
+    for (n, &len) in p.coords.iter().enumerate() {
+        let tex = layout.accessor(
+            root,
+            len / 4,
+            p.vertices,
+            Type::Vec2,
+            ComponentType::F32,
+            vertex_data,
+        );
+        attributes.insert(Valid(json::mesh::Semantic::TexCoords(n as u32)), tex);
+    }
+    if let Some(len) = p.tangents {
+        let acc = layout.accessor(
+            root,
+            len / 4,
+            p.vertices,
+            Type::Vec4,
+            ComponentType::F32,
+            vertex_data,
+        );
+        attributes.insert(Valid(json::mesh::Semantic::Tangents), acc);
+    }
+    let indices = layout.accessor(
+        root,
+        p.indices / 4,
+        p.indices as u64 / 4,
+        Type::Scalar,
+        ComponentType::U32,
+        Some(json::buffer::Target::ElementArrayBuffer),
+    );
+    json::mesh::Primitive {
+        attributes,
+        extensions: None,
+        extras: Default::default(),
+        indices: Some(indices),
+        material: None,
+        mode: Valid(json::mesh::Mode::Triangles),
+        targets: None,
     }
 }
 
@@ -1077,15 +1353,7 @@ fn write_bin(
     // The arrays hold the bytes to write; arrays larger than the output
     // buffer go to the file directly.
     for b in buckets.iter().filter(|b| !b.indices.is_empty()) {
-        w.write_all(&b.positions).map_err(io)?;
-        w.write_all(&b.normals).map_err(io)?;
-        for coords in &b.coords {
-            w.write_all(coords).map_err(io)?;
-        }
-        if let Some(tangents) = &b.tangents {
-            w.write_all(tangents).map_err(io)?;
-        }
-        w.write_all(&b.indices).map_err(io)?;
+        b.write_arrays(w).map_err(io)?;
     }
     for &t in images {
         let tex = textures.get(t);

@@ -91,6 +91,9 @@ pub struct ExportOptions {
     /// output (glTF `asset.extras.georeference`, an OBJ header comment) so
     /// that models can be placed back.
     pub georeference: Option<Georeference>,
+    /// glTF and GLB: vertex data held in memory before it is written out,
+    /// in MiB (see `gltf`'s module docs): bounds memory for large models.
+    pub flush_mib: usize,
 }
 
 impl Default for ExportOptions {
@@ -99,6 +102,7 @@ impl Default for ExportOptions {
             texture_roots: Vec::new(),
             embed_textures: true,
             georeference: None,
+            flush_mib: gltf::DEFAULT_FLUSH_MIB,
         }
     }
 }
@@ -273,6 +277,7 @@ impl ModelWriter {
                     format == Format::Glb,
                     options.embed_textures,
                     options.georeference.map(Georeference::to_json),
+                    options.flush_mib,
                 )?;
                 let reserved = w.file_names();
                 (Sink::Gltf(w), reserved)
@@ -375,7 +380,7 @@ impl ModelWriter {
             }
         }
         match &mut self.sink {
-            Sink::Gltf(w) => w.begin_mesh(mesh),
+            Sink::Gltf(w) => w.begin_mesh(mesh)?,
             Sink::Obj(w) => w.begin_mesh(mesh),
         }
         // Most meshes are finite throughout: then no face needs the check.

@@ -179,6 +179,7 @@ fn embedded_png_texture_and_flipped_uvs() {
         texture_roots: vec![dir.join("elsewhere"), project.clone()],
         embed_textures: true,
         georeference: None,
+        ..ExportOptions::default()
     };
 
     let glb = dir.join("out/textured.glb");

@@ -134,6 +134,7 @@ fn textures_uvs_and_maps() {
             texture_roots: vec![project.clone()],
             embed_textures: true,
             georeference: None,
+            ..ExportOptions::default()
         },
     );
     assert_eq!(stats.textures, 2);
@@ -172,6 +173,7 @@ fn textures_uvs_and_maps() {
             texture_roots: vec![project],
             embed_textures: false,
             georeference: None,
+            ..ExportOptions::default()
         },
     );
     assert_eq!(
@@ -209,6 +211,7 @@ fn textures_with_the_same_file_name_get_distinct_copies() {
             texture_roots: vec![dir.clone()],
             embed_textures: true,
             georeference: None,
+            ..ExportOptions::default()
         },
     );
     let obj = read_obj(&path);
@@ -304,6 +307,7 @@ fn quad_summary_matches_the_reference_summary_script() {
             texture_roots: vec![dir.clone()],
             embed_textures: true,
             georeference: None,
+            ..ExportOptions::default()
         },
     );
     let out = match Command::new("python3").arg(&script).arg(&path).output() {

@@ -238,6 +238,38 @@ pub(crate) struct PendingRule {
     key: Option<Arc<str>>,
 }
 
+thread_local! {
+    /// The rule queue's room, kept per thread from one initial shape to the
+    /// next: a building's queue holds thousands of pending rules, and
+    /// growing it anew for every lot copied them over and over.
+    static QUEUES: std::cell::RefCell<std::collections::VecDeque<PendingRule>> =
+        const { std::cell::RefCell::new(std::collections::VecDeque::new()) };
+}
+
+/// A rule queue with room from the thread's pool.
+fn pooled_queue() -> std::collections::VecDeque<PendingRule> {
+    QUEUES
+        .try_with(|q| {
+            q.try_borrow_mut()
+                .map(|mut q| std::mem::take(&mut *q))
+                .unwrap_or_default()
+        })
+        .unwrap_or_default()
+}
+
+/// Gives a queue's room back to the thread's pool (the larger room is kept).
+fn return_queue(mut queue: std::collections::VecDeque<PendingRule>) {
+    queue.clear();
+    // `try_with`: nothing to keep while the thread shuts down.
+    let _ = QUEUES.try_with(|q| {
+        if let Ok(mut q) = q.try_borrow_mut() {
+            if q.capacity() < queue.capacity() {
+                *q = queue;
+            }
+        }
+    });
+}
+
 /// The interpreter for one initial shape.
 pub struct Interp<'a> {
     pub program: &'a Program,
@@ -578,7 +610,7 @@ impl<'a> Interp<'a> {
         &mut self,
         start: impl FnOnce(&mut Self) -> Result<(), RtError>,
     ) -> Result<(), RtError> {
-        let outer = std::mem::take(&mut self.queue);
+        let outer = std::mem::replace(&mut self.queue, pooled_queue());
         let mut result = start(self);
         if result.is_ok() {
             while let Some(p) = self.queue.pop_front() {
@@ -588,7 +620,7 @@ impl<'a> Interp<'a> {
                 }
             }
         }
-        self.queue = outer;
+        return_queue(std::mem::replace(&mut self.queue, outer));
         result
     }
 

@@ -46,16 +46,17 @@ use crate::materials::{srgb_to_linear, MaterialTable};
 use crate::textures::{uri_encode, Textures};
 use crate::{ExportError, ExportStats, FaceData};
 
-/// Vertex data of one material, kept as the little-endian bytes the binary
-/// buffer holds (so writing it is one copy, and no conversion per value).
+/// Vertex data of one material, kept as the `f32` and `u32` values the
+/// binary buffer holds (written as their little-endian bytes: on
+/// little-endian machines the arrays' own memory).
 #[derive(Default)]
 struct Bucket {
     /// Vertices so far.
     vertices: usize,
-    /// `f32` x, y, z per vertex.
-    positions: Vec<u8>,
-    /// `f32` x, y, z per vertex.
-    normals: Vec<u8>,
+    /// x, y, z per vertex.
+    positions: Vec<[f32; 3]>,
+    /// x, y, z per vertex.
+    normals: Vec<[f32; 3]>,
     /// The UV sets written as `TEXCOORD` arrays, set 0 first when present,
     /// and their coordinates (`f32` u and flipped v per vertex). A set a mesh
     /// lacks reads set 0 instead, as CGA does for texture layers; vertices
@@ -63,14 +64,14 @@ struct Bucket {
     /// UVs comes (earlier vertices get (0, 0)); a textured material has it
     /// from the start, with one more set per other texture layer it uses.
     sets: Vec<usize>,
-    coords: Vec<Vec<u8>>,
+    coords: Vec<Vec<[f32; 2]>>,
     /// After [`Bucket::merge_equal_coords`]: the `TEXCOORD` index of each
     /// set (sets with equal coordinates share one array).
     tex_coords: Vec<u32>,
-    /// `TANGENT` (`f32` x, y, z, w) per vertex, for normal-mapped materials.
-    tangents: Option<Vec<u8>>,
-    /// `u32` per triangle corner.
-    indices: Vec<u8>,
+    /// `TANGENT` (x, y, z, w) per vertex, for normal-mapped materials.
+    tangents: Option<Vec<[f32; 4]>>,
+    /// Vertex indices per triangle.
+    indices: Vec<[u32; 3]>,
     min: [f32; 3],
     max: [f32; 3],
 }
@@ -99,26 +100,23 @@ pub const DEFAULT_FLUSH_MIB: usize = 64;
 /// binary data is moved up).
 const GLB_JSON_ROOM: u64 = 1 << 20;
 
-/// Appends the little-endian bytes of `x`.
-#[inline(always)]
-fn put<const N: usize>(out: &mut Vec<u8>, x: [f32; N]) {
-    // Built in a local array so that the append is one bounds check and one
-    // copy (`N` is 2 to 4).
-    let mut b = [[0u8; 4]; N];
-    for (d, v) in b.iter_mut().zip(x) {
-        *d = v.to_le_bytes();
+/// Writes values as the little-endian bytes glTF's binary buffer holds.
+fn write_le<T: bytemuck::Pod>(w: &mut impl Write, values: &[T]) -> std::io::Result<()> {
+    if cfg!(target_endian = "little") {
+        return w.write_all(bytemuck::cast_slice(values));
     }
-    out.extend_from_slice(b.as_flattened());
-}
-
-/// Whether two arrays of little-endian `f32`s are equal as numbers (as
-/// comparing the `f32` values would: 0 equals -0, NaN equals nothing).
-fn same_f32s(a: &[u8], b: &[u8]) -> bool {
-    let f = |x: &[u8]| f32::from_le_bytes([x[0], x[1], x[2], x[3]]);
-    a.len() == b.len()
-        && a.chunks_exact(4)
-            .zip(b.chunks_exact(4))
-            .all(|(x, y)| f(x) == f(y))
+    // Every component is 4 bytes: swap each.
+    let mut buf = Vec::with_capacity(1 << 16);
+    for chunk in bytemuck::cast_slice::<T, [u8; 4]>(values).chunks(1 << 14) {
+        buf.clear();
+        buf.extend(
+            chunk
+                .iter()
+                .flat_map(|b| u32::from_ne_bytes(*b).to_le_bytes()),
+        );
+        w.write_all(&buf)?;
+    }
+    Ok(())
 }
 
 /// The tangent written for a vertex with normal `n` given the face's
@@ -140,10 +138,11 @@ impl Bucket {
     /// Keeps one coordinate array per distinct content: a layer whose UV set
     /// no mesh had reads set 0's array.
     fn merge_equal_coords(&mut self) {
-        let mut distinct: Vec<Vec<u8>> = Vec::new();
+        let mut distinct: Vec<Vec<[f32; 2]>> = Vec::new();
         self.tex_coords.clear();
         for c in std::mem::take(&mut self.coords) {
-            match distinct.iter().position(|d| same_f32s(d, &c)) {
+            // Compared as numbers: 0 equals -0, NaN equals nothing.
+            match distinct.iter().position(|d| *d == c) {
                 Some(i) => self.tex_coords.push(i as u32),
                 None => {
                     self.tex_coords.push(distinct.len() as u32);
@@ -164,11 +163,11 @@ impl Bucket {
 
     /// Bytes of vertex data held.
     fn bytes(&self) -> usize {
-        self.positions.len()
-            + self.normals.len()
-            + self.coords.iter().map(Vec::len).sum::<usize>()
-            + self.tangents.as_ref().map_or(0, Vec::len)
-            + self.indices.len()
+        self.positions.len() * 12
+            + self.normals.len() * 12
+            + self.coords.iter().map(|c| c.len() * 8).sum::<usize>()
+            + self.tangents.as_ref().map_or(0, |t| t.len() * 16)
+            + self.indices.len() * 12
     }
 
     /// Each UV set in an array of its own (no merging), as once anything
@@ -182,11 +181,11 @@ impl Bucket {
         PrimitiveLayout {
             material,
             vertices: self.vertices as u64,
-            positions: self.positions.len(),
-            normals: self.normals.len(),
-            coords: self.coords.iter().map(Vec::len).collect(),
-            tangents: self.tangents.as_ref().map(Vec::len),
-            indices: self.indices.len(),
+            positions: self.positions.len() * 12,
+            normals: self.normals.len() * 12,
+            coords: self.coords.iter().map(|c| c.len() * 8).collect(),
+            tangents: self.tangents.as_ref().map(|t| t.len() * 16),
+            indices: self.indices.len() * 12,
             min: self.min,
             max: self.max,
         }
@@ -194,15 +193,15 @@ impl Bucket {
 
     /// The arrays in the order of the binary layout.
     fn write_arrays(&self, w: &mut impl Write) -> std::io::Result<()> {
-        w.write_all(&self.positions)?;
-        w.write_all(&self.normals)?;
+        write_le(w, &self.positions)?;
+        write_le(w, &self.normals)?;
         for coords in &self.coords {
-            w.write_all(coords)?;
+            write_le(w, coords)?;
         }
         if let Some(tangents) = &self.tangents {
-            w.write_all(tangents)?;
+            write_le(w, tangents)?;
         }
-        w.write_all(&self.indices)
+        write_le(w, &self.indices)
     }
 
     /// Empties the arrays (keeping their room), as for a new primitive.
@@ -221,13 +220,13 @@ impl Bucket {
 
     /// Room for `n` more vertices.
     fn reserve(&mut self, n: usize) {
-        self.positions.reserve(12 * n);
-        self.normals.reserve(12 * n);
+        self.positions.reserve(n);
+        self.normals.reserve(n);
         for c in &mut self.coords {
-            c.reserve(8 * n);
+            c.reserve(n);
         }
         if let Some(t) = &mut self.tangents {
-            t.reserve(16 * n);
+            t.reserve(n);
         }
     }
 
@@ -245,12 +244,12 @@ impl Bucket {
         let index = u32::try_from(self.vertices).map_err(|_| too_many_vertices())?;
         self.vertices += 1;
         self.push_position(p);
-        put(&mut self.normals, n.as_vec3().to_array());
+        self.normals.push(n.as_vec3().to_array());
         for (src, coords) in sources.iter().zip(&mut self.coords) {
-            put(coords, uv_at(*src, corner));
+            coords.push(uv_at(*src, corner));
         }
         if let Some(tangents) = &mut self.tangents {
-            put(tangents, vertex_tangent(n, tangent));
+            tangents.push(vertex_tangent(n, tangent));
         }
         Ok(index)
     }
@@ -271,7 +270,7 @@ impl Bucket {
                 *hi = x;
             }
         }
-        put(&mut self.positions, p);
+        self.positions.push(p);
     }
 }
 
@@ -615,7 +614,7 @@ impl GltfWriter {
         let uvs = mesh.uvs[0].as_deref();
         if uvs.is_some() && bucket.sets.is_empty() {
             bucket.sets.push(0);
-            bucket.coords.push(vec![0; bucket.vertices * 8]);
+            bucket.coords.push(vec![[0.0; 2]; bucket.vertices]);
         }
         // Vertices are shared only where one UV set is written (the key
         // holds set 0's coordinates) and no tangents (which are per face).
@@ -688,15 +687,11 @@ impl GltfWriter {
                 )?,
             },
         }
-        bucket.indices.reserve(12 * f.triangles.len());
-        for t in f.triangles {
-            let [a, b, c] = t.map(|c| corner_vertex[c as usize].to_le_bytes());
-            let mut bytes = [0u8; 12];
-            bytes[..4].copy_from_slice(&a);
-            bytes[4..8].copy_from_slice(&b);
-            bytes[8..].copy_from_slice(&c);
-            bucket.indices.extend_from_slice(&bytes);
-        }
+        bucket.indices.extend(
+            f.triangles
+                .iter()
+                .map(|t| t.map(|c| corner_vertex[c as usize])),
+        );
         *held += bucket.bytes() - before;
         Ok(())
     }
@@ -1013,29 +1008,23 @@ fn own_vertices(
         Some(normals) => {
             for c in corners.clone() {
                 let n = normals[c].try_normalize().unwrap_or(f.normal);
-                put(&mut bucket.normals, n.as_vec3().to_array());
+                bucket.normals.push(n.as_vec3().to_array());
                 if let Some(tangents) = &mut bucket.tangents {
-                    put(tangents, vertex_tangent(n, tangent));
+                    tangents.push(vertex_tangent(n, tangent));
                 }
             }
         }
         None => {
             let n = f.normal.as_vec3().to_array();
-            for _ in 0..count {
-                put(&mut bucket.normals, n);
-            }
+            bucket.normals.extend(std::iter::repeat_n(n, count));
             if let Some(tangents) = &mut bucket.tangents {
                 let t = vertex_tangent(f.normal, tangent);
-                for _ in 0..count {
-                    put(tangents, t);
-                }
+                tangents.extend(std::iter::repeat_n(t, count));
             }
         }
     }
     for (src, coords) in sources.iter().zip(&mut bucket.coords) {
-        for c in corners.clone() {
-            put(coords, uv_at(*src, c));
-        }
+        coords.extend(corners.clone().map(|c| uv_at(*src, c)));
     }
     Ok(())
 }
@@ -1382,25 +1371,31 @@ fn write_bin(
 mod tests {
     use super::*;
 
-    fn bytes(x: &[f32]) -> Vec<u8> {
+    #[test]
+    fn values_are_written_little_endian() {
         let mut out = Vec::new();
-        for &v in x {
-            put(&mut out, [v]);
-        }
-        out
+        write_le(&mut out, &[[1.5f32, -2.0]]).unwrap();
+        write_le(&mut out, &[[7u32, 1, 256]]).unwrap();
+        assert_eq!(
+            out,
+            [0, 0, 192, 63, 0, 0, 0, 192, 7, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0]
+        );
     }
 
     #[test]
     fn coordinate_arrays_compare_as_numbers() {
-        assert_eq!(bytes(&[1.5, -2.0]), [0, 0, 192, 63, 0, 0, 0, 192]);
-        assert!(same_f32s(&bytes(&[0.0, 1.0]), &bytes(&[-0.0, 1.0])));
-        assert!(!same_f32s(&bytes(&[f32::NAN]), &bytes(&[f32::NAN])));
-        assert!(!same_f32s(&bytes(&[1.0]), &bytes(&[1.0, 2.0])));
-        // Sets with equal numbers share one array, as before.
+        // Sets with equal numbers share one array (0 equals -0); NaN equals
+        // nothing.
         let mut b = Bucket::new();
-        b.coords = vec![bytes(&[0.0, 0.5]), bytes(&[-0.0, 0.5]), bytes(&[1.0, 0.5])];
+        b.coords = vec![
+            vec![[0.0, 0.5]],
+            vec![[-0.0, 0.5]],
+            vec![[1.0, 0.5]],
+            vec![[f32::NAN, 0.5]],
+            vec![[f32::NAN, 0.5]],
+        ];
         b.merge_equal_coords();
-        assert_eq!(b.tex_coords, [0, 0, 1]);
-        assert_eq!(b.coords.len(), 2);
+        assert_eq!(b.tex_coords, [0, 0, 1, 2, 3]);
+        assert_eq!(b.coords.len(), 4);
     }
 }

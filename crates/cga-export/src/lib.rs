@@ -247,7 +247,7 @@ pub struct ModelWriter {
     positions: Vec<DVec3>,
     normals: Vec<DVec3>,
     /// A placed copy of a mesh whose map mirrors it (its faces reversed).
-    mirrored: Mesh,
+    mirrored: Option<Box<Mesh>>,
     stats: ExportStats,
     skipped_non_finite: u64,
 }
@@ -304,7 +304,7 @@ impl ModelWriter {
             triangles: Vec::new(),
             positions: Vec::new(),
             normals: Vec::new(),
-            mirrored: Mesh::new(),
+            mirrored: None,
             stats: ExportStats::default(),
             skipped_non_finite: 0,
         })
@@ -334,18 +334,18 @@ impl ModelWriter {
         check_mesh(mesh, materials.len())?;
         let mut positions = std::mem::take(&mut self.positions);
         let mut normals = std::mem::take(&mut self.normals);
-        let mut mirrored = std::mem::take(&mut self.mirrored);
+        // Taken only when a map mirrors: moving a whole `Mesh` in and out
+        // for every leaf cost more than some leaves' writing.
+        let mut mirrored = None;
         let view = match transform {
             None => (mesh, &mesh.positions[..], mesh.normals.as_deref()),
             Some(t) if t.matrix3.determinant() < 0.0 => {
-                mirrored.copy_from(mesh);
-                cga_geometry::transform::transform(&mut mirrored, t);
-                cga_geometry::transform::reverse_faces(&mut mirrored);
-                (
-                    &mirrored,
-                    &mirrored.positions[..],
-                    mirrored.normals.as_deref(),
-                )
+                let m = mirrored.insert(self.mirrored.take().unwrap_or_default());
+                m.copy_from(mesh);
+                cga_geometry::transform::transform(m, t);
+                cga_geometry::transform::reverse_faces(m);
+                let m: &Mesh = m;
+                (m, &m.positions[..], m.normals.as_deref())
             }
             Some(t) => {
                 positions.clear();
@@ -362,7 +362,9 @@ impl ModelWriter {
         let result = self.add_view(view, materials);
         self.positions = positions;
         self.normals = normals;
-        self.mirrored = mirrored;
+        if mirrored.is_some() {
+            self.mirrored = mirrored;
+        }
         result
     }
 

@@ -112,6 +112,36 @@ fn broken_asset_is_a_warning_and_the_model_is_written() {
     assert_eq!(summarize(&obj).faces, 1);
 }
 
+/// A Boolean operation on operands of thousands of faces (each subtraction
+/// leaves more for the next; found by fuzzing) took seconds to minutes in
+/// one operation, past the time limit, which was only looked at between
+/// rules. It stops at the limit now, with what was made so far written.
+#[test]
+fn boolean_operations_stop_at_the_time_limit() {
+    let dir = temp_dir("boolean-blowup");
+    let obj = dir.join("b.obj");
+    expect(
+        &[
+            "generate",
+            &file("boolean_blowup.cga"),
+            "--lot",
+            "rect:20,30",
+            "--max-seconds",
+            "0.5",
+            "-o",
+            obj.to_str().unwrap(),
+        ],
+        1,
+        &[
+            "time limit (0.5 s) reached",
+            // Which subtraction runs out of time depends on the machine.
+            "boolean_blowup.cga:",
+            "subtract {",
+        ],
+    );
+    assert!(summarize(&obj).faces > 0);
+}
+
 #[test]
 fn bad_lot_files_are_usage_errors() {
     let ex = example();

@@ -747,15 +747,28 @@ impl<'a> Interp<'a> {
     /// longer than allowed.
     fn check_time(&self, span: Span) -> Result<(), RtError> {
         if self.started.elapsed().as_secs_f64() > self.limits.max_seconds {
-            return Err(RtError::new(
-                format!(
-                    "time limit ({} s) reached for one initial shape (raise the limit with --max-seconds)",
-                    self.limits.max_seconds
-                ),
-                span,
-            ));
+            return Err(self.time_limit_error(span));
         }
         Ok(())
+    }
+
+    /// When the time limit of the initial shape runs out (`None`: never),
+    /// for operations long enough to look at the clock themselves.
+    pub fn deadline(&self) -> Option<std::time::Instant> {
+        std::time::Duration::try_from_secs_f64(self.limits.max_seconds)
+            .ok()
+            .and_then(|d| self.started.checked_add(d))
+    }
+
+    /// The error of a derivation stopped by the time limit.
+    pub fn time_limit_error(&self, span: Span) -> RtError {
+        RtError::new(
+            format!(
+                "time limit ({} s) reached for one initial shape (raise the limit with --max-seconds)",
+                self.limits.max_seconds
+            ),
+            span,
+        )
     }
 
     pub fn count_shape(&mut self, span: Span) -> Result<(), RtError> {

@@ -44,6 +44,9 @@
 //! Tolerances are relative to the size of the model: points within 1e-8 of
 //! the largest coordinate magnitude (at least 1) of a plane lie on it.
 
+use std::cell::Cell;
+use std::time::Instant;
+
 use glam::{DVec2, DVec3};
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
@@ -91,6 +94,27 @@ pub struct BoolResult {
 /// Closed operands give a closed result. Never panics; degenerate faces
 /// (fewer than three corners, no area) take no part in the operation.
 pub fn boolean(a: &Mesh, b: &Mesh, op: BoolOp) -> BoolResult {
+    match boolean_within(a, b, op, None) {
+        Ok(r) => r,
+        Err(TimedOut) => unreachable!("no deadline, no time out"),
+    }
+}
+
+/// The operation gave up at its deadline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TimedOut;
+
+/// [`boolean`] that gives up once `deadline` has passed. Operands of many
+/// thousands of faces can make the BSP trees fragment their polygons into
+/// millions (each clip splits polygons by the other tree's planes), which
+/// takes minutes: the engine's time limit must hold inside one operation.
+pub fn boolean_within(
+    a: &Mesh,
+    b: &Mesh,
+    op: BoolOp,
+    deadline: Option<Instant>,
+) -> Result<BoolResult, TimedOut> {
+    let clock = Clock::new(deadline);
     let scale = a
         .positions
         .iter()
@@ -112,7 +136,7 @@ pub fn boolean(a: &Mesh, b: &Mesh, op: BoolOp) -> BoolResult {
         _ => true,
     };
     if !a_any || !b_any || apart {
-        return match op {
+        return Ok(match op {
             BoolOp::Union => {
                 let mut mesh = a.clone();
                 merge(&mut mesh, b);
@@ -128,12 +152,53 @@ pub fn boolean(a: &Mesh, b: &Mesh, op: BoolOp) -> BoolResult {
                 mesh: empty_like(a),
                 sources: Vec::new(),
             },
-        };
+        });
     }
     if let Some(plane) = common_plane(a, b, tol.plane) {
-        return boolean_2d(a, b, op, plane, &tol);
+        return boolean_2d(a, b, op, plane, &tol, &clock);
     }
-    boolean_3d(a, b, op, &tol)
+    boolean_3d(a, b, op, &tol, &clock)
+}
+
+/// Tells the loops of an operation when its deadline has passed (looking
+/// at the time at the first question and every 256th; once passed, always).
+struct Clock {
+    deadline: Option<Instant>,
+    asked: Cell<u32>,
+    passed: Cell<bool>,
+}
+
+impl Clock {
+    fn new(deadline: Option<Instant>) -> Clock {
+        Clock {
+            deadline,
+            asked: Cell::new(0),
+            passed: Cell::new(false),
+        }
+    }
+
+    fn passed(&self) -> bool {
+        let Some(deadline) = self.deadline else {
+            return false;
+        };
+        if !self.passed.get() {
+            let n = self.asked.get().wrapping_add(1);
+            self.asked.set(n);
+            // The first question and every 256th look at the time.
+            if n % 256 == 1 && Instant::now() >= deadline {
+                self.passed.set(true);
+            }
+        }
+        self.passed.get()
+    }
+
+    fn check(&self) -> Result<(), TimedOut> {
+        if self.passed.get() {
+            Err(TimedOut)
+        } else {
+            Ok(())
+        }
+    }
 }
 
 struct Tol {
@@ -287,17 +352,21 @@ struct Node {
     polys: Vec<Poly>,
 }
 
-/// A BSP tree in an arena (no recursion: deep trees cannot overflow the stack).
-struct Bsp {
+/// A BSP tree in an arena (no recursion: deep trees cannot overflow the
+/// stack). Its loops stop early once the clock says the deadline passed
+/// (the caller then gives up: see [`Clock::check`]).
+struct Bsp<'c> {
     nodes: Vec<Node>,
     eps: f64,
+    clock: &'c Clock,
 }
 
-impl Bsp {
-    fn new(polys: Vec<Poly>, eps: f64) -> Bsp {
+impl<'c> Bsp<'c> {
+    fn new(polys: Vec<Poly>, eps: f64, clock: &'c Clock) -> Bsp<'c> {
         let mut t = Bsp {
             nodes: Vec::new(),
             eps,
+            clock,
         };
         t.build(polys);
         t
@@ -322,6 +391,9 @@ impl Bsp {
         }
         let mut stack = vec![(0u32, polys)];
         while let Some((ni, ps)) = stack.pop() {
+            if self.clock.passed() {
+                return;
+            }
             let Some(first) = ps.first() else { continue };
             let plane = *self.nodes[ni as usize].plane.get_or_insert(first.plane);
             let (mut front, mut back) = (Vec::new(), Vec::new());
@@ -376,6 +448,9 @@ impl Bsp {
         let mut out = Vec::new();
         let mut stack = vec![(0u32, polys)];
         while let Some((ni, ps)) = stack.pop() {
+            if self.clock.passed() {
+                break;
+            }
             let node = &self.nodes[ni as usize];
             let Some(plane) = node.plane else {
                 out.extend(ps);
@@ -407,6 +482,9 @@ impl Bsp {
     /// Removes the parts of this tree's polygons inside `other`'s solid.
     fn clip_to(&mut self, other: &Bsp) {
         for i in 0..self.nodes.len() {
+            if self.clock.passed() {
+                return;
+            }
             let ps = std::mem::take(&mut self.nodes[i].polys);
             self.nodes[i].polys = other.clip_polygons(ps);
         }
@@ -501,12 +579,18 @@ fn polygons(mesh: &Mesh, operand: u8, eps: f64, srcs: &mut Vec<SrcFace>) -> Vec<
     out
 }
 
-fn boolean_3d(a: &Mesh, b: &Mesh, op: BoolOp, tol: &Tol) -> BoolResult {
+fn boolean_3d(
+    a: &Mesh,
+    b: &Mesh,
+    op: BoolOp,
+    tol: &Tol,
+    clock: &Clock,
+) -> Result<BoolResult, TimedOut> {
     let mut srcs = Vec::new();
     let pa = polygons(a, 0, tol.plane, &mut srcs);
     let pb = polygons(b, 1, tol.plane, &mut srcs);
-    let mut ta = Bsp::new(pa, tol.plane);
-    let mut tb = Bsp::new(pb, tol.plane);
+    let mut ta = Bsp::new(pa, tol.plane, clock);
+    let mut tb = Bsp::new(pb, tol.plane, clock);
     // The sequences of csg.js (Evan Wallace): clipping keeps what is outside
     // the other solid; inverting a tree turns its solid inside out.
     let flip_all = match op {
@@ -536,6 +620,8 @@ fn boolean_3d(a: &Mesh, b: &Mesh, op: BoolOp, tol: &Tol) -> BoolResult {
             true
         }
     };
+    // A tree cut short is not the operation's result.
+    clock.check()?;
     let mut polys = Vec::new();
     ta.into_polygons(&mut polys);
     tb.into_polygons(&mut polys);
@@ -582,7 +668,7 @@ fn boolean_3d(a: &Mesh, b: &Mesh, op: BoolOp, tol: &Tol) -> BoolResult {
             &mut scratch,
         );
     }
-    finish(out, tol, Vec::new())
+    finish(out, tol, Vec::new(), clock)
 }
 
 /// The fragments of one face as 2D loops ready for their union: vertices
@@ -653,18 +739,23 @@ fn fragment_loops(
 
 /// Appends B's result to A's and stitches; `sources` names the faces of
 /// A's result (missing entries: `A`), those of B's are `B`.
-fn finish(out: [Mesh; 2], tol: &Tol, mut sources: Vec<FaceSource>) -> BoolResult {
+fn finish(
+    out: [Mesh; 2],
+    tol: &Tol,
+    mut sources: Vec<FaceSource>,
+    clock: &Clock,
+) -> Result<BoolResult, TimedOut> {
     let [mut ma, mb] = out;
     sources.resize(ma.faces.len(), FaceSource::A);
     merge(&mut ma, &mb);
     sources.resize(ma.faces.len(), FaceSource::B);
-    let keep = stitch(&mut ma, tol.weld);
+    let keep = stitch(&mut ma, tol.weld, clock)?;
     let sources = sources
         .into_iter()
         .zip(keep)
         .filter_map(|(s, k)| k.then_some(s))
         .collect();
-    BoolResult { mesh: ma, sources }
+    Ok(BoolResult { mesh: ma, sources })
 }
 
 /// Copies face `f` of `src` into `dst` (same slots: `dst` was made by
@@ -917,7 +1008,14 @@ fn face_loops_2d(m: &Mesh, f: usize, fr: &Frame2, out: &mut Vec<Vec<DVec2>>) {
     }
 }
 
-fn boolean_2d(a: &Mesh, b: &Mesh, op: BoolOp, (n, w): (DVec3, f64), tol: &Tol) -> BoolResult {
+fn boolean_2d(
+    a: &Mesh,
+    b: &Mesh,
+    op: BoolOp,
+    (n, w): (DVec3, f64),
+    tol: &Tol,
+    clock: &Clock,
+) -> Result<BoolResult, TimedOut> {
     let (u, v) = plane_basis(n);
     let fr = Frame2 { u, v, n, w };
     let region = |m: &Mesh| {
@@ -1026,7 +1124,7 @@ fn boolean_2d(a: &Mesh, b: &Mesh, op: BoolOp, (n, w): (DVec3, f64), tol: &Tol) -
     for f in both {
         sources[f] = FaceSource::Both;
     }
-    finish(out, tol, sources)
+    finish(out, tol, sources, clock)
 }
 
 // ----- stitching -----
@@ -1035,7 +1133,7 @@ fn boolean_2d(a: &Mesh, b: &Mesh, op: BoolOp, (n, w): (DVec3, f64), tol: &Tol) -
 /// without area, and inserts into every edge the vertices lying on it
 /// (T-junctions), interpolating per-corner attributes. Returns, per input
 /// face, whether it was kept.
-fn stitch(mesh: &mut Mesh, tol: f64) -> Vec<bool> {
+fn stitch(mesh: &mut Mesh, tol: f64, clock: &Clock) -> Result<Vec<bool>, TimedOut> {
     let weld = weld_points(&mesh.positions, tol);
     let positions: Vec<DVec3> = weld
         .representative
@@ -1063,6 +1161,9 @@ fn stitch(mesh: &mut Mesh, tol: f64) -> Vec<bool> {
     let mut lp: Vec<usize> = Vec::new();
     let mut on_edge: Vec<(f64, u32)> = Vec::new();
     for f in 0..mesh.faces.len() {
+        if clock.passed() {
+            return Err(TimedOut);
+        }
         let face = mesh.faces[f];
         let first_loop = out.loops.len() as u32;
         let mut outer_ok = false;
@@ -1145,7 +1246,7 @@ fn stitch(mesh: &mut Mesh, tol: f64) -> Vec<bool> {
     }
     out.positions = positions;
     *mesh = out;
-    keep
+    Ok(keep)
 }
 
 /// Pushes a corner at vertex `id` with the attributes of corner `ca` of
@@ -1187,6 +1288,19 @@ mod tests {
         let mut m = primitive::cube(size);
         m.map_positions(|p| p + lo);
         m
+    }
+
+    #[test]
+    fn a_passed_deadline_gives_up_and_a_later_one_does_not() {
+        let a = boxm(DVec3::ZERO, DVec3::ONE * 2.0);
+        let b = boxm(DVec3::ONE, DVec3::ONE * 2.0);
+        let past = Instant::now();
+        for op in [BoolOp::Union, BoolOp::Subtract, BoolOp::Intersect] {
+            assert_eq!(boolean_within(&a, &b, op, Some(past)).err(), Some(TimedOut));
+            let later = Instant::now() + std::time::Duration::from_secs(3600);
+            let r = boolean_within(&a, &b, op, Some(later)).unwrap();
+            assert_eq!(r.mesh.faces.len(), boolean(&a, &b, op).mesh.faces.len());
+        }
     }
 
     fn unit_at(lo: f64) -> Mesh {

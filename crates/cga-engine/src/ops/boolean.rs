@@ -20,7 +20,7 @@
 
 use std::sync::Arc;
 
-use cga_geometry::boolean::{boolean, BoolOp, FaceSource};
+use cga_geometry::boolean::{boolean_within, BoolOp, FaceSource};
 use cga_geometry::Mesh;
 use cga_value::Value;
 
@@ -74,7 +74,7 @@ pub fn exec(
         let b = derive_operand(cx, st, call, body, frame)?;
         acc = Some(match acc {
             None => b,
-            Some(a) => combine(a, b, op),
+            Some(a) => combine(cx, call, a, b, op)?,
         });
     }
     let Some(result) = acc else { return Ok(()) };
@@ -131,13 +131,15 @@ fn derive_operand(
         agreed.push(c.shape.clone());
         let mesh = c.shape.object_mesh();
         acc = combine(
+            cx,
+            call,
             acc,
             Operand {
                 shape: c.shape,
                 mesh,
             },
             BoolOp::Union,
-        );
+        )?;
     }
     if !agreed.is_empty() {
         let mut shape = st.shape.clone();
@@ -155,8 +157,14 @@ fn derive_operand(
 }
 
 /// `a op b`: A's shape with the combined geometry. Differing material
-/// attributes are written into the geometry first.
-fn combine(mut a: Operand, mut b: Operand, op: BoolOp) -> Operand {
+/// attributes are written into the geometry first. Stops at the time limit.
+fn combine(
+    cx: &Interp,
+    call: &OpCall,
+    mut a: Operand,
+    mut b: Operand,
+    op: BoolOp,
+) -> Result<Operand, RtError> {
     let same =
         Arc::ptr_eq(&a.shape.material, &b.shape.material) || *a.shape.material == *b.shape.material;
     if !same {
@@ -164,7 +172,8 @@ fn combine(mut a: Operand, mut b: Operand, op: BoolOp) -> Operand {
         bake_material(&mut b.mesh, &b.shape.material);
         a.shape.material = Arc::new(MaterialOverrides::default());
     }
-    let mut r = boolean(&a.mesh, &b.mesh, op);
+    let mut r = boolean_within(&a.mesh, &b.mesh, op, cx.deadline())
+        .map_err(|_| cx.time_limit_error(call.span))?;
     // Auto-tags: `bool.A` on the faces from A (or both operands), `bool.B`
     // on those from B (or both). The edges where faces of different
     // sources meet (`bool.cut`) are not tagged yet.
@@ -182,8 +191,8 @@ fn combine(mut a: Operand, mut b: Operand, op: BoolOp) -> Operand {
             r.mesh.faces[f].tags = i;
         }
     }
-    Operand {
+    Ok(Operand {
         shape: a.shape,
         mesh: r.mesh,
-    }
+    })
 }

@@ -145,7 +145,9 @@ pub fn exec(
             let mut pieces = meshes.iter_mut().filter(|(_, d)| !*d).map(|(m, _)| m);
             let mut out = pieces.next().map(std::mem::take).unwrap_or_default();
             for m in pieces {
-                out = cga_geometry::boolean::boolean(&out, m, cga_geometry::boolean::BoolOp::Union)
+                use cga_geometry::boolean::{boolean_within, BoolOp};
+                out = boolean_within(&out, m, BoolOp::Union, cx.deadline())
+                    .map_err(|_| cx.time_limit_error(call.span))?
                     .mesh;
             }
             out

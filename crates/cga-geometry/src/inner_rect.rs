@@ -22,6 +22,16 @@ use crate::triangulate::plane_basis;
 /// Uniform grid lines added per axis on top of the vertex coordinates.
 const SUBDIVISIONS: usize = 40;
 
+/// Grid lines per axis at most. A polygon with more distinct vertex
+/// coordinates (a round footprint of thousands of vertices) gets an evenly
+/// thinned selection of them: the grid has up to this many squared cells,
+/// each tested against the edges near its row, instead of a cell count that
+/// grows with the square of the vertex count.
+const MAX_LINES: usize = 400;
+
+/// Edge directions tried at most by `innerRectangle(edge)`.
+const MAX_DIRECTIONS: usize = 24;
+
 /// The largest rectangle inside the polygon `loops` (outer boundary
 /// counter-clockwise first, holes clockwise) with sides parallel to `axis`
 /// and its perpendicular. Returns its corners counter-clockwise, or `None`
@@ -57,44 +67,76 @@ pub fn largest_inner_rectangle(loops: &[Vec<DVec2>], axis: DVec2) -> Option<[DVe
         }
         v.sort_by(f64::total_cmp);
         v.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * (hi[k] - lo[k]));
+        if v.len() > MAX_LINES {
+            // Evenly by rank, the first and last kept.
+            let last = v.len() - 1;
+            v = (0..MAX_LINES)
+                .map(|i| v[i * last / (MAX_LINES - 1)])
+                .collect();
+        }
         v
     };
     let (xs, ys) = (lines(0), lines(1));
     let (nc, nr) = (xs.len() - 1, ys.len() - 1);
+    // The edges that reach into each row (closed band): no other edge can
+    // cross a cell of the row or decide whether a point of it is inside.
+    let mut row_edges: Vec<Vec<u32>> = vec![Vec::new(); nr];
+    for (i, &(a, b)) in edges.iter().enumerate() {
+        let (y_lo, y_hi) = (a.y.min(b.y), a.y.max(b.y));
+        let first = ys.partition_point(|&y| y < y_lo).saturating_sub(1);
+        let end = ys.partition_point(|&y| y <= y_hi).min(nr);
+        for row in &mut row_edges[first.min(end)..end] {
+            row.push(i as u32);
+        }
+    }
     // free[r][c]: cell wholly inside.
     let mut free = vec![false; nr * nc];
     for r in 0..nr {
+        let near: Vec<(DVec2, DVec2)> = row_edges[r].iter().map(|&i| edges[i as usize]).collect();
         for c in 0..nc {
             let (x0, x1, y0, y1) = (xs[c], xs[c + 1], ys[r], ys[r + 1]);
             let centre = DVec2::new(0.5 * (x0 + x1), 0.5 * (y0 + y1));
-            free[r * nc + c] = inside(&local, centre)
-                && !edges
+            free[r * nc + c] = inside(&near, centre)
+                && !near
                     .iter()
                     .any(|&(a, b)| segment_crosses_box(a, b, x0, x1, y0, y1));
         }
     }
-    // Largest block of free cells.
+    // Largest block of free cells: with each row as the bottom, the free
+    // runs above every column form a histogram whose largest rectangle a
+    // stack finds in one pass (widths and heights are the grid's, not
+    // equal): linear in the cells instead of cubic in the lines.
+    // run[c]: the first row of the free run of column c ending at the
+    // current row (the row after it when the cell is not free).
     let mut best = (0.0, 0, 0, 0, 0);
-    let mut col_ok = vec![true; nc];
-    for r0 in 0..nr {
-        col_ok.iter_mut().for_each(|x| *x = true);
-        for r1 in r0..nr {
-            let h = ys[r1 + 1] - ys[r0];
-            let mut start = 0;
-            for c in 0..=nc {
-                let ok = c < nc && {
-                    col_ok[c] &= free[r1 * nc + c];
-                    col_ok[c]
-                };
-                if !ok {
-                    if c > start {
-                        let a = (xs[c] - xs[start]) * h;
-                        if a > best.0 {
-                            best = (a, start, c, r0, r1 + 1);
-                        }
-                    }
-                    start = c + 1;
+    let mut run = vec![0usize; nc];
+    let mut stack: Vec<(usize, usize)> = Vec::with_capacity(nc + 1);
+    for r in 0..nr {
+        for (c, start) in run.iter_mut().enumerate() {
+            if !free[r * nc + c] {
+                *start = r + 1;
+            }
+        }
+        stack.clear();
+        for c in 0..=nc {
+            // The column's run start; past the last column an empty one
+            // closes every open rectangle.
+            let here = if c < nc { run[c] } else { r + 1 };
+            let mut from = c;
+            // Columns whose runs are taller than this one end here.
+            while let Some(&(c0, r0)) = stack.last() {
+                if r0 >= here {
+                    break;
                 }
+                stack.pop();
+                let a = (xs[c] - xs[c0]) * (ys[r + 1] - ys[r0]);
+                if a > best.0 {
+                    best = (a, c0, c, r0, r + 1);
+                }
+                from = c0;
+            }
+            if here <= r && stack.last().is_none_or(|&(_, r0)| r0 > here) {
+                stack.push((from, here));
             }
         }
     }
@@ -170,21 +212,20 @@ fn push(edges: &[(DVec2, DVec2)], at: f64, lo: f64, hi: f64, sign: f64, swap: bo
     }
 }
 
-fn inside(loops: &[Vec<DVec2>], p: DVec2) -> bool {
+/// Whether `p` is inside the polygon with these edges (winding number;
+/// only edges that straddle `p`'s height count, so any subset holding
+/// those gives the same answer).
+fn inside(edges: &[(DVec2, DVec2)], p: DVec2) -> bool {
     let c = |q: DVec2| robust::Coord { x: q.x, y: q.y };
     let mut wn = 0i32;
-    for l in loops {
-        let n = l.len();
-        for i in 0..n {
-            let (a, b) = (l[i], l[(i + 1) % n]);
-            let o = robust::orient2d(c(a), c(b), c(p));
-            if a.y <= p.y {
-                if b.y > p.y && o > 0.0 {
-                    wn += 1;
-                }
-            } else if b.y <= p.y && o < 0.0 {
-                wn -= 1;
+    for &(a, b) in edges {
+        let o = robust::orient2d(c(a), c(b), c(p));
+        if a.y <= p.y {
+            if b.y > p.y && o > 0.0 {
+                wn += 1;
             }
+        } else if b.y <= p.y && o < 0.0 {
+            wn -= 1;
         }
     }
     wn != 0
@@ -244,18 +285,49 @@ pub fn inner_rectangle(mesh: &Mesh, face: usize, axis: Option<DVec3>) -> Option<
     let rect = match axis {
         Some(a) => largest_inner_rectangle(&loops, DVec2::new(a.dot(u), a.dot(v))),
         None => {
-            let mut best: Option<[DVec2; 4]> = None;
+            // Candidate edges, in loop order, then each direction once
+            // (parallel and perpendicular edges give the same rectangle),
+            // at most MAX_DIRECTIONS of them, longest edges first: a round
+            // footprint of thousands of edges would otherwise try each.
+            let mut edges: Vec<(f64, DVec2)> = Vec::new();
             for l in &loops {
                 let len = |i: usize| (l[(i + 1) % l.len()] - l[i]).length();
                 let longest = (0..l.len()).map(len).fold(0.0, f64::max);
                 for i in 0..l.len() {
-                    if len(i) <= 0.25 * longest {
-                        continue;
+                    if len(i) > 0.25 * longest {
+                        edges.push((len(i), l[(i + 1) % l.len()] - l[i]));
                     }
-                    if let Some(r) = largest_inner_rectangle(&loops, l[(i + 1) % l.len()] - l[i]) {
-                        if best.is_none_or(|b| area(&r) > area(&b)) {
-                            best = Some(r);
-                        }
+                }
+            }
+            let mut order: Vec<usize> = (0..edges.len()).collect();
+            order.sort_by(|&a, &b| edges[b].0.total_cmp(&edges[a].0));
+            let quarter = std::f64::consts::FRAC_PI_2;
+            let mut angles: Vec<f64> = Vec::new();
+            let mut tried: Vec<usize> = Vec::new();
+            for i in order {
+                let d = edges[i].1;
+                let a = d.y.atan2(d.x).rem_euclid(quarter);
+                let same = |t: &f64| {
+                    let gap = (t - a).abs();
+                    gap.min(quarter - gap) <= 1e-9
+                };
+                if angles.iter().any(same) {
+                    continue;
+                }
+                if tried.len() == MAX_DIRECTIONS {
+                    break;
+                }
+                angles.push(a);
+                tried.push(i);
+            }
+            // Tried in loop order, so that of equal rectangles the first
+            // edge's wins.
+            tried.sort_unstable();
+            let mut best: Option<[DVec2; 4]> = None;
+            for i in tried {
+                if let Some(r) = largest_inner_rectangle(&loops, edges[i].1) {
+                    if best.is_none_or(|b| area(&r) > area(&b)) {
+                        best = Some(r);
                     }
                 }
             }

@@ -821,6 +821,14 @@ impl Sim {
         self.settle(c);
     }
 
+    /// Gives edge `e` the weight (speed) `w` from time `t` on, keeping its
+    /// line where it is at `t`.
+    fn set_weight(&mut self, e: u32, w: f64, t: f64) {
+        let ed = &mut self.edges[e as usize];
+        ed.c += (ed.w - w) * t;
+        ed.w = w;
+    }
+
     fn process(&mut self, ev: Event) {
         match ev.kind {
             Kind::Fold { v } => {
@@ -854,11 +862,23 @@ impl Sim {
             }
             Kind::Weight { e, w } => {
                 let t = self.tc;
-                let ed = &mut self.edges[e as usize];
-                ed.c += (ed.w - w) * t;
-                ed.w = w;
-                // All vertices are renewed: split candidates against this
-                // edge are stale, and they are recomputed with the vertices.
+                self.set_weight(e, w, t);
+                // Every other weight change due now too (an envelope changes
+                // all edges' weights at one height): the vertices are then
+                // renewed once, not once per edge, which made it quadratic
+                // in the edge count.
+                while let Some(next) = self.heap.peek().copied() {
+                    let Kind::Weight { e, w } = next.kind else {
+                        break;
+                    };
+                    if next.t != t {
+                        break;
+                    }
+                    self.heap.pop();
+                    self.set_weight(e, w, t);
+                }
+                // All vertices are renewed: split candidates against these
+                // edges are stale, and they are recomputed with the vertices.
                 let affected: Vec<u32> = (0..self.verts.len() as u32)
                     .filter(|&v| self.verts[v as usize].alive)
                     .collect();

@@ -51,9 +51,7 @@ use crate::{ExportError, ExportStats, FaceData};
 /// little-endian machines the arrays' own memory).
 #[derive(Default)]
 struct Bucket {
-    /// Vertices so far.
-    vertices: usize,
-    /// x, y, z per vertex.
+    /// x, y, z per vertex (their number is the bucket's vertex count).
     positions: Vec<[f32; 3]>,
     /// x, y, z per vertex.
     normals: Vec<[f32; 3]>,
@@ -180,7 +178,7 @@ impl Bucket {
     fn primitive(&self, material: u32) -> PrimitiveLayout {
         PrimitiveLayout {
             material,
-            vertices: self.vertices as u64,
+            vertices: self.positions.len() as u64,
             positions: self.positions.len() * 12,
             normals: self.normals.len() * 12,
             coords: self.coords.iter().map(|c| c.len() * 8).collect(),
@@ -206,7 +204,6 @@ impl Bucket {
 
     /// Empties the arrays (keeping their room), as for a new primitive.
     fn clear(&mut self) {
-        self.vertices = 0;
         self.positions.clear();
         self.normals.clear();
         self.coords.iter_mut().for_each(Vec::clear);
@@ -241,8 +238,7 @@ impl Bucket {
         corner: usize,
         tangent: (DVec3, f64),
     ) -> Result<u32, ExportError> {
-        let index = u32::try_from(self.vertices).map_err(|_| too_many_vertices())?;
-        self.vertices += 1;
+        let index = u32::try_from(self.positions.len()).map_err(|_| too_many_vertices())?;
         self.push_position(p);
         self.normals.push(n.as_vec3().to_array());
         for (src, coords) in sources.iter().zip(&mut self.coords) {
@@ -614,7 +610,7 @@ impl GltfWriter {
         let uvs = mesh.uvs[0].as_deref();
         if uvs.is_some() && bucket.sets.is_empty() {
             bucket.sets.push(0);
-            bucket.coords.push(vec![[0.0; 2]; bucket.vertices]);
+            bucket.coords.push(vec![[0.0; 2]; bucket.positions.len()]);
         }
         // Vertices are shared only where one UV set is written (the key
         // holds set 0's coordinates) and no tangents (which are per face).
@@ -993,13 +989,12 @@ fn own_vertices(
 ) -> Result<(), ExportError> {
     let mesh = f.mesh;
     let count = corners.clone().count();
-    let first = bucket.vertices;
+    let first = bucket.positions.len();
     // Vertex indices are u32: the last one must fit.
     if first + count > u32::MAX as usize + 1 {
         return Err(too_many_vertices());
     }
     bucket.reserve(count);
-    bucket.vertices += count;
     for (v, c) in (first as u32..).zip(corners.clone()) {
         bucket.push_position(f.positions[mesh.corners[c] as usize]);
         corner_vertex[c] = v;

@@ -456,19 +456,39 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
     let mut shapes = 0usize;
     let mut leaves = 0usize;
     let mut seen_warnings = std::collections::HashSet::new();
-    // Leaves go to the writing thread as they are emitted, so writing the
-    // model overlaps deriving it even for a single lot. Without an output
-    // they are dropped where they were made.
-    let stream = writer.is_some();
-    // Takes what the lots produce, in lot order: each leaf into the writer
+    // Leaves go to the writing thread in batches as they are emitted, so
+    // writing the model overlaps deriving it even for a single lot; for
+    // glTF and GLB the workers encode them into vertex data first, leaving
+    // the writing thread little to do. Without an output they are dropped
+    // where they were made.
+    let encoder = writer.as_ref().and_then(ModelWriter::encoder);
+    let has_writer = writer.is_some();
+    let new_batcher = || match &encoder {
+        Some(e) => Batcher::Encode(Box::new(e.another()), 0),
+        None if has_writer => Batcher::Leaves(Vec::new()),
+        None => Batcher::Drop,
+    };
+    // Takes what the lots produce, in lot order: each batch into the writer
     // as it comes, then the lot's prints, diagnostics and reports.
-    let mut take = |i: usize, taken: Taken<Leaf, (LotOutput, Option<RtError>)>| {
+    let mut take = |i: usize, taken: Taken<Piece, (LotOutput, Option<RtError>)>| {
         let (out, error) = match taken {
-            Taken::Leaf(leaf) => {
-                leaves += 1;
-                if let Some(w) = writer.as_mut() {
-                    w.add_placed(&leaf.mesh, Some(&leaf.transform), &leaf.materials)
-                        .map_err(|e| Failure::Usage(format!("export failed: {e}")))?;
+            Taken::Piece(piece) => {
+                let export = |e| Failure::Usage(format!("export failed: {e}"));
+                let Some(w) = writer.as_mut() else {
+                    return Ok(());
+                };
+                match piece {
+                    Piece::Leaves(batch) => {
+                        leaves += batch.len();
+                        for leaf in batch {
+                            w.add_placed(&leaf.mesh, Some(&leaf.transform), &leaf.materials)
+                                .map_err(export)?;
+                        }
+                    }
+                    Piece::Encoded(batch, n) => {
+                        leaves += n;
+                        w.append(batch).map_err(export)?;
+                    }
                 }
                 return Ok(());
             }
@@ -499,14 +519,20 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
         progress.inc(1);
         Ok(())
     };
-    let generate_one = |i: usize, sink: &mut dyn FnMut(Leaf)| {
-        generate_lot_streaming(&program, &assets, rule, &lots[i], i, &options, |leaf| {
-            if stream {
-                sink(leaf)
-            }
-        })
+    let generate_one = |batcher: &mut Batcher, i: usize, send: &mut dyn FnMut(Piece)| {
+        let r = generate_lot_streaming(&program, &assets, rule, &lots[i], i, &options, |leaf| {
+            batcher.add(leaf, send)
+        });
+        batcher.flush(send);
+        r
     };
-    run_pipeline(lots.len(), jobs.max(1), generate_one, &mut take)?;
+    run_pipeline(
+        lots.len(),
+        jobs.max(1),
+        new_batcher,
+        generate_one,
+        &mut take,
+    )?;
     let derived_after = started.elapsed().as_secs_f64();
     progress.finish_and_clear();
     let failed = failed_lots > 0;
@@ -618,35 +644,100 @@ fn collect_scene(
     ))
 }
 
-/// What the writing thread is handed for a lot, in order: its leaves as
-/// they are emitted, then its result.
-enum Taken<L, R> {
-    Leaf(L),
-    Done(R),
+/// A piece of a lot's output on its way to the writing thread.
+enum Piece {
+    /// Leaves, for writers that take meshes (OBJ).
+    Leaves(Vec<Leaf>),
+    /// Leaves encoded into vertex data (glTF, GLB), and how many.
+    Encoded(cga_export::Encoded, usize),
 }
 
-/// What a worker sends for a lot: the channel its leaves will come
-/// through in batches (when it starts), then its result.
-enum Delivery<L, R> {
-    Leaves(mpsc::Receiver<Vec<L>>),
-    Done(R),
-}
-
-/// Leaves per message from a worker to the writing thread.
+/// Leaves per piece at most: a message per leaf would wake the writing
+/// thread for each (a system call apiece).
 const LEAF_BATCH: usize = 512;
 
+/// Encoded vertex data per piece at most, in bytes: large enough that the
+/// writing thread is seldom woken, small enough to keep little in flight.
+const ENCODED_BATCH_BYTES: usize = 1 << 20;
+
+/// How a worker gathers its leaves into pieces.
+enum Batcher {
+    /// No output: leaves are dropped where they are made.
+    Drop,
+    Leaves(Vec<Leaf>),
+    /// The leaves encoded so far into the encoder's batch, and their count.
+    Encode(Box<cga_export::Encoder>, usize),
+}
+
+impl Batcher {
+    fn add(&mut self, leaf: Leaf, send: &mut dyn FnMut(Piece)) {
+        match self {
+            Batcher::Drop => {}
+            Batcher::Leaves(batch) => {
+                batch.push(leaf);
+                if batch.len() == LEAF_BATCH {
+                    let full = std::mem::replace(batch, Vec::with_capacity(LEAF_BATCH));
+                    send(Piece::Leaves(full));
+                }
+            }
+            Batcher::Encode(encoder, n) => {
+                encoder.add_placed(&leaf.mesh, Some(&leaf.transform), &leaf.materials);
+                *n += 1;
+                if *n == LEAF_BATCH || encoder.bytes() >= ENCODED_BATCH_BYTES {
+                    send(Piece::Encoded(encoder.take(), std::mem::take(n)));
+                }
+            }
+        }
+    }
+
+    /// Sends what was gathered (at the end of a lot).
+    fn flush(&mut self, send: &mut dyn FnMut(Piece)) {
+        match self {
+            Batcher::Drop => {}
+            Batcher::Leaves(batch) => {
+                if !batch.is_empty() {
+                    send(Piece::Leaves(std::mem::take(batch)));
+                }
+            }
+            Batcher::Encode(encoder, n) => {
+                if *n > 0 {
+                    send(Piece::Encoded(encoder.take(), std::mem::take(n)));
+                }
+            }
+        }
+    }
+}
+
+/// What the writing thread is handed for a lot, in order: the pieces of
+/// its output as they are sent, then its result.
+enum Taken<L, R> {
+    Piece(L),
+    Done(R),
+}
+
+/// What a worker sends for a lot: the channel its pieces will come
+/// through (when it starts), then its result.
+enum Delivery<L, R> {
+    Pieces(mpsc::Receiver<L>),
+    Done(R),
+}
+
 /// Derives lots `0..count` on `jobs` worker threads while the calling
-/// thread hands what they produce to `take` in lot order: the leaves of a
-/// lot as they come (`generate` emits them through its sink), then its
-/// result. So writing overlaps deriving, even within one lot, and the
-/// output does not depend on the number of threads. A worker starts a lot
-/// only while fewer than a few lots per worker wait to be taken, so memory
-/// holds a bounded number of lots, not the whole city. An error from
-/// `take` stops the workers and is returned.
-fn run_pipeline<L: Send, R: Send>(
+/// thread hands what they produce to `take` in lot order: the pieces of a
+/// lot's output as they come (`generate` sends them through its sink, each
+/// piece a message: batches, not single leaves, so that the writing thread
+/// is not woken for every leaf), then its result. So writing overlaps
+/// deriving, even within one lot, and the output does not depend on the
+/// number of threads. Each worker has a state of its own, made by `init`,
+/// that `generate` uses for all its lots. A worker starts a lot only while
+/// fewer than a few lots per worker wait to be taken, so memory holds a
+/// bounded number of lots, not the whole city. An error from `take` stops
+/// the workers and is returned.
+fn run_pipeline<W, L: Send, R: Send>(
     count: usize,
     jobs: usize,
-    generate: impl Fn(usize, &mut dyn FnMut(L)) -> R + Sync,
+    init: impl Fn() -> W + Sync,
+    generate: impl Fn(&mut W, usize, &mut dyn FnMut(L)) -> R + Sync,
     take: &mut dyn FnMut(usize, Taken<L, R>) -> Result<(), Failure>,
 ) -> Result<(), Failure> {
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -679,10 +770,11 @@ fn run_pipeline<L: Send, R: Send>(
         let (tx, rx) = mpsc::channel::<(usize, Delivery<L, R>)>();
         for _ in 0..jobs.min(count) {
             let tx = tx.clone();
-            let (next, stop, taken, generate, lock, halt) =
-                (&next, &stop, &taken, &generate, &lock, &halt);
+            let (next, stop, taken, init, generate, lock, halt) =
+                (&next, &stop, &taken, &init, &generate, &lock, &halt);
             let worker = move || {
                 let _guard = StopOnPanic(halt);
+                let mut state = init();
                 loop {
                     let i = next.fetch_add(1, Ordering::Relaxed);
                     if i >= count {
@@ -694,28 +786,17 @@ fn run_pipeline<L: Send, R: Send>(
                             done = taken.1.wait(done).unwrap_or_else(|e| e.into_inner());
                         }
                     }
-                    let (leaf_tx, leaf_rx) = mpsc::channel();
+                    let (piece_tx, piece_rx) = mpsc::channel();
                     if stop.load(Ordering::Relaxed)
-                        || tx.send((i, Delivery::Leaves(leaf_rx))).is_err()
+                        || tx.send((i, Delivery::Pieces(piece_rx))).is_err()
                     {
                         break;
                     }
-                    // Leaves go in batches: a message per leaf would wake
-                    // the writing thread for each (a system call apiece).
-                    let mut batch = Vec::with_capacity(LEAF_BATCH);
-                    let r = generate(i, &mut |leaf| {
-                        batch.push(leaf);
-                        if batch.len() == LEAF_BATCH {
-                            let full =
-                                std::mem::replace(&mut batch, Vec::with_capacity(LEAF_BATCH));
-                            // A closed channel means the writing stopped.
-                            let _ = leaf_tx.send(full);
-                        }
+                    let r = generate(&mut state, i, &mut |piece| {
+                        // A closed channel means the writing stopped.
+                        let _ = piece_tx.send(piece);
                     });
-                    if !batch.is_empty() {
-                        let _ = leaf_tx.send(batch);
-                    }
-                    drop(leaf_tx);
+                    drop(piece_tx);
                     if tx.send((i, Delivery::Done(r))).is_err() {
                         break;
                     }
@@ -730,21 +811,21 @@ fn run_pipeline<L: Send, R: Send>(
             }
         }
         drop(tx);
-        let mut leaves = std::collections::BTreeMap::new();
+        let mut pieces = std::collections::BTreeMap::new();
         let mut results = std::collections::BTreeMap::new();
-        // The next message for lot `i` of the kind `pick` takes out of the
+        // The next message for lot `i` of the kind asked for, out of the
         // waiting ones; `None` when the workers are gone.
-        let mut wait_for = |i: usize, want_leaves: bool| loop {
-            if want_leaves {
-                if let Some(r) = leaves.remove(&i) {
-                    return Some(Delivery::Leaves(r));
+        let mut wait_for = |i: usize, want_pieces: bool| loop {
+            if want_pieces {
+                if let Some(r) = pieces.remove(&i) {
+                    return Some(Delivery::Pieces(r));
                 }
             } else if let Some(r) = results.remove(&i) {
                 return Some(Delivery::Done(r));
             }
             match rx.recv() {
-                Ok((j, Delivery::Leaves(r))) => {
-                    leaves.insert(j, r);
+                Ok((j, Delivery::Pieces(r))) => {
+                    pieces.insert(j, r);
                 }
                 Ok((j, Delivery::Done(r))) => {
                     results.insert(j, r);
@@ -754,11 +835,11 @@ fn run_pipeline<L: Send, R: Send>(
         };
         let mut result = Ok(());
         'lots: for i in 0..count {
-            let Some(Delivery::Leaves(leaf_rx)) = wait_for(i, true) else {
+            let Some(Delivery::Pieces(piece_rx)) = wait_for(i, true) else {
                 break;
             };
-            for leaf in leaf_rx.iter().flatten() {
-                result = take(i, Taken::Leaf(leaf));
+            for piece in piece_rx.iter() {
+                result = take(i, Taken::Piece(piece));
                 if result.is_err() {
                     break 'lots;
                 }
@@ -820,15 +901,18 @@ mod tests {
     /// results in `10 i`; returns what was taken, in order.
     fn run(count: usize, jobs: usize, fail_at: Option<usize>) -> (Vec<String>, bool) {
         let mut seen = Vec::new();
-        let generate = |i: usize, sink: &mut dyn FnMut((usize, usize))| {
+        // Each worker counts the lots it derived in its own state.
+        let generate = |lots: &mut usize, i: usize, sink: &mut dyn FnMut((usize, usize))| {
+            *lots += 1;
+            assert!(*lots <= count);
             for k in 0..i % 5 {
                 sink((i, k));
             }
             10 * i
         };
-        let r = run_pipeline(count, jobs, generate, &mut |i, taken| {
+        let r = run_pipeline(count, jobs, || 0usize, generate, &mut |i, taken| {
             match taken {
-                Taken::Leaf((j, k)) => seen.push(format!("{i}:{j}.{k}")),
+                Taken::Piece((j, k)) => seen.push(format!("{i}:{j}.{k}")),
                 Taken::Done(r) => seen.push(format!("{i}={r}")),
             }
             if Some(i) == fail_at {
@@ -868,11 +952,11 @@ mod tests {
     #[test]
     fn a_worker_panic_does_not_hang_the_pipeline() {
         let r = std::panic::catch_unwind(|| {
-            let generate = |i: usize, _: &mut dyn FnMut(())| {
+            let generate = |_: &mut (), i: usize, _: &mut dyn FnMut(())| {
                 assert!(i != 3, "lot 3 fails");
                 i
             };
-            run_pipeline(40, 2, generate, &mut |_, _| Ok(()))
+            run_pipeline(40, 2, || (), generate, &mut |_, _| Ok(()))
         });
         assert!(r.is_err());
     }

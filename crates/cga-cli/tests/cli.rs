@@ -294,6 +294,60 @@ fn an_error_in_one_lot_does_not_stop_the_others() {
     assert_eq!(stdout(&out), "1\n");
 }
 
+/// The written model does not depend on the number of threads: GLB and
+/// glTF are encoded on the deriving threads in batches and appended in lot
+/// order, OBJ is written from leaves on the writing thread. Lots of many
+/// leaves (more than one batch each) and of different materials.
+#[test]
+fn written_models_do_not_depend_on_the_thread_count() {
+    let dir = temp_dir("jobs-bytes");
+    let rules = rule_file(
+        &dir,
+        "city.cga",
+        "Lot --> extrude(6 + scope.sx / 10) comp(f) { side : Facade | top : color(\"#803020\") Roof. }\n\
+         Facade --> split(y) { ~1 : Floor }*\n\
+         Floor --> split(x) { ~0.7 : Tile }*\n\
+         Tile --> case split.index % 2 == 0 : color(\"#cccccc\") X. else : color(0.2, 0.3, split.index / 40) extrude(0.2) Y.\n",
+    );
+    for ext in ["glb", "gltf", "obj"] {
+        let mut want: Option<Vec<u8>> = None;
+        for jobs in ["1", "2", "3"] {
+            let sub = dir.join(format!("{ext}-{jobs}"));
+            std::fs::create_dir_all(&sub).unwrap();
+            let model = sub.join(format!("city.{ext}"));
+            let out = run(&[
+                "generate",
+                rules.to_str().unwrap(),
+                "--lot",
+                "grid:4x3",
+                "--jobs",
+                jobs,
+                "-o",
+                model.to_str().unwrap(),
+            ]);
+            assert!(out.status.success(), "{}", stderr(&out));
+            let mut bytes = std::fs::read(&model).unwrap();
+            if ext == "gltf" {
+                bytes.extend(std::fs::read(model.with_extension("bin")).unwrap());
+                assert_valid_gltf(&model);
+            }
+            // 12 lots, each with hundreds of leaves.
+            let err = stderr(&out);
+            let leaves: usize = err
+                .split(" leaf shapes")
+                .next()
+                .and_then(|s| s.rsplit(' ').next())
+                .and_then(|n| n.parse().ok())
+                .unwrap_or_else(|| panic!("no leaf count in {err}"));
+            assert!(leaves > 12 * 512, "{leaves} leaves");
+            match &want {
+                None => want = Some(bytes),
+                Some(w) => assert!(*w == bytes, "{ext}: --jobs {jobs} wrote other bytes"),
+            }
+        }
+    }
+}
+
 /// Found by fuzzing: `extrude(888884) split(y) { 2 : X. }*` asks for
 /// 444,442 slabs; with a small shape limit it stops before cutting them.
 /// A split beyond a million parts is refused whatever the limits.

@@ -38,41 +38,14 @@ use std::path::{Path, PathBuf};
 
 use std::sync::Arc;
 
-use cga_geometry::{DVec2, DVec3, Material, Mesh, UV_SETS};
+use cga_geometry::{DVec3, Material};
 use gltf_json as json;
 use json::validation::{Checked::Valid, USize64};
 
+use crate::bucket::Bucket;
 use crate::materials::{srgb_to_linear, MaterialTable};
 use crate::textures::{uri_encode, Textures};
 use crate::{ExportError, ExportStats, FaceData};
-
-/// Vertex data of one material, kept as the `f32` and `u32` values the
-/// binary buffer holds (written as their little-endian bytes: on
-/// little-endian machines the arrays' own memory).
-#[derive(Default)]
-struct Bucket {
-    /// x, y, z per vertex (their number is the bucket's vertex count).
-    positions: Vec<[f32; 3]>,
-    /// x, y, z per vertex.
-    normals: Vec<[f32; 3]>,
-    /// The UV sets written as `TEXCOORD` arrays, set 0 first when present,
-    /// and their coordinates (`f32` u and flipped v per vertex). A set a mesh
-    /// lacks reads set 0 instead, as CGA does for texture layers; vertices
-    /// without either get (0, 0). Set 0 is added when the first mesh with
-    /// UVs comes (earlier vertices get (0, 0)); a textured material has it
-    /// from the start, with one more set per other texture layer it uses.
-    sets: Vec<usize>,
-    coords: Vec<Vec<[f32; 2]>>,
-    /// After [`Bucket::merge_equal_coords`]: the `TEXCOORD` index of each
-    /// set (sets with equal coordinates share one array).
-    tex_coords: Vec<u32>,
-    /// `TANGENT` (x, y, z, w) per vertex, for normal-mapped materials.
-    tangents: Option<Vec<[f32; 4]>>,
-    /// Vertex indices per triangle.
-    indices: Vec<[u32; 3]>,
-    min: [f32; 3],
-    max: [f32; 3],
-}
 
 /// The sizes (in bytes) of a primitive's arrays, in the order of the binary
 /// layout, with its material and bounds: what its accessors need.
@@ -117,21 +90,6 @@ fn write_le<T: bytemuck::Pod>(w: &mut impl Write, values: &[T]) -> std::io::Resu
     Ok(())
 }
 
-/// The tangent written for a vertex with normal `n` given the face's
-/// tangent: perpendicular to the normal, as glTF requires.
-#[inline]
-fn vertex_tangent(n: DVec3, (t, w): (DVec3, f64)) -> [f32; 4] {
-    let t = (t - n * n.dot(t))
-        .try_normalize()
-        .unwrap_or_else(|| n.any_orthonormal_vector());
-    let t = t.as_vec3();
-    [t.x, t.y, t.z, w as f32]
-}
-
-fn too_many_vertices() -> ExportError {
-    ExportError::TooLarge("more than 2^32 vertices with one material".into())
-}
-
 impl Bucket {
     /// Keeps one coordinate array per distinct content: a layer whose UV set
     /// no mesh had reads set 0's array.
@@ -149,23 +107,6 @@ impl Bucket {
             }
         }
         self.coords = distinct;
-    }
-
-    fn new() -> Bucket {
-        Bucket {
-            min: [f32::INFINITY; 3],
-            max: [f32::NEG_INFINITY; 3],
-            ..Bucket::default()
-        }
-    }
-
-    /// Bytes of vertex data held.
-    fn bytes(&self) -> usize {
-        self.positions.len() * 12
-            + self.normals.len() * 12
-            + self.coords.iter().map(|c| c.len() * 8).sum::<usize>()
-            + self.tangents.as_ref().map_or(0, |t| t.len() * 16)
-            + self.indices.len() * 12
     }
 
     /// Each UV set in an array of its own (no merging), as once anything
@@ -201,84 +142,72 @@ impl Bucket {
         }
         write_le(w, &self.indices)
     }
-
-    /// Empties the arrays (keeping their room), as for a new primitive.
-    fn clear(&mut self) {
-        self.positions.clear();
-        self.normals.clear();
-        self.coords.iter_mut().for_each(Vec::clear);
-        if let Some(t) = &mut self.tangents {
-            t.clear();
-        }
-        self.indices.clear();
-        self.min = [f32::INFINITY; 3];
-        self.max = [f32::NEG_INFINITY; 3];
-    }
-
-    /// Room for `n` more vertices.
-    fn reserve(&mut self, n: usize) {
-        self.positions.reserve(n);
-        self.normals.reserve(n);
-        for c in &mut self.coords {
-            c.reserve(n);
-        }
-        if let Some(t) = &mut self.tangents {
-            t.reserve(n);
-        }
-    }
-
-    /// Appends a vertex at `p` with normal `n`; `sources[k]` is where the
-    /// `k`-th written UV set reads (see [`Bucket::sets`]), at `corner`.
-    #[inline(always)]
-    fn push_vertex(
-        &mut self,
-        p: DVec3,
-        n: DVec3,
-        sources: &[Option<&[DVec2]>],
-        corner: usize,
-        tangent: (DVec3, f64),
-    ) -> Result<u32, ExportError> {
-        let index = u32::try_from(self.positions.len()).map_err(|_| too_many_vertices())?;
-        self.push_position(p);
-        self.normals.push(n.as_vec3().to_array());
-        for (src, coords) in sources.iter().zip(&mut self.coords) {
-            coords.push(uv_at(*src, corner));
-        }
-        if let Some(tangents) = &mut self.tangents {
-            tangents.push(vertex_tangent(n, tangent));
-        }
-        Ok(index)
-    }
-
-    /// Appends a position and widens the bounds.
-    #[inline(always)]
-    fn push_position(&mut self, p: DVec3) {
-        let p = p.as_vec3().to_array();
-        // `min` and `max` start at +inf and -inf (see `Bucket::new`) and are
-        // never NaN, so plain comparisons keep what `f32::min` and `max`
-        // would (a NaN coordinate changes nothing; of 0 and -0 the first
-        // stays) without their NaN handling.
-        for ((lo, hi), x) in self.min.iter_mut().zip(&mut self.max).zip(p) {
-            if x < *lo {
-                *lo = x;
-            }
-            if x > *hi {
-                *hi = x;
-            }
-        }
-        self.positions.push(p);
-    }
 }
 
-/// The written texture coordinates of `corner` from a UV source: v flipped
-/// (glTF puts v = 0 at the top of the image, CGA at the bottom); (0, 0)
-/// without a source.
-#[inline(always)]
-fn uv_at(src: Option<&[DVec2]>, corner: usize) -> [f32; 2] {
-    match src.and_then(|u| u.get(corner)) {
-        Some(t) => [t.x as f32, (1.0 - t.y) as f32],
-        None => [0.0, 0.0],
+/// The textures a material uses in glTF, with `find` telling which of its
+/// texture paths are usable and their texture ids; `find` and the layers
+/// glTF cannot hold put their warnings into `warnings`, in order.
+pub(crate) fn texture_uses(
+    material: &Material,
+    mut find: impl FnMut(&Arc<str>, &mut Vec<String>) -> Option<u32>,
+    warnings: &mut Vec<String>,
+) -> Vec<MapUse> {
+    let mut maps = Vec::new();
+    for (slot, channel) in [
+        (Slot::BaseColor, 0),
+        (Slot::Normal, 5),
+        (Slot::Emissive, 6),
+        (Slot::Occlusion, 7),
+    ] {
+        if let Some(texture) = find(&material.maps[channel].path, warnings) {
+            maps.push(MapUse {
+                slot,
+                texture,
+                channel,
+            });
+        }
     }
+    // glTF packs roughness (green) and metalness (blue) into one image.
+    // The same image for both layers is exactly that; a roughness map
+    // alone works too when the material is not metallic (the factor
+    // zeroes the blue channel). Other combinations cannot be written.
+    let (rough, metal) = (&material.maps[8].path, &material.maps[9].path);
+    let packed = match (rough.is_empty(), metal.is_empty()) {
+        (false, false) if rough == metal => Some(8),
+        (false, true) if material.metallic == 0.0 => Some(8),
+        (true, true) => None,
+        _ => {
+            warnings.push(format!(
+                "roughness map '{rough}' and metallic map '{metal}' are not one image, as glTF requires; written without them"
+            ));
+            None
+        }
+    };
+    if let Some(texture) = packed.and_then(|k| find(&material.maps[k].path, warnings)) {
+        maps.push(MapUse {
+            slot: Slot::MetallicRoughness,
+            texture,
+            channel: 8,
+        });
+    }
+    maps
+}
+
+/// The UV sets and whether tangents are written for a material with these
+/// textures: a textured material's vertices all need coordinates, set 0
+/// first, then each other set a texture reads; a normal map needs
+/// tangents.
+pub(crate) fn bucket_layout(maps: &[MapUse]) -> (Vec<usize>, bool) {
+    let mut sets = Vec::new();
+    if !maps.is_empty() {
+        sets.push(0);
+        for m in maps {
+            if !sets.contains(&m.channel) {
+                sets.push(m.channel);
+            }
+        }
+    }
+    (sets, maps.iter().any(|m| m.slot == Slot::Normal))
 }
 
 /// The texture `path` names if it was found and glTF can use it (PNG or
@@ -299,7 +228,7 @@ fn usable(textures: &mut Textures, warnings: &mut Vec<String>, path: &Arc<str>) 
 /// its normal map, whose coordinates are UV set 5 or else set 0. glTF's
 /// bitangent is `cross(normal, tangent) * w` and points along its own v,
 /// which runs opposite to CGA's.
-fn face_tangent(f: &FaceData) -> (DVec3, f64) {
+pub(crate) fn face_tangent(f: &FaceData) -> (DVec3, f64) {
     let mesh = f.mesh;
     let Some(uvs) = mesh.uvs[5].as_deref().or(mesh.uvs[0].as_deref()) else {
         return (f.normal.any_orthonormal_vector(), 1.0);
@@ -341,32 +270,11 @@ enum Slot {
 /// A texture a material uses: its glTF slot, the texture, and the CGA
 /// texture layer it comes from (its transform, and its UV set).
 #[derive(Clone, Copy, Debug)]
-struct MapUse {
+pub(crate) struct MapUse {
     slot: Slot,
     texture: u32,
     channel: usize,
 }
-
-/// Identifies a vertex at one position of an input mesh that carries its
-/// own normals, so corners that share position, normal and UV (and
-/// material) share one output vertex.
-#[derive(Clone, Copy, PartialEq, Eq)]
-struct VertexKey {
-    material: u32,
-    normal: [u32; 3],
-    uv: [u32; 2],
-}
-
-/// An output vertex made for a position of the mesh being added: its key,
-/// the vertex, and the next entry of the same position (`NO_ENTRY`: none).
-#[derive(Clone, Copy)]
-struct SharedVertex {
-    key: VertexKey,
-    vertex: u32,
-    next: u32,
-}
-
-const NO_ENTRY: u32 = u32::MAX;
 
 pub(crate) struct GltfWriter {
     path: PathBuf,
@@ -386,14 +294,6 @@ pub(crate) struct GltfWriter {
     alpha_maps: Vec<bool>,
     /// Whether some material uses `KHR_texture_transform`.
     uses_transform: bool,
-    /// Output vertex of each corner of the mesh being added.
-    corner_vertex: Vec<u32>,
-    /// The output vertices made for each position of the mesh being added
-    /// (per position the first entry in `shared`, chained by `next`): a
-    /// position rarely has more than a few, so this is a short walk
-    /// instead of hashing every corner.
-    first_shared: Vec<u32>,
-    shared: Vec<SharedVertex>,
     /// Vertex data held by all buckets, in bytes, and how much may be held
     /// before it is written out.
     held: usize,
@@ -436,9 +336,6 @@ impl GltfWriter {
             maps: Vec::new(),
             alpha_maps: Vec::new(),
             uses_transform: false,
-            corner_vertex: Vec::new(),
-            first_shared: Vec::new(),
-            shared: Vec::new(),
             held: 0,
             flush_bytes: flush_mib.saturating_mul(1 << 20),
             written: Vec::new(),
@@ -466,46 +363,7 @@ impl GltfWriter {
         textures: &mut Textures,
         warnings: &mut Vec<String>,
     ) {
-        let mut maps = Vec::new();
-        for (slot, channel) in [
-            (Slot::BaseColor, 0),
-            (Slot::Normal, 5),
-            (Slot::Emissive, 6),
-            (Slot::Occlusion, 7),
-        ] {
-            if let Some(texture) = usable(textures, warnings, &material.maps[channel].path) {
-                maps.push(MapUse {
-                    slot,
-                    texture,
-                    channel,
-                });
-            }
-        }
-        // glTF packs roughness (green) and metalness (blue) into one image.
-        // The same image for both layers is exactly that; a roughness map
-        // alone works too when the material is not metallic (the factor
-        // zeroes the blue channel). Other combinations cannot be written.
-        let (rough, metal) = (&material.maps[8].path, &material.maps[9].path);
-        let packed = match (rough.is_empty(), metal.is_empty()) {
-            (false, false) if rough == metal => Some(8),
-            (false, true) if material.metallic == 0.0 => Some(8),
-            (true, true) => None,
-            _ => {
-                warnings.push(format!(
-                    "roughness map '{rough}' and metallic map '{metal}' are not one image, as glTF requires; written without them"
-                ));
-                None
-            }
-        };
-        if let Some(texture) =
-            packed.and_then(|k| usable(textures, warnings, &material.maps[k].path))
-        {
-            maps.push(MapUse {
-                slot: Slot::MetallicRoughness,
-                texture,
-                channel: 8,
-            });
-        }
+        let maps = texture_uses(material, |path, w| usable(textures, w, path), warnings);
         // glTF has no opacity map of its own: opacity is the base colour
         // texture's alpha. An opacity map that is the colour map (what
         // `texture()` sets for images with alpha) is exactly that.
@@ -518,39 +376,26 @@ impl GltfWriter {
                 "opacity map '{opacity_map}' is not the colour map; glTF takes opacity from the colour map's alpha: written without it"
             ));
         }
-        let mut bucket = Bucket::new();
-        if !maps.is_empty() {
-            // Textured: every vertex needs coordinates, set 0 first.
-            bucket.sets.push(0);
-            for m in &maps {
-                if !bucket.sets.contains(&m.channel) {
-                    bucket.sets.push(m.channel);
-                }
-            }
-            bucket.coords = vec![Vec::new(); bucket.sets.len()];
-        }
-        if maps.iter().any(|m| m.slot == Slot::Normal) {
-            bucket.tangents = Some(Vec::new());
-        }
+        let (sets, tangents) = bucket_layout(&maps);
         if maps
             .iter()
             .any(|m| texture_transform(&material.maps[m.channel]).is_some())
         {
             self.uses_transform = true;
         }
-        self.buckets.push(bucket);
+        self.buckets.push(Bucket::with_layout(sets, tangents));
         self.maps.push(maps);
         self.alpha_maps.push(alpha);
     }
 
-    /// Starts a new input mesh; writes out the data held if it is more
-    /// than allowed (between meshes, as vertex sharing is per mesh).
-    pub(crate) fn begin_mesh(&mut self, mesh: &Mesh) -> Result<(), ExportError> {
+    /// Appends encoded vertex data of material `id` (see `encode`), first
+    /// writing out the data held if it is more than allowed.
+    pub(crate) fn append(&mut self, id: u32, data: &mut Bucket) -> Result<(), ExportError> {
         if self.held > self.flush_bytes {
             self.flush()?;
         }
-        self.begin_mesh_data(mesh);
-        Ok(())
+        self.held += data.bytes();
+        self.buckets[id as usize].append(data)
     }
 
     /// Writes every bucket's data as a primitive and empties the buckets.
@@ -582,113 +427,6 @@ impl GltfWriter {
             b.clear();
         }
         self.held = 0;
-        Ok(())
-    }
-
-    fn begin_mesh_data(&mut self, mesh: &Mesh) {
-        self.corner_vertex.clear();
-        self.corner_vertex.resize(mesh.corners.len(), 0);
-        self.first_shared.clear();
-        if mesh.normals.is_some() {
-            self.first_shared.resize(mesh.positions.len(), NO_ENTRY);
-        }
-        self.shared.clear();
-    }
-
-    pub(crate) fn add_face(&mut self, f: &FaceData) -> Result<(), ExportError> {
-        let GltfWriter {
-            buckets,
-            corner_vertex,
-            first_shared,
-            shared: made,
-            held,
-            ..
-        } = self;
-        let mesh = f.mesh;
-        let bucket = &mut buckets[f.material as usize];
-        let before = bucket.bytes();
-        let uvs = mesh.uvs[0].as_deref();
-        if uvs.is_some() && bucket.sets.is_empty() {
-            bucket.sets.push(0);
-            bucket.coords.push(vec![[0.0; 2]; bucket.positions.len()]);
-        }
-        // Vertices are shared only where one UV set is written (the key
-        // holds set 0's coordinates) and no tangents (which are per face).
-        let shared = bucket.sets.len() <= 1 && bucket.tangents.is_none();
-        let tangent = match bucket.tangents {
-            Some(_) => face_tangent(f),
-            None => (DVec3::X, 1.0),
-        };
-        // Where each written UV set reads: the mesh's set, else set 0.
-        let mut sources: [Option<&[DVec2]>; UV_SETS] = [None; UV_SETS];
-        for (src, &set) in sources.iter_mut().zip(&bucket.sets) {
-            *src = mesh.uvs[set].as_deref().or(uvs);
-        }
-        let sources = &sources[..bucket.sets.len()];
-        let loops = mesh.face_loops(f.face);
-        match f.normals {
-            Some(normals) if shared => {
-                bucket.reserve(loops.iter().map(|l| l.len as usize).sum());
-                let corners = loops.iter().flat_map(|&l| mesh.loop_corners(l));
-                for c in corners {
-                    let position = mesh.corners[c] as usize;
-                    let n = normals[c].try_normalize().unwrap_or(f.normal);
-                    let uv = uvs.map_or([0; 2], |u| u[c].as_vec2().to_array().map(f32::to_bits));
-                    let key = VertexKey {
-                        material: f.material,
-                        normal: n.as_vec3().to_array().map(f32::to_bits),
-                        uv,
-                    };
-                    let mut e = first_shared[position];
-                    while e != NO_ENTRY {
-                        let s = &made[e as usize];
-                        if s.key == key {
-                            break;
-                        }
-                        e = s.next;
-                    }
-                    corner_vertex[c] = if e != NO_ENTRY {
-                        made[e as usize].vertex
-                    } else {
-                        let v =
-                            bucket.push_vertex(f.positions[position], n, sources, c, tangent)?;
-                        made.push(SharedVertex {
-                            key,
-                            vertex: v,
-                            next: first_shared[position],
-                        });
-                        first_shared[position] = made.len() as u32 - 1;
-                        v
-                    };
-                }
-            }
-            // Every corner its own vertex: the attributes are appended one
-            // array at a time (a face's corners are mostly one range).
-            _ => match loops {
-                [l] => own_vertices(
-                    bucket,
-                    f,
-                    sources,
-                    tangent,
-                    corner_vertex,
-                    mesh.loop_corners(*l),
-                )?,
-                _ => own_vertices(
-                    bucket,
-                    f,
-                    sources,
-                    tangent,
-                    corner_vertex,
-                    loops.iter().flat_map(|&l| mesh.loop_corners(l)),
-                )?,
-            },
-        }
-        bucket.indices.extend(
-            f.triangles
-                .iter()
-                .map(|t| t.map(|c| corner_vertex[c as usize])),
-        );
-        *held += bucket.bytes() - before;
         Ok(())
     }
 
@@ -969,57 +707,6 @@ fn move_up(file: &mut File, start: u64, len: u64, by: u64) -> std::io::Result<()
         file.seek(SeekFrom::Start(from + by))?;
         file.write_all(&buf[..n as usize])?;
         end = from;
-    }
-    Ok(())
-}
-
-/// Appends one vertex per corner of face `f` (`corners`, in order) to
-/// `bucket`, recording each corner's vertex in `corner_vertex`: the values
-/// `Bucket::push_vertex` would append corner by corner, written one
-/// attribute array at a time. Without normals of its own every vertex has
-/// the face normal (flat shading), so the normal and tangent are converted
-/// once for the face.
-fn own_vertices(
-    bucket: &mut Bucket,
-    f: &FaceData,
-    sources: &[Option<&[DVec2]>],
-    tangent: (DVec3, f64),
-    corner_vertex: &mut [u32],
-    corners: impl Iterator<Item = usize> + Clone,
-) -> Result<(), ExportError> {
-    let mesh = f.mesh;
-    let count = corners.clone().count();
-    let first = bucket.positions.len();
-    // Vertex indices are u32: the last one must fit.
-    if first + count > u32::MAX as usize + 1 {
-        return Err(too_many_vertices());
-    }
-    bucket.reserve(count);
-    for (v, c) in (first as u32..).zip(corners.clone()) {
-        bucket.push_position(f.positions[mesh.corners[c] as usize]);
-        corner_vertex[c] = v;
-    }
-    match f.normals {
-        Some(normals) => {
-            for c in corners.clone() {
-                let n = normals[c].try_normalize().unwrap_or(f.normal);
-                bucket.normals.push(n.as_vec3().to_array());
-                if let Some(tangents) = &mut bucket.tangents {
-                    tangents.push(vertex_tangent(n, tangent));
-                }
-            }
-        }
-        None => {
-            let n = f.normal.as_vec3().to_array();
-            bucket.normals.extend(std::iter::repeat_n(n, count));
-            if let Some(tangents) = &mut bucket.tangents {
-                let t = vertex_tangent(f.normal, tangent);
-                tangents.extend(std::iter::repeat_n(t, count));
-            }
-        }
-    }
-    for (src, coords) in sources.iter().zip(&mut bucket.coords) {
-        coords.extend(corners.clone().map(|c| uv_at(*src, c)));
     }
     Ok(())
 }

@@ -26,12 +26,15 @@
 //! # Ok::<(), cga_export::ExportError>(())
 //! ```
 
+mod bucket;
 pub mod builtin;
+mod encode;
 mod faces;
 mod gltf;
 mod hash;
 mod materials;
 mod obj;
+mod prepare;
 mod textures;
 
 use std::fmt;
@@ -40,13 +43,13 @@ use std::path::{Path, PathBuf};
 use cga_geometry::mesh::SharedVec;
 use cga_geometry::{DAffine3, DVec3, Material, Mesh};
 
-use crate::faces::{face_is_finite, face_normals};
-use crate::hash::FastMap;
-use crate::materials::MaterialTable;
-use crate::textures::Textures;
+use std::sync::Arc;
 
-/// The triangulation every writer uses.
-use cga_geometry::triangulate::triangulate_face_with_normal;
+use crate::encode::EncoderShared;
+pub use crate::encode::{Encoded, Encoder};
+use crate::materials::MaterialTable;
+use crate::prepare::{FacePrep, SlotIds};
+use crate::textures::{TextureProbe, Textures};
 
 /// Output file format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -203,7 +206,8 @@ impl std::error::Error for ExportError {
 }
 
 /// One face on its way to a writer: the triangulation and the normal are
-/// computed once, by [`ModelWriter`], for every format.
+/// computed once (`prepare::FacePrep`), for every format.
+#[derive(Clone, Copy)]
 pub(crate) struct FaceData<'a> {
     pub mesh: &'a Mesh,
     /// Where the mesh's vertices are placed (world coordinates): the mesh's
@@ -212,7 +216,8 @@ pub(crate) struct FaceData<'a> {
     /// The per-corner normals as placed, if the mesh has normals.
     pub normals: Option<&'a [DVec3]>,
     pub face: usize,
-    /// Output material id.
+    /// Output material id (from `FacePrep`: the face's material slot, which
+    /// the writer maps to its id).
     pub material: u32,
     /// Unit face normal (flat shading when the mesh has no normals).
     pub normal: DVec3,
@@ -221,8 +226,10 @@ pub(crate) struct FaceData<'a> {
 }
 
 enum Sink {
-    Gltf(gltf::GltfWriter),
-    Obj(obj::ObjWriter),
+    /// glTF's faces go through an encoder: the writer's own for meshes
+    /// added here, or those of other threads ([`ModelWriter::append`]).
+    Gltf(gltf::GltfWriter, Box<Encoder>),
+    Obj(obj::ObjWriter, FacePrep, SlotIds),
 }
 
 /// Streams meshes into a GLB, glTF or OBJ file; see the crate docs.
@@ -233,30 +240,12 @@ enum Sink {
 pub struct ModelWriter {
     table: MaterialTable,
     textures: Textures,
+    /// What this writer's encoders share (glTF).
+    encoders: Arc<EncoderShared>,
     sink: Sink,
-    /// Output material id of each material slot of the mesh being added
-    /// (`UNSEEN` until a face uses the slot).
-    slot_ids: Vec<u32>,
-    /// The slot ids of material lists seen before, by the address of the
-    /// shared list (the entry holds a clone, so the address stays valid):
-    /// the many shapes that share a material list are looked up once, not
-    /// compared by value slot by slot.
-    known_slots: FastMap<usize, (SharedVec<Material>, Vec<u32>)>,
-    triangles: Vec<[u32; 3]>,
-    /// Placed positions and normals of the mesh being added.
-    positions: Vec<DVec3>,
-    normals: Vec<DVec3>,
-    /// A placed copy of a mesh whose map mirrors it (its faces reversed).
-    mirrored: Option<Box<Mesh>>,
     stats: ExportStats,
     skipped_non_finite: u64,
 }
-
-const UNSEEN: u32 = u32::MAX;
-
-/// Entries of [`ModelWriter::known_slots`] above which it is emptied, so
-/// memory stays bounded on cities of distinct materials.
-const KNOWN_SLOTS_LIMIT: usize = 1 << 12;
 
 impl ModelWriter {
     /// Creates the output file (and, for glTF and OBJ, claims the names of
@@ -270,6 +259,9 @@ impl ModelWriter {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         };
+        let encoders = Arc::new(EncoderShared::new(TextureProbe::new(
+            &options.texture_roots,
+        )));
         let (sink, reserved) = match format {
             Format::Glb | Format::Gltf => {
                 let w = gltf::GltfWriter::create(
@@ -280,7 +272,8 @@ impl ModelWriter {
                     options.flush_mib,
                 )?;
                 let reserved = w.file_names();
-                (Sink::Gltf(w), reserved)
+                let encoder = Box::new(Encoder::new(encoders.clone()));
+                (Sink::Gltf(w, encoder), reserved)
             }
             Format::Obj => {
                 let w = obj::ObjWriter::create(
@@ -288,7 +281,10 @@ impl ModelWriter {
                     options.georeference.map(Georeference::obj_comment),
                 )?;
                 let reserved = w.file_names();
-                (Sink::Obj(w), reserved)
+                (
+                    Sink::Obj(w, FacePrep::default(), SlotIds::default()),
+                    reserved,
+                )
             }
         };
         let reserved: Vec<&str> = reserved.iter().map(String::as_str).collect();
@@ -298,13 +294,8 @@ impl ModelWriter {
         Ok(ModelWriter {
             table: MaterialTable::default(),
             textures,
+            encoders,
             sink,
-            slot_ids: Vec::new(),
-            known_slots: FastMap::default(),
-            triangles: Vec::new(),
-            positions: Vec::new(),
-            normals: Vec::new(),
-            mirrored: None,
             stats: ExportStats::default(),
             skipped_non_finite: 0,
         })
@@ -331,136 +322,80 @@ impl ModelWriter {
         transform: Option<&DAffine3>,
         materials: &SharedVec<Material>,
     ) -> Result<(), ExportError> {
-        check_mesh(mesh, materials.len())?;
-        let mut positions = std::mem::take(&mut self.positions);
-        let mut normals = std::mem::take(&mut self.normals);
-        // Taken only when a map mirrors: moving a whole `Mesh` in and out
-        // for every leaf cost more than some leaves' writing.
-        let mut mirrored = None;
-        let view = match transform {
-            None => (mesh, &mesh.positions[..], mesh.normals.as_deref()),
-            Some(t) if t.matrix3.determinant() < 0.0 => {
-                let m = mirrored.insert(self.mirrored.take().unwrap_or_default());
-                m.copy_from(mesh);
-                cga_geometry::transform::transform(m, t);
-                cga_geometry::transform::reverse_faces(m);
-                let m: &Mesh = m;
-                (m, &m.positions[..], m.normals.as_deref())
-            }
-            Some(t) => {
-                positions.clear();
-                positions.extend(mesh.positions.iter().map(|&p| t.transform_point3(p)));
-                let n = mesh.normals.as_ref().map(|src| {
-                    let nm = cga_geometry::transform::normal_matrix(t);
-                    normals.clear();
-                    normals.extend(src.iter().map(|&n| (nm * n).normalize_or_zero()));
-                    &normals[..]
-                });
-                (mesh, &positions[..], n)
-            }
-        };
-        let result = self.add_view(view, materials);
-        self.positions = positions;
-        self.normals = normals;
-        if mirrored.is_some() {
-            self.mirrored = mirrored;
-        }
-        result
-    }
-
-    fn add_view(
-        &mut self,
-        (mesh, positions, normals): (&Mesh, &[DVec3], Option<&[DVec3]>),
-        materials: &SharedVec<Material>,
-    ) -> Result<(), ExportError> {
-        let key = materials.as_ptr() as usize;
-        match self.known_slots.get_mut(&key) {
-            Some((_, ids)) => std::mem::swap(&mut self.slot_ids, ids),
-            None => {
-                self.slot_ids.clear();
-                self.slot_ids.resize(materials.len(), UNSEEN);
-            }
-        }
         match &mut self.sink {
-            Sink::Gltf(w) => w.begin_mesh(mesh)?,
-            Sink::Obj(w) => w.begin_mesh(mesh),
-        }
-        // Most meshes are finite throughout: then no face needs the check.
-        let all_finite = positions.iter().all(|p| p.is_finite())
-            && mesh.uvs[0]
-                .as_ref()
-                .is_none_or(|u| u.iter().all(|t| t.is_finite()))
-            && normals.is_none_or(|n| n.iter().all(|v| v.is_finite()));
-        let mut result = Ok(());
-        for face in 0..mesh.faces.len() {
-            if mesh.outer_loop(face).len < 3 {
-                continue;
+            Sink::Gltf(_, encoder) => {
+                encoder.add_placed(mesh, transform, materials);
+                let batch = encoder.take();
+                self.append(batch)
             }
-            if !all_finite && !face_is_finite(mesh, positions, normals, face) {
-                self.skipped_non_finite += 1;
-                continue;
-            }
-            self.triangles.clear();
-            let (unit, normal) = face_normals(mesh, positions, face);
-            triangulate_face_with_normal(mesh, positions, face, unit, &mut self.triangles);
-            if self.triangles.is_empty() {
-                continue;
-            }
-            // No normal means zero area: nothing to see, and no valid normal
-            // to write.
-            let Some(normal) =
-                normal.or_else(|| triangles_normal(mesh, positions, &self.triangles))
-            else {
-                continue;
-            };
-            let slot = mesh.faces[face].material as usize;
-            if self.slot_ids[slot] == UNSEEN {
-                self.slot_ids[slot] = self.intern(&materials[slot]);
-            }
-            let data = FaceData {
-                mesh,
-                positions,
-                normals,
-                face,
-                material: self.slot_ids[slot],
-                normal,
-                triangles: &self.triangles,
-            };
-            result = match &mut self.sink {
-                Sink::Gltf(w) => w.add_face(&data),
-                Sink::Obj(w) => w.add_face(&data),
-            };
-            if result.is_err() {
-                break;
-            }
-            self.stats.faces += 1;
-            self.stats.triangles += self.triangles.len() as u64;
-        }
-        // Remember the slot ids of this material list for the next mesh
-        // that shares it.
-        match self.known_slots.get_mut(&key) {
-            Some((_, ids)) => std::mem::swap(&mut self.slot_ids, ids),
-            None => {
-                if self.known_slots.len() >= KNOWN_SLOTS_LIMIT {
-                    self.known_slots.clear();
-                }
-                self.known_slots
-                    .insert(key, (materials.clone(), self.slot_ids.clone()));
+            Sink::Obj(w, prep, slots) => {
+                check_mesh(mesh, materials.len())?;
+                let (table, textures, stats) =
+                    (&mut self.table, &mut self.textures, &mut self.stats);
+                w.begin_mesh(mesh);
+                slots.begin(materials);
+                let result = prep.faces(mesh, transform, |f| {
+                    let material = slots.id(f.material, || {
+                        let (id, new) = table.intern(&materials[f.material as usize]);
+                        if new {
+                            w.new_material(table.get(id), textures, &mut stats.warnings);
+                        }
+                        id
+                    });
+                    w.add_face(&FaceData { material, ..*f })?;
+                    stats.faces += 1;
+                    stats.triangles += f.triangles.len() as u64;
+                    Ok(())
+                });
+                slots.end(materials);
+                self.skipped_non_finite += result?;
+                Ok(())
             }
         }
-        result
     }
 
-    fn intern(&mut self, material: &Material) -> u32 {
-        let (id, new) = self.table.intern(material);
-        if new {
-            let warnings = &mut self.stats.warnings;
-            match &mut self.sink {
-                Sink::Gltf(w) => w.new_material(material, &mut self.textures, warnings),
-                Sink::Obj(w) => w.new_material(material, &mut self.textures, warnings),
-            }
+    /// An encoder for this writer's format, for another thread: it does the
+    /// work of [`add_placed`](ModelWriter::add_placed) there, and
+    /// [`append`](ModelWriter::append) adds its batches. `None` for OBJ,
+    /// whose meshes are added here.
+    pub fn encoder(&self) -> Option<Encoder> {
+        match self.sink {
+            Sink::Gltf(..) => Some(Encoder::new(self.encoders.clone())),
+            Sink::Obj(..) => None,
         }
-        id
+    }
+
+    /// Adds a batch of meshes an [`Encoder`] of this writer encoded: the
+    /// output is what adding the same meshes here, in the same order, gives.
+    /// Fails if a mesh in it was invalid. The batch's room goes back to the
+    /// encoders.
+    pub fn append(&mut self, mut batch: Encoded) -> Result<(), ExportError> {
+        if let Some(e) = batch.error.take() {
+            return Err(e);
+        }
+        let Sink::Gltf(w, _) = &mut self.sink else {
+            return Err(ExportError::InvalidMesh(
+                "encoded glTF data given to an OBJ writer".into(),
+            ));
+        };
+        // The batch's materials in their order of first use: interned in
+        // that order, they get the ids the faces would have given them.
+        for (material, data) in batch.materials.iter().zip(&mut batch.buckets) {
+            let (id, new) = self.table.intern(material);
+            if new {
+                w.new_material(
+                    self.table.get(id),
+                    &mut self.textures,
+                    &mut self.stats.warnings,
+                );
+            }
+            w.append(id, data)?;
+        }
+        self.stats.faces += batch.faces;
+        self.stats.triangles += batch.triangles;
+        self.skipped_non_finite += batch.skipped_non_finite;
+        self.encoders.recycle(batch);
+        Ok(())
     }
 
     /// Writes everything that is still pending and closes the files.
@@ -472,22 +407,11 @@ impl ModelWriter {
             ));
         }
         match self.sink {
-            Sink::Gltf(w) => w.finish(&self.table, &self.textures, &mut self.stats)?,
-            Sink::Obj(w) => w.finish(&self.table, &self.textures, &mut self.stats)?,
+            Sink::Gltf(w, _) => w.finish(&self.table, &self.textures, &mut self.stats)?,
+            Sink::Obj(w, ..) => w.finish(&self.table, &self.textures, &mut self.stats)?,
         }
         Ok(self.stats)
     }
-}
-
-/// Area-weighted normal of triangles, for faces whose outer loop alone is
-/// degenerate.
-fn triangles_normal(mesh: &Mesh, positions: &[DVec3], triangles: &[[u32; 3]]) -> Option<DVec3> {
-    let p = |c: u32| positions[mesh.corners[c as usize] as usize];
-    let n: DVec3 = triangles
-        .iter()
-        .map(|&[a, b, c]| (p(b) - p(a)).cross(p(c) - p(a)))
-        .sum();
-    n.try_normalize()
 }
 
 /// Rejects meshes whose indices would make a writer read out of bounds.

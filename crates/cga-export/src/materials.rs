@@ -129,6 +129,13 @@ impl MaterialTable {
         (id, new)
     }
 
+    /// The materials by id, leaving the table empty.
+    pub(crate) fn take_materials(&mut self) -> Vec<Material> {
+        let materials = std::mem::take(&mut self.materials);
+        *self = MaterialTable::default();
+        materials
+    }
+
     pub(crate) fn get(&self, id: u32) -> &Material {
         &self.materials[id as usize]
     }

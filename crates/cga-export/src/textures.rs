@@ -15,7 +15,7 @@ use std::collections::{HashMap, HashSet};
 use std::fs::File;
 use std::io::Read;
 use std::path::{Component, Path, PathBuf};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use crate::ExportError;
 
@@ -84,7 +84,7 @@ impl Textures {
             self.by_rule_path.insert(rule_path.clone(), found);
             return found;
         }
-        let found = self.locate(rule_path).and_then(|p| self.add(&p).ok());
+        let found = locate(&self.roots, rule_path).and_then(|p| self.add(&p).ok());
         if found.is_none() {
             let searched = if self.roots.is_empty() {
                 "the current directory".to_string()
@@ -103,35 +103,12 @@ impl Textures {
         found
     }
 
-    fn locate(&self, rule_path: &str) -> Option<PathBuf> {
-        let path = Path::new(rule_path);
-        if path.is_absolute() && path.is_file() {
-            return Some(path.to_path_buf());
-        }
-        let relative = rule_path.trim_start_matches(['/', '\\']);
-        if relative.is_empty() {
-            return None;
-        }
-        if self.roots.is_empty() {
-            let p = Path::new(relative);
-            return p.is_file().then(|| p.to_path_buf());
-        }
-        self.roots
-            .iter()
-            .map(|root| root.join(relative))
-            .find(|p| p.is_file())
-    }
-
     fn add(&mut self, path: &Path) -> std::io::Result<u32> {
         let source = path.canonicalize()?;
         if let Some(&i) = self.by_source.get(&source) {
             return Ok(i);
         }
-        let mut file = File::open(&source)?;
-        let len = file.metadata()?.len();
-        let mut magic = [0u8; 8];
-        let n = read_up_to(&mut file, &mut magic)?;
-        let mime = sniff_mime(&magic[..n]);
+        let (len, mime) = file_kind(&source)?;
         let out_name = self.unique_name(&source);
         let i = self.list.len() as u32;
         self.list.push(Texture {
@@ -228,6 +205,73 @@ impl Textures {
             }
         }
         Ok(())
+    }
+}
+
+/// Where a rule path names a file: an existing absolute path, else the
+/// first texture root holding it (a leading `/` dropped).
+fn locate(roots: &[PathBuf], rule_path: &str) -> Option<PathBuf> {
+    let path = Path::new(rule_path);
+    if path.is_absolute() && path.is_file() {
+        return Some(path.to_path_buf());
+    }
+    let relative = rule_path.trim_start_matches(['/', '\\']);
+    if relative.is_empty() {
+        return None;
+    }
+    if roots.is_empty() {
+        let p = Path::new(relative);
+        return p.is_file().then(|| p.to_path_buf());
+    }
+    roots
+        .iter()
+        .map(|root| root.join(relative))
+        .find(|p| p.is_file())
+}
+
+/// A file's size and image format (`None`: neither PNG nor JPEG).
+fn file_kind(path: &Path) -> std::io::Result<(u64, Option<&'static str>)> {
+    let mut file = File::open(path)?;
+    let len = file.metadata()?.len();
+    let mut magic = [0u8; 8];
+    let n = read_up_to(&mut file, &mut magic)?;
+    Ok((len, sniff_mime(&magic[..n])))
+}
+
+/// Tells, from any thread, whether a texture path will be usable in glTF
+/// (found, and PNG or JPEG), as [`Textures::resolve`] will find: encoders
+/// need it to lay out vertices before the writer resolves the texture.
+/// Each path is looked at once.
+pub(crate) struct TextureProbe {
+    roots: Vec<PathBuf>,
+    known: Mutex<HashMap<Arc<str>, bool>>,
+}
+
+impl TextureProbe {
+    pub(crate) fn new(roots: &[PathBuf]) -> TextureProbe {
+        TextureProbe {
+            roots: roots.to_vec(),
+            known: Mutex::new(HashMap::new()),
+        }
+    }
+
+    pub(crate) fn usable(&self, rule_path: &Arc<str>) -> bool {
+        if rule_path.is_empty() {
+            return false;
+        }
+        let lock = || self.known.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(&known) = lock().get(rule_path) {
+            return known;
+        }
+        let usable = if rule_path.starts_with(crate::builtin::PREFIX) {
+            crate::builtin::builtin_texture(rule_path).is_some()
+        } else {
+            locate(&self.roots, rule_path)
+                .and_then(|p| file_kind(&p).ok())
+                .is_some_and(|(_, mime)| mime.is_some())
+        };
+        lock().insert(rule_path.clone(), usable);
+        usable
     }
 }
 

@@ -1,0 +1,316 @@
+//! The vertex data of one material as glTF stores it, and how it grows: an
+//! [`Encoder`](crate::Encoder) fills buckets of its own off the writing
+//! thread, and the writer appends them to the model's buckets
+//! ([`Bucket::append`]). How the data is laid out in the file is
+//! `gltf`'s part.
+
+use cga_geometry::{DVec2, DVec3};
+
+use crate::ExportError;
+
+/// Vertex data of one material, kept as the `f32` and `u32` values the
+/// binary buffer holds (written as their little-endian bytes: on
+/// little-endian machines the arrays' own memory).
+#[derive(Default)]
+pub(crate) struct Bucket {
+    /// x, y, z per vertex (their number is the bucket's vertex count).
+    pub positions: Vec<[f32; 3]>,
+    /// x, y, z per vertex.
+    pub normals: Vec<[f32; 3]>,
+    /// The UV sets written as `TEXCOORD` arrays, set 0 first when present,
+    /// and their coordinates (`f32` u and flipped v per vertex). A set a mesh
+    /// lacks reads set 0 instead, as CGA does for texture layers; vertices
+    /// without either get (0, 0). Set 0 is added when the first mesh with
+    /// UVs comes (earlier vertices get (0, 0)); a textured material has it
+    /// from the start, with one more set per other texture layer it uses.
+    pub sets: Vec<usize>,
+    pub coords: Vec<Vec<[f32; 2]>>,
+    /// After `merge_equal_coords`: the `TEXCOORD` index of each set (sets
+    /// with equal coordinates share one array).
+    pub tex_coords: Vec<u32>,
+    /// `TANGENT` (x, y, z, w) per vertex, for normal-mapped materials.
+    pub tangents: Option<Vec<[f32; 4]>>,
+    /// Vertex indices per triangle.
+    pub indices: Vec<[u32; 3]>,
+    pub min: [f32; 3],
+    pub max: [f32; 3],
+}
+
+pub(crate) fn too_many_vertices() -> ExportError {
+    ExportError::TooLarge("more than 2^32 vertices with one material".into())
+}
+
+/// The tangent written for a vertex with normal `n` given the face's
+/// tangent: perpendicular to the normal, as glTF requires.
+#[inline]
+pub(crate) fn vertex_tangent(n: DVec3, (t, w): (DVec3, f64)) -> [f32; 4] {
+    let t = (t - n * n.dot(t))
+        .try_normalize()
+        .unwrap_or_else(|| n.any_orthonormal_vector());
+    let t = t.as_vec3();
+    [t.x, t.y, t.z, w as f32]
+}
+
+/// The written texture coordinates of `corner` from a UV source: v flipped
+/// (glTF puts v = 0 at the top of the image, CGA at the bottom); (0, 0)
+/// without a source.
+#[inline(always)]
+pub(crate) fn uv_at(src: Option<&[DVec2]>, corner: usize) -> [f32; 2] {
+    match src.and_then(|u| u.get(corner)) {
+        Some(t) => [t.x as f32, (1.0 - t.y) as f32],
+        None => [0.0, 0.0],
+    }
+}
+
+impl Bucket {
+    pub fn new() -> Bucket {
+        Bucket {
+            min: [f32::INFINITY; 3],
+            max: [f32::NEG_INFINITY; 3],
+            ..Bucket::default()
+        }
+    }
+
+    /// An empty bucket that writes the UV `sets` (set 0 first, if any) and,
+    /// if `tangents`, tangents.
+    pub fn with_layout(sets: Vec<usize>, tangents: bool) -> Bucket {
+        Bucket {
+            coords: vec![Vec::new(); sets.len()],
+            sets,
+            tangents: tangents.then(Vec::new),
+            ..Bucket::new()
+        }
+    }
+
+    /// Empties the bucket for a material that writes the UV `sets` and, if
+    /// `tangents`, tangents, keeping the arrays' room.
+    pub fn relayout(&mut self, sets: Vec<usize>, tangents: bool) {
+        self.clear();
+        self.coords.resize_with(sets.len(), Vec::new);
+        self.sets = sets;
+        self.tex_coords.clear();
+        self.tangents = match (tangents, self.tangents.take()) {
+            (true, t) => Some(t.unwrap_or_default()),
+            (false, _) => None,
+        };
+    }
+
+    /// Bytes of vertex data held.
+    pub fn bytes(&self) -> usize {
+        self.positions.len() * 12
+            + self.normals.len() * 12
+            + self.coords.iter().map(|c| c.len() * 8).sum::<usize>()
+            + self.tangents.as_ref().map_or(0, |t| t.len() * 16)
+            + self.indices.len() * 12
+    }
+
+    /// Empties the arrays (keeping their room), as for a new primitive.
+    pub fn clear(&mut self) {
+        self.positions.clear();
+        self.normals.clear();
+        self.coords.iter_mut().for_each(Vec::clear);
+        if let Some(t) = &mut self.tangents {
+            t.clear();
+        }
+        self.indices.clear();
+        self.min = [f32::INFINITY; 3];
+        self.max = [f32::NEG_INFINITY; 3];
+    }
+
+    /// Room for `n` more vertices.
+    pub fn reserve(&mut self, n: usize) {
+        self.positions.reserve(n);
+        self.normals.reserve(n);
+        for c in &mut self.coords {
+            c.reserve(n);
+        }
+        if let Some(t) = &mut self.tangents {
+            t.reserve(n);
+        }
+    }
+
+    /// Starts writing UV set 0, with (0, 0) for the vertices so far: the
+    /// first mesh with UVs of an untextured material.
+    pub fn start_coords(&mut self) {
+        self.sets.push(0);
+        self.coords.push(vec![[0.0; 2]; self.positions.len()]);
+    }
+
+    /// Appends a vertex at `p` with normal `n`; `sources[k]` is where the
+    /// `k`-th written UV set reads (see [`Bucket::sets`]), at `corner`.
+    #[inline(always)]
+    pub fn push_vertex(
+        &mut self,
+        p: DVec3,
+        n: DVec3,
+        sources: &[Option<&[DVec2]>],
+        corner: usize,
+        tangent: (DVec3, f64),
+    ) -> Result<u32, ExportError> {
+        let index = u32::try_from(self.positions.len()).map_err(|_| too_many_vertices())?;
+        self.push_position(p);
+        self.normals.push(n.as_vec3().to_array());
+        for (src, coords) in sources.iter().zip(&mut self.coords) {
+            coords.push(uv_at(*src, corner));
+        }
+        if let Some(tangents) = &mut self.tangents {
+            tangents.push(vertex_tangent(n, tangent));
+        }
+        Ok(index)
+    }
+
+    /// Appends a position and widens the bounds.
+    #[inline(always)]
+    pub fn push_position(&mut self, p: DVec3) {
+        let p = p.as_vec3().to_array();
+        self.widen(p, p);
+        self.positions.push(p);
+    }
+
+    /// Widens the bounds to take in `lo..hi`.
+    #[inline(always)]
+    fn widen(&mut self, lo: [f32; 3], hi: [f32; 3]) {
+        // `min` and `max` start at +inf and -inf (see `Bucket::new`) and are
+        // never NaN, so plain comparisons keep what `f32::min` and `max`
+        // would (a NaN coordinate changes nothing; of 0 and -0 the first
+        // stays) without their NaN handling. Widening by another bucket's
+        // bounds gives what pushing its positions one by one would.
+        for (((a, b), x), y) in self.min.iter_mut().zip(&mut self.max).zip(lo).zip(hi) {
+            if x < *a {
+                *a = x;
+            }
+            if y > *b {
+                *b = y;
+            }
+        }
+    }
+
+    /// Moves the data of `other` (filled for the same material) to the end
+    /// of this bucket, leaving `other` empty with its room: the result is
+    /// what pushing `other`'s vertices here would have given. Where the two
+    /// write different UV sets or tangents (a texture file that changed
+    /// between the encoder's look and the writer's), missing arrays are
+    /// filled with (0, 0) and default tangents and extra ones are dropped.
+    pub fn append(&mut self, other: &mut Bucket) -> Result<(), ExportError> {
+        let base = self.positions.len();
+        let added = other.positions.len();
+        if base + added > u32::MAX as usize + 1 {
+            return Err(too_many_vertices());
+        }
+        if self.sets.is_empty() && other.sets == [0] {
+            self.start_coords();
+        }
+        for (set, coords) in self.sets.iter().zip(&mut self.coords) {
+            match other.sets.iter().position(|s| s == set) {
+                Some(k) => coords.append(&mut other.coords[k]),
+                None => coords.resize(base + added, [0.0; 2]),
+            }
+        }
+        if let Some(tangents) = &mut self.tangents {
+            match &mut other.tangents {
+                Some(t) => tangents.append(t),
+                None => tangents.extend(other.normals.iter().map(|n| {
+                    let n = DVec3::from(n.map(f64::from));
+                    vertex_tangent(n, (n.any_orthonormal_vector(), 1.0))
+                })),
+            }
+        }
+        self.positions.append(&mut other.positions);
+        self.normals.append(&mut other.normals);
+        let base = base as u32;
+        self.indices
+            .extend(other.indices.iter().map(|t| t.map(|v| v + base)));
+        if added > 0 {
+            self.widen(other.min, other.max);
+        }
+        other.clear();
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(uvs: bool) -> Bucket {
+        let mut b = Bucket::new();
+        let src = [DVec2::new(0.25, 0.75), DVec2::new(1.0, 0.0)];
+        let sources = [uvs.then_some(&src[..])];
+        let sets = if uvs {
+            b.start_coords();
+            &sources[..]
+        } else {
+            &sources[..0]
+        };
+        for (i, x) in [-1.5, 2.0].into_iter().enumerate() {
+            b.push_vertex(DVec3::new(x, 0.5, -x), DVec3::Y, sets, i, (DVec3::X, 1.0))
+                .unwrap();
+        }
+        b.indices.push([0, 1, 0]);
+        b
+    }
+
+    #[test]
+    fn appending_gives_what_pushing_gives() {
+        let mut whole = Bucket::new();
+        let mut parts = Bucket::new();
+        for uvs in [false, true, false] {
+            let mut part = sample(uvs);
+            // Pushed into `whole` directly, as one writer would.
+            if uvs && whole.sets.is_empty() {
+                whole.start_coords();
+            }
+            let base = whole.positions.len() as u32;
+            let src = [DVec2::new(0.25, 0.75), DVec2::new(1.0, 0.0)];
+            let sources = [uvs.then_some(&src[..])];
+            let n = whole.sets.len();
+            for (i, x) in [-1.5, 2.0].into_iter().enumerate() {
+                whole
+                    .push_vertex(
+                        DVec3::new(x, 0.5, -x),
+                        DVec3::Y,
+                        &sources[..n],
+                        i,
+                        (DVec3::X, 1.0),
+                    )
+                    .unwrap();
+            }
+            whole.indices.push([base, base + 1, base]);
+            parts.append(&mut part).unwrap();
+            assert!(part.positions.is_empty() && part.indices.is_empty());
+        }
+        assert_eq!(parts.positions, whole.positions);
+        assert_eq!(parts.normals, whole.normals);
+        assert_eq!(parts.sets, [0]);
+        assert_eq!(parts.coords, whole.coords);
+        assert_eq!(parts.coords[0].len(), 6);
+        assert_eq!(parts.coords[0][0], [0.0, 0.0]);
+        assert_eq!(parts.coords[0][2], [0.25, 0.25]);
+        assert_eq!(parts.indices, [[0, 1, 0], [2, 3, 2], [4, 5, 4]]);
+        assert_eq!((parts.min, parts.max), (whole.min, whole.max));
+        assert_eq!(parts.min, [-1.5, 0.5, -2.0]);
+        assert_eq!(parts.max, [2.0, 0.5, 1.5]);
+    }
+
+    #[test]
+    fn differing_layouts_are_filled_not_lost() {
+        let mut target = Bucket::with_layout(vec![0, 5], true);
+        let mut part = sample(false);
+        target.append(&mut part).unwrap();
+        assert_eq!(target.positions.len(), 2);
+        assert_eq!(target.coords, [vec![[0.0; 2]; 2], vec![[0.0; 2]; 2]]);
+        let t = target.tangents.as_ref().unwrap();
+        assert_eq!(t.len(), 2);
+        // Perpendicular to the normal (y), as glTF requires.
+        assert!(t.iter().all(|t| t[1].abs() < 1e-6 && t[3] == 1.0));
+    }
+
+    #[test]
+    fn empty_buckets_leave_the_bounds_alone() {
+        let mut target = sample(false);
+        let (min, max) = (target.min, target.max);
+        target.append(&mut Bucket::new()).unwrap();
+        assert_eq!((target.min, target.max), (min, max));
+        assert_eq!(target.positions.len(), 2);
+    }
+}

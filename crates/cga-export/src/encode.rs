@@ -1,0 +1,406 @@
+//! Turning leaf meshes into glTF vertex data, on any thread.
+//!
+//! Placing, triangulating and converting a mesh's faces is most of the
+//! work of writing a model. An [`Encoder`] does it where the meshes are
+//! made (a worker thread deriving lots) into a batch of per-material
+//! vertex arrays, [`Encoded`]; the writing thread only appends batches, in
+//! order, to the model ([`ModelWriter::append`](crate::ModelWriter::append)),
+//! so the output does not depend on which thread encoded what. A batch
+//! names its materials by value; the writer gives them their ids, in the
+//! order of first appearance, as if it had seen the faces itself.
+
+use std::sync::{Arc, Mutex};
+
+use cga_geometry::mesh::SharedVec;
+use cga_geometry::{DAffine3, DVec2, DVec3, Material, Mesh, UV_SETS};
+
+use crate::bucket::{too_many_vertices, Bucket};
+use crate::gltf::{bucket_layout, face_tangent, texture_uses};
+use crate::materials::MaterialTable;
+use crate::prepare::{FacePrep, SlotIds};
+use crate::textures::TextureProbe;
+use crate::{check_mesh, ExportError, FaceData};
+
+/// Meshes encoded into vertex data, ready for [`ModelWriter::append`]
+/// (crate::ModelWriter::append).
+#[derive(Default)]
+pub struct Encoded {
+    /// The batch's materials, in order of first use by a written face.
+    pub(crate) materials: Vec<Material>,
+    /// Vertex data per material of `materials`.
+    pub(crate) buckets: Vec<Bucket>,
+    pub(crate) faces: u64,
+    pub(crate) triangles: u64,
+    /// Faces left out for non-finite values.
+    pub(crate) skipped_non_finite: u64,
+    /// Bytes of vertex data held.
+    pub(crate) bytes: usize,
+    /// The first invalid mesh given, which fails the model.
+    pub(crate) error: Option<ExportError>,
+    /// Emptied buckets of an earlier use of this batch, whose room new
+    /// materials take.
+    spare: Vec<Bucket>,
+}
+
+impl Encoded {
+    /// Bytes of vertex data the batch holds.
+    pub fn bytes(&self) -> usize {
+        self.bytes
+    }
+
+    /// Whether nothing was encoded (and nothing failed).
+    pub fn is_empty(&self) -> bool {
+        self.faces == 0 && self.skipped_non_finite == 0 && self.error.is_none()
+    }
+
+    /// A bucket for a new material of the batch, in the room of an old one
+    /// if there is one.
+    fn new_bucket(&mut self, sets: Vec<usize>, tangents: bool) {
+        let bucket = match self.spare.pop() {
+            Some(mut b) => {
+                b.relayout(sets, tangents);
+                b
+            }
+            None => Bucket::with_layout(sets, tangents),
+        };
+        self.buckets.push(bucket);
+    }
+
+    /// Empties the batch (its buckets were emptied by appending them),
+    /// keeping its room.
+    fn recycle(&mut self) {
+        self.materials.clear();
+        self.spare.append(&mut self.buckets);
+        self.faces = 0;
+        self.triangles = 0;
+        self.skipped_non_finite = 0;
+        self.bytes = 0;
+        self.error = None;
+    }
+}
+
+/// What the encoders of one writer share.
+pub(crate) struct EncoderShared {
+    /// Which textures the writer will find usable: that decides which UV
+    /// sets and tangents a material's vertices carry.
+    pub probe: TextureProbe,
+    /// Batches the writer has appended, for encoders to fill again: their
+    /// arrays keep their room, so a running model allocates no more.
+    pool: Mutex<Vec<Encoded>>,
+}
+
+impl EncoderShared {
+    pub(crate) fn new(probe: TextureProbe) -> EncoderShared {
+        EncoderShared {
+            probe,
+            pool: Mutex::new(Vec::new()),
+        }
+    }
+
+    fn pool(&self) -> std::sync::MutexGuard<'_, Vec<Encoded>> {
+        self.pool.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Takes back a batch that was appended.
+    pub(crate) fn recycle(&self, mut batch: Encoded) {
+        batch.recycle();
+        self.pool().push(batch);
+    }
+}
+
+/// Encodes meshes for a glTF or GLB [`ModelWriter`](crate::ModelWriter),
+/// which makes it ([`ModelWriter::encoder`](crate::ModelWriter::encoder)).
+/// One per thread; it keeps its scratch room from one mesh to the next.
+pub struct Encoder {
+    shared: Arc<EncoderShared>,
+    prep: FacePrep,
+    slots: SlotIds,
+    /// The materials of the batch being filled.
+    table: MaterialTable,
+    batch: Encoded,
+    vertices: VertexSharing,
+}
+
+impl Encoder {
+    pub(crate) fn new(shared: Arc<EncoderShared>) -> Encoder {
+        Encoder {
+            shared,
+            prep: FacePrep::default(),
+            slots: SlotIds::default(),
+            table: MaterialTable::default(),
+            batch: Encoded::default(),
+            vertices: VertexSharing::default(),
+        }
+    }
+
+    /// A new encoder for the same writer (for another thread).
+    pub fn another(&self) -> Encoder {
+        Encoder::new(self.shared.clone())
+    }
+
+    /// Encodes one shape's geometry, given in its own coordinates and
+    /// placed in the world by `transform`, with `materials` for its
+    /// material slots (see [`ModelWriter::add_placed`]
+    /// (crate::ModelWriter::add_placed), whose output this gives). An
+    /// invalid mesh fails the batch: appending it returns the error.
+    pub fn add_placed(
+        &mut self,
+        mesh: &Mesh,
+        transform: Option<&DAffine3>,
+        materials: &SharedVec<Material>,
+    ) {
+        if self.batch.error.is_some() {
+            return;
+        }
+        if let Err(e) = check_mesh(mesh, materials.len()) {
+            self.batch.error = Some(e);
+            return;
+        }
+        let Encoder {
+            shared,
+            prep,
+            slots,
+            table,
+            batch,
+            vertices,
+        } = self;
+        slots.begin(materials);
+        vertices.begin(mesh);
+        let result = prep.faces(mesh, transform, |f| {
+            let material = slots.id(f.material, || {
+                let (id, new) = table.intern(&materials[f.material as usize]);
+                if new {
+                    let uses = texture_uses(
+                        table.get(id),
+                        |path, _| shared.probe.usable(path).then_some(0),
+                        &mut Vec::new(),
+                    );
+                    let (sets, tangents) = bucket_layout(&uses);
+                    batch.new_bucket(sets, tangents);
+                }
+                id
+            });
+            let bucket = &mut batch.buckets[material as usize];
+            let before = bucket.bytes();
+            add_face(bucket, vertices, &FaceData { material, ..*f })?;
+            batch.bytes += bucket.bytes() - before;
+            batch.faces += 1;
+            batch.triangles += f.triangles.len() as u64;
+            Ok(())
+        });
+        slots.end(materials);
+        match result {
+            Ok(skipped) => batch.skipped_non_finite += skipped,
+            Err(e) => batch.error = Some(e),
+        }
+    }
+
+    /// Bytes of vertex data encoded since the last [`take`](Encoder::take).
+    pub fn bytes(&self) -> usize {
+        self.batch.bytes
+    }
+
+    /// The meshes encoded since the last call, as one batch; the encoder
+    /// starts an empty one.
+    pub fn take(&mut self) -> Encoded {
+        let fresh = self.shared.pool().pop().unwrap_or_default();
+        let mut batch = std::mem::replace(&mut self.batch, fresh);
+        batch.materials = self.table.take_materials();
+        // Slot ids name this batch's materials.
+        self.slots.clear();
+        batch
+    }
+}
+
+/// Identifies a vertex at one position of an input mesh that carries its
+/// own normals, so corners that share position, normal and UV (and
+/// material) share one output vertex.
+#[derive(Clone, Copy, PartialEq, Eq)]
+struct VertexKey {
+    material: u32,
+    normal: [u32; 3],
+    uv: [u32; 2],
+}
+
+/// An output vertex made for a position of the mesh being added: its key,
+/// the vertex, and the next entry of the same position (`NO_ENTRY`: none).
+#[derive(Clone, Copy)]
+struct SharedVertex {
+    key: VertexKey,
+    vertex: u32,
+    next: u32,
+}
+
+const NO_ENTRY: u32 = u32::MAX;
+
+/// Which output vertex each corner of the mesh being encoded became.
+#[derive(Default)]
+struct VertexSharing {
+    /// Output vertex of each corner.
+    corner_vertex: Vec<u32>,
+    /// The output vertices made for each position (per position the first
+    /// entry in `shared`, chained by `next`): a position rarely has more
+    /// than a few, so this is a short walk instead of hashing every corner.
+    first_shared: Vec<u32>,
+    shared: Vec<SharedVertex>,
+}
+
+impl VertexSharing {
+    fn begin(&mut self, mesh: &Mesh) {
+        self.corner_vertex.clear();
+        self.corner_vertex.resize(mesh.corners.len(), 0);
+        self.first_shared.clear();
+        if mesh.normals.is_some() {
+            self.first_shared.resize(mesh.positions.len(), NO_ENTRY);
+        }
+        self.shared.clear();
+    }
+}
+
+/// Appends face `f` to the bucket of its material: its vertices and
+/// triangles. Corners of a mesh with its own normals share vertices where
+/// position, normal and UV agree; other faces get a vertex per corner.
+fn add_face(
+    bucket: &mut Bucket,
+    sharing: &mut VertexSharing,
+    f: &FaceData,
+) -> Result<(), ExportError> {
+    let VertexSharing {
+        corner_vertex,
+        first_shared,
+        shared: made,
+    } = sharing;
+    let mesh = f.mesh;
+    let uvs = mesh.uvs[0].as_deref();
+    if uvs.is_some() && bucket.sets.is_empty() {
+        bucket.start_coords();
+    }
+    // Vertices are shared only where one UV set is written (the key
+    // holds set 0's coordinates) and no tangents (which are per face).
+    let shared = bucket.sets.len() <= 1 && bucket.tangents.is_none();
+    let tangent = match bucket.tangents {
+        Some(_) => face_tangent(f),
+        None => (DVec3::X, 1.0),
+    };
+    // Where each written UV set reads: the mesh's set, else set 0.
+    let mut sources: [Option<&[DVec2]>; UV_SETS] = [None; UV_SETS];
+    for (src, &set) in sources.iter_mut().zip(&bucket.sets) {
+        *src = mesh.uvs[set].as_deref().or(uvs);
+    }
+    let sources = &sources[..bucket.sets.len()];
+    let loops = mesh.face_loops(f.face);
+    match f.normals {
+        Some(normals) if shared => {
+            bucket.reserve(loops.iter().map(|l| l.len as usize).sum());
+            let corners = loops.iter().flat_map(|&l| mesh.loop_corners(l));
+            for c in corners {
+                let position = mesh.corners[c] as usize;
+                let n = normals[c].try_normalize().unwrap_or(f.normal);
+                let uv = uvs.map_or([0; 2], |u| u[c].as_vec2().to_array().map(f32::to_bits));
+                let key = VertexKey {
+                    material: f.material,
+                    normal: n.as_vec3().to_array().map(f32::to_bits),
+                    uv,
+                };
+                let mut e = first_shared[position];
+                while e != NO_ENTRY {
+                    let s = &made[e as usize];
+                    if s.key == key {
+                        break;
+                    }
+                    e = s.next;
+                }
+                corner_vertex[c] = if e != NO_ENTRY {
+                    made[e as usize].vertex
+                } else {
+                    let v = bucket.push_vertex(f.positions[position], n, sources, c, tangent)?;
+                    made.push(SharedVertex {
+                        key,
+                        vertex: v,
+                        next: first_shared[position],
+                    });
+                    first_shared[position] = made.len() as u32 - 1;
+                    v
+                };
+            }
+        }
+        // Every corner its own vertex: the attributes are appended one
+        // array at a time (a face's corners are mostly one range).
+        _ => match loops {
+            [l] => own_vertices(
+                bucket,
+                f,
+                sources,
+                tangent,
+                corner_vertex,
+                mesh.loop_corners(*l),
+            )?,
+            _ => own_vertices(
+                bucket,
+                f,
+                sources,
+                tangent,
+                corner_vertex,
+                loops.iter().flat_map(|&l| mesh.loop_corners(l)),
+            )?,
+        },
+    }
+    bucket.indices.extend(
+        f.triangles
+            .iter()
+            .map(|t| t.map(|c| corner_vertex[c as usize])),
+    );
+    Ok(())
+}
+
+/// Appends one vertex per corner of face `f` (`corners`, in order) to
+/// `bucket`, recording each corner's vertex in `corner_vertex`: the values
+/// `Bucket::push_vertex` would append corner by corner, written one
+/// attribute array at a time. Without normals of its own every vertex has
+/// the face normal (flat shading), so the normal and tangent are converted
+/// once for the face.
+fn own_vertices(
+    bucket: &mut Bucket,
+    f: &FaceData,
+    sources: &[Option<&[DVec2]>],
+    tangent: (DVec3, f64),
+    corner_vertex: &mut [u32],
+    corners: impl Iterator<Item = usize> + Clone,
+) -> Result<(), ExportError> {
+    use crate::bucket::{uv_at, vertex_tangent};
+    let mesh = f.mesh;
+    let count = corners.clone().count();
+    let first = bucket.positions.len();
+    // Vertex indices are u32: the last one must fit.
+    if first + count > u32::MAX as usize + 1 {
+        return Err(too_many_vertices());
+    }
+    bucket.reserve(count);
+    for (v, c) in (first as u32..).zip(corners.clone()) {
+        bucket.push_position(f.positions[mesh.corners[c] as usize]);
+        corner_vertex[c] = v;
+    }
+    match f.normals {
+        Some(normals) => {
+            for c in corners.clone() {
+                let n = normals[c].try_normalize().unwrap_or(f.normal);
+                bucket.normals.push(n.as_vec3().to_array());
+                if let Some(tangents) = &mut bucket.tangents {
+                    tangents.push(vertex_tangent(n, tangent));
+                }
+            }
+        }
+        None => {
+            let n = f.normal.as_vec3().to_array();
+            bucket.normals.extend(std::iter::repeat_n(n, count));
+            if let Some(tangents) = &mut bucket.tangents {
+                let t = vertex_tangent(f.normal, tangent);
+                tangents.extend(std::iter::repeat_n(t, count));
+            }
+        }
+    }
+    for (src, coords) in sources.iter().zip(&mut bucket.coords) {
+        coords.extend(corners.clone().map(|c| uv_at(*src, c)));
+    }
+    Ok(())
+}

@@ -457,11 +457,16 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
     let mut leaves = 0usize;
     let mut seen_warnings = std::collections::HashSet::new();
     // Leaves go to the writing thread in batches as they are emitted, so
-    // writing the model overlaps deriving it even for a single lot; for
-    // glTF and GLB the workers encode them into vertex data first, leaving
-    // the writing thread little to do. Without an output they are dropped
-    // where they were made.
-    let encoder = writer.as_ref().and_then(ModelWriter::encoder);
+    // writing the model overlaps deriving it even for a single lot. For
+    // glTF and GLB with several workers, the workers encode them into
+    // vertex data first, leaving the writing thread little to do; with one,
+    // the writing thread encodes them, so that two threads share the work.
+    // (The output is the same either way.) Without an output they are
+    // dropped where they were made.
+    let encoder = match jobs.max(1) {
+        1 => None,
+        _ => writer.as_ref().and_then(ModelWriter::encoder),
+    };
     let has_writer = writer.is_some();
     let new_batcher = || match &encoder {
         Some(e) => Batcher::Encode(Box::new(e.another()), 0),

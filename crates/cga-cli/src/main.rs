@@ -459,11 +459,11 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
     // Leaves go to the writing thread in batches as they are emitted, so
     // writing the model overlaps deriving it even for a single lot. For
     // glTF and GLB with several workers, the workers encode them into
-    // vertex data first, leaving the writing thread little to do; with one,
-    // the writing thread encodes them, so that two threads share the work.
-    // (The output is the same either way.) Without an output they are
-    // dropped where they were made.
-    let encoder = match jobs.max(1) {
+    // vertex data first, leaving the writing thread little to do; with one
+    // (one job, or one lot), the writing thread encodes them, so that two
+    // threads share the work. (The output is the same either way.) Without
+    // an output they are dropped where they were made.
+    let encoder = match jobs.max(1).min(lots.len()) {
         1 => None,
         _ => writer.as_ref().and_then(ModelWriter::encoder),
     };

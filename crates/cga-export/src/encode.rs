@@ -108,28 +108,122 @@ impl EncoderShared {
     }
 }
 
+/// Where encoded faces go: vertex data by material id.
+pub(crate) trait Buckets {
+    /// The id of material `m`, with a bucket made for it if it is new.
+    fn id_of(&mut self, m: &Material) -> u32;
+    fn bucket(&mut self, id: u32) -> &mut Bucket;
+}
+
+/// What encoding a mesh added.
+#[derive(Default, Clone, Copy)]
+pub(crate) struct Counts {
+    pub faces: u64,
+    pub triangles: u64,
+    /// Faces left out for non-finite values.
+    pub skipped_non_finite: u64,
+    /// Bytes of vertex data.
+    pub bytes: usize,
+}
+
+/// Scratch room for encoding meshes, kept from one mesh to the next.
+#[derive(Default)]
+pub(crate) struct MeshEncoder {
+    prep: FacePrep,
+    slots: SlotIds,
+    vertices: VertexSharing,
+}
+
+impl MeshEncoder {
+    /// Encodes one shape's geometry into `store`: given in its own
+    /// coordinates, placed by `transform`, with `materials` for its slots
+    /// (see [`ModelWriter::add_placed`](crate::ModelWriter::add_placed)).
+    /// The ids `store` gives are remembered per material list until
+    /// [`forget_ids`](MeshEncoder::forget_ids).
+    pub fn encode(
+        &mut self,
+        mesh: &Mesh,
+        transform: Option<&DAffine3>,
+        materials: &SharedVec<Material>,
+        store: &mut impl Buckets,
+    ) -> Result<Counts, ExportError> {
+        check_mesh(mesh, materials.len())?;
+        let MeshEncoder {
+            prep,
+            slots,
+            vertices,
+        } = self;
+        slots.begin(materials);
+        vertices.begin(mesh);
+        let mut counts = Counts::default();
+        let result = prep.faces(mesh, transform, |f| {
+            let material = slots.id(f.material, || store.id_of(&materials[f.material as usize]));
+            let bucket = store.bucket(material);
+            let before = bucket.bytes();
+            add_face(bucket, vertices, &FaceData { material, ..*f })?;
+            counts.bytes += bucket.bytes() - before;
+            counts.faces += 1;
+            counts.triangles += f.triangles.len() as u64;
+            Ok(())
+        });
+        slots.end(materials);
+        counts.skipped_non_finite = result?;
+        Ok(counts)
+    }
+
+    /// Forgets the ids of the material lists seen (the store's ids start
+    /// again).
+    pub fn forget_ids(&mut self) {
+        self.slots.clear();
+    }
+}
+
+/// The buckets of a batch: materials get ids of their own, in order of
+/// first use, and buckets laid out as the writer will lay them out.
+struct BatchBuckets<'a> {
+    table: &'a mut MaterialTable,
+    batch: &'a mut Encoded,
+    probe: &'a TextureProbe,
+}
+
+impl Buckets for BatchBuckets<'_> {
+    fn id_of(&mut self, m: &Material) -> u32 {
+        let (id, new) = self.table.intern(m);
+        if new {
+            let uses = texture_uses(
+                m,
+                |path, _| self.probe.usable(path).then_some(0),
+                &mut Vec::new(),
+            );
+            let (sets, tangents) = bucket_layout(&uses);
+            self.batch.new_bucket(sets, tangents);
+        }
+        id
+    }
+
+    fn bucket(&mut self, id: u32) -> &mut Bucket {
+        &mut self.batch.buckets[id as usize]
+    }
+}
+
 /// Encodes meshes for a glTF or GLB [`ModelWriter`](crate::ModelWriter),
 /// which makes it ([`ModelWriter::encoder`](crate::ModelWriter::encoder)).
 /// One per thread; it keeps its scratch room from one mesh to the next.
 pub struct Encoder {
     shared: Arc<EncoderShared>,
-    prep: FacePrep,
-    slots: SlotIds,
+    mesh: MeshEncoder,
     /// The materials of the batch being filled.
     table: MaterialTable,
     batch: Encoded,
-    vertices: VertexSharing,
 }
 
 impl Encoder {
     pub(crate) fn new(shared: Arc<EncoderShared>) -> Encoder {
         Encoder {
             shared,
-            prep: FacePrep::default(),
-            slots: SlotIds::default(),
+            mesh: MeshEncoder::default(),
             table: MaterialTable::default(),
             batch: Encoded::default(),
-            vertices: VertexSharing::default(),
         }
     }
 
@@ -149,48 +243,22 @@ impl Encoder {
         transform: Option<&DAffine3>,
         materials: &SharedVec<Material>,
     ) {
-        if self.batch.error.is_some() {
+        let batch = &mut self.batch;
+        if batch.error.is_some() {
             return;
         }
-        if let Err(e) = check_mesh(mesh, materials.len()) {
-            self.batch.error = Some(e);
-            return;
-        }
-        let Encoder {
-            shared,
-            prep,
-            slots,
-            table,
-            batch,
-            vertices,
-        } = self;
-        slots.begin(materials);
-        vertices.begin(mesh);
-        let result = prep.faces(mesh, transform, |f| {
-            let material = slots.id(f.material, || {
-                let (id, new) = table.intern(&materials[f.material as usize]);
-                if new {
-                    let uses = texture_uses(
-                        table.get(id),
-                        |path, _| shared.probe.usable(path).then_some(0),
-                        &mut Vec::new(),
-                    );
-                    let (sets, tangents) = bucket_layout(&uses);
-                    batch.new_bucket(sets, tangents);
-                }
-                id
-            });
-            let bucket = &mut batch.buckets[material as usize];
-            let before = bucket.bytes();
-            add_face(bucket, vertices, &FaceData { material, ..*f })?;
-            batch.bytes += bucket.bytes() - before;
-            batch.faces += 1;
-            batch.triangles += f.triangles.len() as u64;
-            Ok(())
-        });
-        slots.end(materials);
-        match result {
-            Ok(skipped) => batch.skipped_non_finite += skipped,
+        let mut store = BatchBuckets {
+            table: &mut self.table,
+            batch: &mut *batch,
+            probe: &self.shared.probe,
+        };
+        match self.mesh.encode(mesh, transform, materials, &mut store) {
+            Ok(c) => {
+                batch.faces += c.faces;
+                batch.triangles += c.triangles;
+                batch.skipped_non_finite += c.skipped_non_finite;
+                batch.bytes += c.bytes;
+            }
             Err(e) => batch.error = Some(e),
         }
     }
@@ -207,7 +275,7 @@ impl Encoder {
         let mut batch = std::mem::replace(&mut self.batch, fresh);
         batch.materials = self.table.take_materials();
         // Slot ids name this batch's materials.
-        self.slots.clear();
+        self.mesh.forget_ids();
         batch
     }
 }

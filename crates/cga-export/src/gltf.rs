@@ -43,6 +43,7 @@ use gltf_json as json;
 use json::validation::{Checked::Valid, USize64};
 
 use crate::bucket::Bucket;
+use crate::encode::Buckets;
 use crate::materials::{srgb_to_linear, MaterialTable};
 use crate::textures::{uri_encode, Textures};
 use crate::{ExportError, ExportStats, FaceData};
@@ -141,6 +142,31 @@ impl Bucket {
             write_le(w, tangents)?;
         }
         write_le(w, &self.indices)
+    }
+}
+
+/// The model's buckets, for meshes encoded on the writing thread: a
+/// material's id is its output id in the model's table, and a new one gets
+/// its glTF material and bucket at once.
+pub(crate) struct ModelBuckets<'a> {
+    pub writer: &'a mut GltfWriter,
+    pub table: &'a mut MaterialTable,
+    pub textures: &'a mut Textures,
+    pub warnings: &'a mut Vec<String>,
+}
+
+impl Buckets for ModelBuckets<'_> {
+    fn id_of(&mut self, m: &Material) -> u32 {
+        let (id, new) = self.table.intern(m);
+        if new {
+            self.writer
+                .new_material(self.table.get(id), self.textures, self.warnings);
+        }
+        id
+    }
+
+    fn bucket(&mut self, id: u32) -> &mut Bucket {
+        &mut self.writer.buckets[id as usize]
     }
 }
 
@@ -391,11 +417,23 @@ impl GltfWriter {
     /// Appends encoded vertex data of material `id` (see `encode`), first
     /// writing out the data held if it is more than allowed.
     pub(crate) fn append(&mut self, id: u32, data: &mut Bucket) -> Result<(), ExportError> {
+        self.flush_if_full()?;
+        self.held += data.bytes();
+        self.buckets[id as usize].append(data)
+    }
+
+    /// Writes out the data held if it is more than allowed: between input
+    /// meshes or batches, never inside one.
+    pub(crate) fn flush_if_full(&mut self) -> Result<(), ExportError> {
         if self.held > self.flush_bytes {
             self.flush()?;
         }
-        self.held += data.bytes();
-        self.buckets[id as usize].append(data)
+        Ok(())
+    }
+
+    /// Counts `bytes` of vertex data encoded into the buckets directly.
+    pub(crate) fn hold(&mut self, bytes: usize) {
+        self.held += bytes;
     }
 
     /// Writes every bucket's data as a primitive and empties the buckets.

@@ -45,8 +45,8 @@ use cga_geometry::{DAffine3, DVec3, Material, Mesh};
 
 use std::sync::Arc;
 
-use crate::encode::EncoderShared;
 pub use crate::encode::{Encoded, Encoder};
+use crate::encode::{EncoderShared, MeshEncoder};
 use crate::materials::MaterialTable;
 use crate::prepare::{FacePrep, SlotIds};
 use crate::textures::{TextureProbe, Textures};
@@ -226,9 +226,9 @@ pub(crate) struct FaceData<'a> {
 }
 
 enum Sink {
-    /// glTF's faces go through an encoder: the writer's own for meshes
-    /// added here, or those of other threads ([`ModelWriter::append`]).
-    Gltf(gltf::GltfWriter, Box<Encoder>),
+    /// glTF's faces are encoded here (`add_placed`) or by encoders of
+    /// other threads ([`ModelWriter::append`]).
+    Gltf(gltf::GltfWriter, Box<MeshEncoder>),
     Obj(obj::ObjWriter, FacePrep, SlotIds),
 }
 
@@ -272,8 +272,7 @@ impl ModelWriter {
                     options.flush_mib,
                 )?;
                 let reserved = w.file_names();
-                let encoder = Box::new(Encoder::new(encoders.clone()));
-                (Sink::Gltf(w, encoder), reserved)
+                (Sink::Gltf(w, Box::default()), reserved)
             }
             Format::Obj => {
                 let w = obj::ObjWriter::create(
@@ -323,10 +322,20 @@ impl ModelWriter {
         materials: &SharedVec<Material>,
     ) -> Result<(), ExportError> {
         match &mut self.sink {
-            Sink::Gltf(_, encoder) => {
-                encoder.add_placed(mesh, transform, materials);
-                let batch = encoder.take();
-                self.append(batch)
+            Sink::Gltf(w, encoder) => {
+                w.flush_if_full()?;
+                let mut store = gltf::ModelBuckets {
+                    writer: w,
+                    table: &mut self.table,
+                    textures: &mut self.textures,
+                    warnings: &mut self.stats.warnings,
+                };
+                let c = encoder.encode(mesh, transform, materials, &mut store)?;
+                w.hold(c.bytes);
+                self.stats.faces += c.faces;
+                self.stats.triangles += c.triangles;
+                self.skipped_non_finite += c.skipped_non_finite;
+                Ok(())
             }
             Sink::Obj(w, prep, slots) => {
                 check_mesh(mesh, materials.len())?;

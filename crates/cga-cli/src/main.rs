@@ -122,6 +122,10 @@ struct GenerateArgs {
     /// Largest asset file (OBJ, tables, texts) that is read, in MiB.
     #[arg(long, default_value_t = cga_engine::assets::DEFAULT_MAX_ASSET_MIB)]
     max_asset_mib: u64,
+    /// glTF/GLB: vertex data held before it is written out, in MiB (bounds
+    /// memory; more is fewer primitives per material).
+    #[arg(long, value_name = "MIB", default_value_t = cga_export::DEFAULT_FLUSH_MIB)]
+    held_mib: usize,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -420,6 +424,7 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
                     latitude: o.lat,
                     earth_radius: cga_engine::geo::EARTH_RADIUS,
                 }),
+                flush_mib: args.held_mib,
                 ..ExportOptions::default()
             };
             Some(
@@ -460,18 +465,23 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
     // writing the model overlaps deriving it even for a single lot. For
     // glTF and GLB with several workers, the workers encode them into
     // vertex data first, leaving the writing thread little to do; with one
-    // (one job, or one lot), the writing thread encodes them, so that two
-    // threads share the work. (The output is the same either way.) Without
-    // an output they are dropped where they were made.
-    let encoder = match jobs.max(1).min(lots.len()) {
-        1 => None,
-        _ => writer.as_ref().and_then(ModelWriter::encoder),
-    };
+    // (one job, or one lot), the writing thread encodes the leaves it is
+    // sent, so that two threads share the work. Either way a lot's leaves
+    // are encoded in the same batches (`Batcher`), so the model is written
+    // out at the same points and the output is the same. Without an output
+    // leaves are dropped where they were made.
+    let encoder = writer.as_ref().and_then(ModelWriter::encoder);
+    let workers_encode = jobs.max(1).min(lots.len()) > 1;
     let has_writer = writer.is_some();
     let new_batcher = || match &encoder {
-        Some(e) => Batcher::Encode(Box::new(e.another()), 0),
-        None if has_writer => Batcher::Leaves(Vec::new()),
-        None => Batcher::Drop,
+        Some(e) if workers_encode => Batcher::Encode(Box::new(e.another()), 0),
+        _ if has_writer => Batcher::Leaves(Vec::new()),
+        _ => Batcher::Drop,
+    };
+    // What the writing thread encodes itself.
+    let mut own_batcher = match &encoder {
+        Some(e) if !workers_encode => Batcher::Encode(Box::new(e.another()), 0),
+        _ => Batcher::Drop,
     };
     // Takes what the lots produce, in lot order: each batch into the writer
     // as it comes, then the lot's prints, diagnostics and reports.
@@ -483,6 +493,18 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
                     return Ok(());
                 };
                 match piece {
+                    Piece::Leaves(batch) if matches!(own_batcher, Batcher::Encode(..)) => {
+                        let mut result = Ok(());
+                        for leaf in batch {
+                            own_batcher.add(leaf, &mut |piece| {
+                                if let (Piece::Encoded(b, n), Ok(())) = (piece, &result) {
+                                    leaves += n;
+                                    result = w.append(b);
+                                }
+                            });
+                        }
+                        result.map_err(export)?;
+                    }
                     Piece::Leaves(batch) => {
                         leaves += batch.len();
                         for leaf in batch {
@@ -499,6 +521,16 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
             }
             Taken::Done(r) => r,
         };
+        if let Some(w) = writer.as_mut() {
+            let mut result = Ok(());
+            own_batcher.flush(&mut |piece| {
+                if let (Piece::Encoded(b, n), Ok(())) = (piece, &result) {
+                    leaves += n;
+                    result = w.append(b);
+                }
+            });
+            result.map_err(|e| Failure::Usage(format!("export failed: {e}")))?;
+        }
         {
             use std::io::Write;
             let mut stdout = std::io::stdout().lock();

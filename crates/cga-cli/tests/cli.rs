@@ -295,9 +295,11 @@ fn an_error_in_one_lot_does_not_stop_the_others() {
 }
 
 /// The written model does not depend on the number of threads: GLB and
-/// glTF are encoded on the deriving threads in batches and appended in lot
-/// order, OBJ is written from leaves on the writing thread. Lots of many
-/// leaves (more than one batch each) and of different materials.
+/// glTF are encoded in batches (on the deriving threads, or on the writing
+/// thread with one job) and appended in lot order, OBJ is written from
+/// leaves on the writing thread. Lots of many leaves (more than one batch
+/// each) and of different materials; with `--held-mib 1` the vertex data is
+/// written out early many times, at the same points whatever the threads.
 #[test]
 fn written_models_do_not_depend_on_the_thread_count() {
     let dir = temp_dir("jobs-bytes");
@@ -309,10 +311,10 @@ fn written_models_do_not_depend_on_the_thread_count() {
          Floor --> split(x) { ~0.7 : Tile }*\n\
          Tile --> case split.index % 2 == 0 : color(\"#cccccc\") X. else : color(0.2, 0.3, split.index / 40) extrude(0.2) Y.\n",
     );
-    for ext in ["glb", "gltf", "obj"] {
+    for (ext, held) in [("glb", "64"), ("glb", "1"), ("gltf", "1"), ("obj", "64")] {
         let mut want: Option<Vec<u8>> = None;
         for jobs in ["1", "2", "3"] {
-            let sub = dir.join(format!("{ext}-{jobs}"));
+            let sub = dir.join(format!("{ext}-{held}-{jobs}"));
             std::fs::create_dir_all(&sub).unwrap();
             let model = sub.join(format!("city.{ext}"));
             let out = run(&[
@@ -322,14 +324,22 @@ fn written_models_do_not_depend_on_the_thread_count() {
                 "grid:4x3",
                 "--jobs",
                 jobs,
+                "--held-mib",
+                held,
                 "-o",
                 model.to_str().unwrap(),
             ]);
             assert!(out.status.success(), "{}", stderr(&out));
             let mut bytes = std::fs::read(&model).unwrap();
+            if ext != "obj" {
+                assert_valid_gltf(&model);
+                let json = gltf_json(&model);
+                let prims = json["meshes"][0]["primitives"].as_array().unwrap().len();
+                // Written early: several primitives per material.
+                assert_eq!(prims > 1, held == "1", "{ext} {held}: {prims} primitives");
+            }
             if ext == "gltf" {
                 bytes.extend(std::fs::read(model.with_extension("bin")).unwrap());
-                assert_valid_gltf(&model);
             }
             // 12 lots, each with hundreds of leaves.
             let err = stderr(&out);
@@ -342,10 +352,25 @@ fn written_models_do_not_depend_on_the_thread_count() {
             assert!(leaves > 12 * 512, "{leaves} leaves");
             match &want {
                 None => want = Some(bytes),
-                Some(w) => assert!(*w == bytes, "{ext}: --jobs {jobs} wrote other bytes"),
+                Some(w) => assert!(
+                    *w == bytes,
+                    "{ext}, --held-mib {held}: --jobs {jobs} wrote other bytes"
+                ),
             }
         }
     }
+}
+
+/// The JSON of a glTF or GLB file.
+fn gltf_json(path: &std::path::Path) -> serde_json::Value {
+    let bytes = std::fs::read(path).unwrap();
+    let json = if bytes.starts_with(b"glTF") {
+        let len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+        bytes[20..20 + len].to_vec()
+    } else {
+        bytes
+    };
+    serde_json::from_slice(&json).unwrap()
 }
 
 /// Found by fuzzing: `extrude(888884) split(y) { 2 : X. }*` asks for

@@ -32,6 +32,7 @@ mod encode;
 mod faces;
 mod gltf;
 mod hash;
+mod held;
 mod materials;
 mod obj;
 mod prepare;
@@ -47,6 +48,7 @@ use std::sync::Arc;
 
 pub use crate::encode::{Encoded, Encoder};
 use crate::encode::{EncoderShared, MeshEncoder};
+pub use crate::gltf::DEFAULT_FLUSH_MIB;
 use crate::materials::MaterialTable;
 use crate::prepare::{FacePrep, SlotIds};
 use crate::textures::{TextureProbe, Textures};
@@ -404,6 +406,7 @@ impl ModelWriter {
         self.stats.triangles += batch.triangles;
         self.skipped_non_finite += batch.skipped_non_finite;
         self.encoders.recycle(batch);
+        self.encoders.give_back(w.take_spare());
         Ok(())
     }
 

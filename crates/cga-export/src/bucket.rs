@@ -1,7 +1,8 @@
 //! The vertex data of one material as glTF stores it, and how it grows: an
 //! [`Encoder`](crate::Encoder) fills buckets of its own off the writing
-//! thread, and the writer holds them as chunks of the material's data
-//! (`held`) until it writes them.
+//! thread, and the writer appends them to the model's buckets
+//! ([`Bucket::append`]). How the data is laid out in the file is
+//! `gltf`'s part.
 
 use cga_geometry::{DVec2, DVec3};
 
@@ -24,6 +25,9 @@ pub(crate) struct Bucket {
     /// from the start, with one more set per other texture layer it uses.
     pub sets: Vec<usize>,
     pub coords: Vec<Vec<[f32; 2]>>,
+    /// After `merge_equal_coords`: the `TEXCOORD` index of each set (sets
+    /// with equal coordinates share one array).
+    pub tex_coords: Vec<u32>,
     /// `TANGENT` (x, y, z, w) per vertex, for normal-mapped materials.
     pub tangents: Option<Vec<[f32; 4]>>,
     /// Vertex indices per triangle.
@@ -58,24 +62,6 @@ pub(crate) fn uv_at(src: Option<&[DVec2]>, corner: usize) -> [f32; 2] {
     }
 }
 
-/// Widens the bounds `min..max` to take in `lo..hi`.
-#[inline(always)]
-pub(crate) fn widen(min: &mut [f32; 3], max: &mut [f32; 3], lo: [f32; 3], hi: [f32; 3]) {
-    // Bounds start at +inf and -inf and are never NaN, so plain comparisons
-    // keep what `f32::min` and `max` would (a NaN coordinate changes
-    // nothing; of 0 and -0 the first stays) without their NaN handling.
-    // Widening by another bucket's bounds gives what pushing its positions
-    // one by one would.
-    for (((a, b), x), y) in min.iter_mut().zip(max).zip(lo).zip(hi) {
-        if x < *a {
-            *a = x;
-        }
-        if y > *b {
-            *b = y;
-        }
-    }
-}
-
 impl Bucket {
     pub fn new() -> Bucket {
         Bucket {
@@ -102,6 +88,7 @@ impl Bucket {
         self.clear();
         self.coords.resize_with(sets.len(), Vec::new);
         self.sets = sets;
+        self.tex_coords.clear();
         self.tangents = match (tangents, self.tangents.take()) {
             (true, t) => Some(t.unwrap_or_default()),
             (false, _) => None,
@@ -176,39 +163,68 @@ impl Bucket {
     #[inline(always)]
     pub fn push_position(&mut self, p: DVec3) {
         let p = p.as_vec3().to_array();
-        widen(&mut self.min, &mut self.max, p, p);
+        self.widen(p, p);
         self.positions.push(p);
     }
 
-    /// Makes the bucket carry the UV `sets` and, if `tangents`, tangents,
-    /// as the material's other chunks do (a texture file that changed
-    /// between an encoder's look and the writer's, or UVs that came late):
-    /// missing coordinates are (0, 0), missing tangents perpendicular to
-    /// the normals, extra arrays are dropped.
-    pub fn conform(&mut self, sets: &[usize], tangents: bool) {
-        let n = self.positions.len();
-        let mut coords: Vec<Vec<[f32; 2]>> = sets
-            .iter()
-            .map(|set| match self.sets.iter().position(|s| s == set) {
-                Some(k) => std::mem::take(&mut self.coords[k]),
-                None => vec![[0.0; 2]; n],
-            })
-            .collect();
-        std::mem::swap(&mut self.coords, &mut coords);
-        self.sets = sets.to_vec();
-        self.tangents = match (tangents, self.tangents.take()) {
-            (false, _) => None,
-            (true, Some(t)) => Some(t),
-            (true, None) => Some(
-                self.normals
-                    .iter()
-                    .map(|n| {
-                        let n = DVec3::from(n.map(f64::from));
-                        vertex_tangent(n, (n.any_orthonormal_vector(), 1.0))
-                    })
-                    .collect(),
-            ),
-        };
+    /// Widens the bounds to take in `lo..hi`.
+    #[inline(always)]
+    fn widen(&mut self, lo: [f32; 3], hi: [f32; 3]) {
+        // `min` and `max` start at +inf and -inf (see `Bucket::new`) and are
+        // never NaN, so plain comparisons keep what `f32::min` and `max`
+        // would (a NaN coordinate changes nothing; of 0 and -0 the first
+        // stays) without their NaN handling. Widening by another bucket's
+        // bounds gives what pushing its positions one by one would.
+        for (((a, b), x), y) in self.min.iter_mut().zip(&mut self.max).zip(lo).zip(hi) {
+            if x < *a {
+                *a = x;
+            }
+            if y > *b {
+                *b = y;
+            }
+        }
+    }
+
+    /// Moves the data of `other` (filled for the same material) to the end
+    /// of this bucket, leaving `other` empty with its room: the result is
+    /// what pushing `other`'s vertices here would have given. Where the two
+    /// write different UV sets or tangents (a texture file that changed
+    /// between the encoder's look and the writer's), missing arrays are
+    /// filled with (0, 0) and default tangents and extra ones are dropped.
+    pub fn append(&mut self, other: &mut Bucket) -> Result<(), ExportError> {
+        let base = self.positions.len();
+        let added = other.positions.len();
+        if base + added > u32::MAX as usize + 1 {
+            return Err(too_many_vertices());
+        }
+        if self.sets.is_empty() && other.sets == [0] {
+            self.start_coords();
+        }
+        for (set, coords) in self.sets.iter().zip(&mut self.coords) {
+            match other.sets.iter().position(|s| s == set) {
+                Some(k) => coords.append(&mut other.coords[k]),
+                None => coords.resize(base + added, [0.0; 2]),
+            }
+        }
+        if let Some(tangents) = &mut self.tangents {
+            match &mut other.tangents {
+                Some(t) => tangents.append(t),
+                None => tangents.extend(other.normals.iter().map(|n| {
+                    let n = DVec3::from(n.map(f64::from));
+                    vertex_tangent(n, (n.any_orthonormal_vector(), 1.0))
+                })),
+            }
+        }
+        self.positions.append(&mut other.positions);
+        self.normals.append(&mut other.normals);
+        let base = base as u32;
+        self.indices
+            .extend(other.indices.iter().map(|t| t.map(|v| v + base)));
+        if added > 0 {
+            self.widen(other.min, other.max);
+        }
+        other.clear();
+        Ok(())
     }
 }
 
@@ -220,56 +236,81 @@ mod tests {
         let mut b = Bucket::new();
         let src = [DVec2::new(0.25, 0.75), DVec2::new(1.0, 0.0)];
         let sources = [uvs.then_some(&src[..])];
-        if uvs {
+        let sets = if uvs {
             b.start_coords();
-        }
+            &sources[..]
+        } else {
+            &sources[..0]
+        };
         for (i, x) in [-1.5, 2.0].into_iter().enumerate() {
-            b.push_vertex(
-                DVec3::new(x, 0.5, -x),
-                DVec3::Y,
-                &sources[..b.sets.len()],
-                i,
-                (DVec3::X, 1.0),
-            )
-            .unwrap();
+            b.push_vertex(DVec3::new(x, 0.5, -x), DVec3::Y, sets, i, (DVec3::X, 1.0))
+                .unwrap();
         }
         b.indices.push([0, 1, 0]);
         b
     }
 
     #[test]
-    fn pushing_widens_the_bounds_and_flips_v() {
-        let b = sample(true);
-        assert_eq!(b.min, [-1.5, 0.5, -2.0]);
-        assert_eq!(b.max, [2.0, 0.5, 1.5]);
-        assert_eq!(b.coords, [vec![[0.25, 0.25], [1.0, 1.0]]]);
-        assert_eq!(b.bytes(), 2 * (12 + 12 + 8) + 12);
+    fn appending_gives_what_pushing_gives() {
+        let mut whole = Bucket::new();
+        let mut parts = Bucket::new();
+        for uvs in [false, true, false] {
+            let mut part = sample(uvs);
+            // Pushed into `whole` directly, as one writer would.
+            if uvs && whole.sets.is_empty() {
+                whole.start_coords();
+            }
+            let base = whole.positions.len() as u32;
+            let src = [DVec2::new(0.25, 0.75), DVec2::new(1.0, 0.0)];
+            let sources = [uvs.then_some(&src[..])];
+            let n = whole.sets.len();
+            for (i, x) in [-1.5, 2.0].into_iter().enumerate() {
+                whole
+                    .push_vertex(
+                        DVec3::new(x, 0.5, -x),
+                        DVec3::Y,
+                        &sources[..n],
+                        i,
+                        (DVec3::X, 1.0),
+                    )
+                    .unwrap();
+            }
+            whole.indices.push([base, base + 1, base]);
+            parts.append(&mut part).unwrap();
+            assert!(part.positions.is_empty() && part.indices.is_empty());
+        }
+        assert_eq!(parts.positions, whole.positions);
+        assert_eq!(parts.normals, whole.normals);
+        assert_eq!(parts.sets, [0]);
+        assert_eq!(parts.coords, whole.coords);
+        assert_eq!(parts.coords[0].len(), 6);
+        assert_eq!(parts.coords[0][0], [0.0, 0.0]);
+        assert_eq!(parts.coords[0][2], [0.25, 0.25]);
+        assert_eq!(parts.indices, [[0, 1, 0], [2, 3, 2], [4, 5, 4]]);
+        assert_eq!((parts.min, parts.max), (whole.min, whole.max));
+        assert_eq!(parts.min, [-1.5, 0.5, -2.0]);
+        assert_eq!(parts.max, [2.0, 0.5, 1.5]);
     }
 
     #[test]
-    fn conforming_fills_what_is_missing_and_drops_the_rest() {
-        let mut b = sample(true);
-        b.conform(&[0, 5], true);
-        assert_eq!(b.sets, [0, 5]);
-        assert_eq!(b.coords[0], [[0.25, 0.25], [1.0, 1.0]]);
-        assert_eq!(b.coords[1], [[0.0; 2]; 2]);
-        let t = b.tangents.as_ref().unwrap();
+    fn differing_layouts_are_filled_not_lost() {
+        let mut target = Bucket::with_layout(vec![0, 5], true);
+        let mut part = sample(false);
+        target.append(&mut part).unwrap();
+        assert_eq!(target.positions.len(), 2);
+        assert_eq!(target.coords, [vec![[0.0; 2]; 2], vec![[0.0; 2]; 2]]);
+        let t = target.tangents.as_ref().unwrap();
         assert_eq!(t.len(), 2);
         // Perpendicular to the normal (y), as glTF requires.
         assert!(t.iter().all(|t| t[1].abs() < 1e-6 && t[3] == 1.0));
-        b.conform(&[], false);
-        assert!(b.sets.is_empty() && b.coords.is_empty() && b.tangents.is_none());
-        assert_eq!(b.positions.len(), 2);
     }
 
     #[test]
-    fn a_relaid_bucket_keeps_its_room() {
-        let mut b = sample(true);
-        let room = b.positions.capacity();
-        b.relayout(vec![0, 7], false);
-        assert!(b.positions.is_empty() && b.positions.capacity() == room);
-        assert_eq!(b.sets, [0, 7]);
-        assert_eq!(b.coords.len(), 2);
-        assert_eq!((b.min, b.max), ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]));
+    fn empty_buckets_leave_the_bounds_alone() {
+        let mut target = sample(false);
+        let (min, max) = (target.min, target.max);
+        target.append(&mut Bucket::new()).unwrap();
+        assert_eq!((target.min, target.max), (min, max));
+        assert_eq!(target.positions.len(), 2);
     }
 }

@@ -37,6 +37,9 @@ pub struct Encoded {
     pub(crate) bytes: usize,
     /// The first invalid mesh given, which fails the model.
     pub(crate) error: Option<ExportError>,
+    /// Emptied buckets of an earlier use of this batch, whose room new
+    /// materials take.
+    spare: Vec<Bucket>,
 }
 
 impl Encoded {
@@ -50,11 +53,24 @@ impl Encoded {
         self.faces == 0 && self.skipped_non_finite == 0 && self.error.is_none()
     }
 
-    /// Empties the batch (its buckets were taken by the writer), keeping
-    /// its room.
+    /// A bucket for a new material of the batch, in the room of an old one
+    /// if there is one.
+    fn new_bucket(&mut self, sets: Vec<usize>, tangents: bool) {
+        let bucket = match self.spare.pop() {
+            Some(mut b) => {
+                b.relayout(sets, tangents);
+                b
+            }
+            None => Bucket::with_layout(sets, tangents),
+        };
+        self.buckets.push(bucket);
+    }
+
+    /// Empties the batch (its buckets were emptied by appending them),
+    /// keeping its room.
     fn recycle(&mut self) {
         self.materials.clear();
-        self.buckets.clear();
+        self.spare.append(&mut self.buckets);
         self.faces = 0;
         self.triangles = 0;
         self.skipped_non_finite = 0;
@@ -68,15 +84,9 @@ pub(crate) struct EncoderShared {
     /// Which textures the writer will find usable: that decides which UV
     /// sets and tangents a material's vertices carry.
     pub probe: TextureProbe,
-    /// Batches the writer has appended, for encoders to fill again.
+    /// Batches the writer has appended, for encoders to fill again: their
+    /// arrays keep their room, so a running model allocates no more.
     pool: Mutex<Vec<Encoded>>,
-    /// Buckets the writer has written out, whose room new buckets take: a
-    /// running model allocates no more vertex arrays than it holds.
-    spare: Mutex<Vec<Bucket>>,
-}
-
-fn locked<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 impl EncoderShared {
@@ -84,33 +94,17 @@ impl EncoderShared {
         EncoderShared {
             probe,
             pool: Mutex::new(Vec::new()),
-            spare: Mutex::new(Vec::new()),
         }
+    }
+
+    fn pool(&self) -> std::sync::MutexGuard<'_, Vec<Encoded>> {
+        self.pool.lock().unwrap_or_else(|e| e.into_inner())
     }
 
     /// Takes back a batch that was appended.
     pub(crate) fn recycle(&self, mut batch: Encoded) {
         batch.recycle();
-        locked(&self.pool).push(batch);
-    }
-
-    /// Takes back buckets that were written out.
-    pub(crate) fn give_back(&self, mut buckets: Vec<Bucket>) {
-        if !buckets.is_empty() {
-            locked(&self.spare).append(&mut buckets);
-        }
-    }
-
-    /// An empty bucket that writes the UV `sets` and, if `tangents`,
-    /// tangents, in the room of a spare one if there is one.
-    fn bucket(&self, sets: Vec<usize>, tangents: bool) -> Bucket {
-        match locked(&self.spare).pop() {
-            Some(mut b) => {
-                b.relayout(sets, tangents);
-                b
-            }
-            None => Bucket::with_layout(sets, tangents),
-        }
+        self.pool().push(batch);
     }
 }
 
@@ -189,21 +183,20 @@ impl MeshEncoder {
 struct BatchBuckets<'a> {
     table: &'a mut MaterialTable,
     batch: &'a mut Encoded,
-    shared: &'a EncoderShared,
+    probe: &'a TextureProbe,
 }
 
 impl Buckets for BatchBuckets<'_> {
     fn id_of(&mut self, m: &Material) -> u32 {
         let (id, new) = self.table.intern(m);
         if new {
-            let probe = &self.shared.probe;
             let uses = texture_uses(
                 m,
-                |path, _| probe.usable(path).then_some(0),
+                |path, _| self.probe.usable(path).then_some(0),
                 &mut Vec::new(),
             );
             let (sets, tangents) = bucket_layout(&uses);
-            self.batch.buckets.push(self.shared.bucket(sets, tangents));
+            self.batch.new_bucket(sets, tangents);
         }
         id
     }
@@ -257,7 +250,7 @@ impl Encoder {
         let mut store = BatchBuckets {
             table: &mut self.table,
             batch: &mut *batch,
-            shared: &self.shared,
+            probe: &self.shared.probe,
         };
         match self.mesh.encode(mesh, transform, materials, &mut store) {
             Ok(c) => {
@@ -278,7 +271,7 @@ impl Encoder {
     /// The meshes encoded since the last call, as one batch; the encoder
     /// starts an empty one.
     pub fn take(&mut self) -> Encoded {
-        let fresh = locked(&self.shared.pool).pop().unwrap_or_default();
+        let fresh = self.shared.pool().pop().unwrap_or_default();
         let mut batch = std::mem::replace(&mut self.batch, fresh);
         batch.materials = self.table.take_materials();
         // Slot ids name this batch's materials.

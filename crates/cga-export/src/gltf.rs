@@ -44,7 +44,6 @@ use json::validation::{Checked::Valid, USize64};
 
 use crate::bucket::Bucket;
 use crate::encode::Buckets;
-use crate::held::Held;
 use crate::materials::{srgb_to_linear, MaterialTable};
 use crate::textures::{uri_encode, Textures};
 use crate::{ExportError, ExportStats, FaceData};
@@ -73,20 +72,76 @@ pub const DEFAULT_FLUSH_MIB: usize = 64;
 /// binary data is moved up).
 const GLB_JSON_ROOM: u64 = 1 << 20;
 
-/// What the accessors of a material's held data as a primitive need.
-fn primitive(held: &Held, material: u32) -> PrimitiveLayout {
-    let vertices = held.vertices();
-    let (min, max) = held.bounds();
-    PrimitiveLayout {
-        material,
-        vertices: vertices as u64,
-        positions: vertices * 12,
-        normals: vertices * 12,
-        coords: vec![vertices * 8; held.written_sets.len()],
-        tangents: held.tangents.then_some(vertices * 16),
-        indices: held.triangles() * 12,
-        min,
-        max,
+/// Writes values as the little-endian bytes glTF's binary buffer holds.
+fn write_le<T: bytemuck::Pod>(w: &mut impl Write, values: &[T]) -> std::io::Result<()> {
+    if cfg!(target_endian = "little") {
+        return w.write_all(bytemuck::cast_slice(values));
+    }
+    // Every component is 4 bytes: swap each.
+    let mut buf = Vec::with_capacity(1 << 16);
+    for chunk in bytemuck::cast_slice::<T, [u8; 4]>(values).chunks(1 << 14) {
+        buf.clear();
+        buf.extend(
+            chunk
+                .iter()
+                .flat_map(|b| u32::from_ne_bytes(*b).to_le_bytes()),
+        );
+        w.write_all(&buf)?;
+    }
+    Ok(())
+}
+
+impl Bucket {
+    /// Keeps one coordinate array per distinct content: a layer whose UV set
+    /// no mesh had reads set 0's array.
+    fn merge_equal_coords(&mut self) {
+        let mut distinct: Vec<Vec<[f32; 2]>> = Vec::new();
+        self.tex_coords.clear();
+        for c in std::mem::take(&mut self.coords) {
+            // Compared as numbers: 0 equals -0, NaN equals nothing.
+            match distinct.iter().position(|d| *d == c) {
+                Some(i) => self.tex_coords.push(i as u32),
+                None => {
+                    self.tex_coords.push(distinct.len() as u32);
+                    distinct.push(c);
+                }
+            }
+        }
+        self.coords = distinct;
+    }
+
+    /// Each UV set in an array of its own (no merging), as once anything
+    /// was written early.
+    fn unmerged_coords(&mut self) {
+        self.tex_coords = (0..self.coords.len() as u32).collect();
+    }
+
+    /// What the accessors of this bucket's data as a primitive need.
+    fn primitive(&self, material: u32) -> PrimitiveLayout {
+        PrimitiveLayout {
+            material,
+            vertices: self.positions.len() as u64,
+            positions: self.positions.len() * 12,
+            normals: self.normals.len() * 12,
+            coords: self.coords.iter().map(|c| c.len() * 8).collect(),
+            tangents: self.tangents.as_ref().map(|t| t.len() * 16),
+            indices: self.indices.len() * 12,
+            min: self.min,
+            max: self.max,
+        }
+    }
+
+    /// The arrays in the order of the binary layout.
+    fn write_arrays(&self, w: &mut impl Write) -> std::io::Result<()> {
+        write_le(w, &self.positions)?;
+        write_le(w, &self.normals)?;
+        for coords in &self.coords {
+            write_le(w, coords)?;
+        }
+        if let Some(tangents) = &self.tangents {
+            write_le(w, tangents)?;
+        }
+        write_le(w, &self.indices)
     }
 }
 
@@ -111,7 +166,7 @@ impl Buckets for ModelBuckets<'_> {
     }
 
     fn bucket(&mut self, id: u32) -> &mut Bucket {
-        &mut self.writer.buckets[id as usize].open
+        &mut self.writer.buckets[id as usize]
     }
 }
 
@@ -257,12 +312,7 @@ pub(crate) struct GltfWriter {
     asset_extras: Option<serde_json::Value>,
     /// `.gltf`: file name of the `.bin` beside it.
     bin_name: String,
-    /// Vertex data held per material id.
-    buckets: Vec<Held>,
-    /// Emptied chunks whose room encoders may take (`take_spare`).
-    spare: Vec<Bucket>,
-    /// Room for vertex indices as written.
-    index_scratch: Vec<[u32; 3]>,
+    buckets: Vec<Bucket>,
     /// The textures of each material id.
     maps: Vec<Vec<MapUse>>,
     /// Whether each material takes its opacity from the colour map's alpha
@@ -309,8 +359,6 @@ impl GltfWriter {
             asset_extras,
             bin_name: format!("{stem}.bin"),
             buckets: Vec::new(),
-            spare: Vec::new(),
-            index_scratch: Vec::new(),
             maps: Vec::new(),
             alpha_maps: Vec::new(),
             uses_transform: false,
@@ -361,7 +409,7 @@ impl GltfWriter {
         {
             self.uses_transform = true;
         }
-        self.buckets.push(Held::new(sets, tangents));
+        self.buckets.push(Bucket::with_layout(sets, tangents));
         self.maps.push(maps);
         self.alpha_maps.push(alpha);
     }
@@ -370,14 +418,8 @@ impl GltfWriter {
     /// writing out the data held if it is more than allowed.
     pub(crate) fn append(&mut self, id: u32, data: &mut Bucket) -> Result<(), ExportError> {
         self.flush_if_full()?;
-        let chunk = std::mem::take(data);
-        self.held += chunk.bytes();
-        self.buckets[id as usize].push(chunk)
-    }
-
-    /// Emptied chunks, for encoders to fill again.
-    pub(crate) fn take_spare(&mut self) -> Vec<Bucket> {
-        std::mem::take(&mut self.spare)
+        self.held += data.bytes();
+        self.buckets[id as usize].append(data)
     }
 
     /// Writes out the data held if it is more than allowed: between input
@@ -412,15 +454,15 @@ impl GltfWriter {
             self.bin_out.as_mut().expect("created above")
         };
         for (id, b) in self.buckets.iter_mut().enumerate() {
-            b.seal()?;
-            if b.is_empty() {
+            if b.indices.is_empty() {
                 continue;
             }
             b.unmerged_coords();
-            b.write_arrays(out, &mut self.index_scratch).map_err(io)?;
+            b.write_arrays(out).map_err(io)?;
+            let p = b.primitive(id as u32);
             self.written_bytes += b.bytes() as u64;
-            self.written.push(primitive(b, id as u32));
-            b.clear(&mut self.spare);
+            self.written.push(p);
+            b.clear();
         }
         self.held = 0;
         Ok(())
@@ -453,7 +495,6 @@ impl GltfWriter {
         // carries each of its UV sets (the material names the set to read).
         let early = !self.written.is_empty();
         for b in &mut self.buckets {
-            b.seal()?;
             if early {
                 b.unmerged_coords();
             } else {
@@ -464,8 +505,8 @@ impl GltfWriter {
             .buckets
             .iter()
             .enumerate()
-            .filter(|(_, b)| !b.is_empty())
-            .map(|(id, b)| primitive(b, id as u32))
+            .filter(|(_, b)| !b.indices.is_empty())
+            .map(|(id, b)| b.primitive(id as u32))
             .collect();
         // Accessors in the order of the binary data; primitives by material.
         let mut primitives: Vec<Vec<json::mesh::Primitive>> = Vec::new();
@@ -1012,7 +1053,7 @@ fn gltf_material(
 /// positions, normals, UVs and indices, then the embedded `images`.
 fn write_bin(
     w: &mut impl Write,
-    buckets: &[Held],
+    buckets: &[Bucket],
     images: &[u32],
     textures: &Textures,
     path: &Path,
@@ -1020,9 +1061,8 @@ fn write_bin(
     let io = |e| ExportError::io(path, e);
     // The arrays hold the bytes to write; arrays larger than the output
     // buffer go to the file directly.
-    let mut scratch = Vec::new();
-    for b in buckets.iter().filter(|b| !b.is_empty()) {
-        b.write_arrays(w, &mut scratch).map_err(io)?;
+    for b in buckets.iter().filter(|b| !b.indices.is_empty()) {
+        b.write_arrays(w).map_err(io)?;
     }
     for &t in images {
         let tex = textures.get(t);
@@ -1045,4 +1085,37 @@ fn write_bin(
         w.write_all(&[0u8; 3][..pad]).map_err(io)?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn values_are_written_little_endian() {
+        let mut out = Vec::new();
+        write_le(&mut out, &[[1.5f32, -2.0]]).unwrap();
+        write_le(&mut out, &[[7u32, 1, 256]]).unwrap();
+        assert_eq!(
+            out,
+            [0, 0, 192, 63, 0, 0, 0, 192, 7, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0]
+        );
+    }
+
+    #[test]
+    fn coordinate_arrays_compare_as_numbers() {
+        // Sets with equal numbers share one array (0 equals -0); NaN equals
+        // nothing.
+        let mut b = Bucket::new();
+        b.coords = vec![
+            vec![[0.0, 0.5]],
+            vec![[-0.0, 0.5]],
+            vec![[1.0, 0.5]],
+            vec![[f32::NAN, 0.5]],
+            vec![[f32::NAN, 0.5]],
+        ];
+        b.merge_equal_coords();
+        assert_eq!(b.tex_coords, [0, 0, 1, 2, 3]);
+        assert_eq!(b.coords.len(), 4);
+    }
 }

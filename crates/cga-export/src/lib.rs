@@ -32,7 +32,6 @@ mod encode;
 mod faces;
 mod gltf;
 mod hash;
-mod held;
 mod materials;
 mod obj;
 mod prepare;
@@ -406,7 +405,6 @@ impl ModelWriter {
         self.stats.triangles += batch.triangles;
         self.skipped_non_finite += batch.skipped_non_finite;
         self.encoders.recycle(batch);
-        self.encoders.give_back(w.take_spare());
         Ok(())
     }
 

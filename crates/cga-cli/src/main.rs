@@ -478,59 +478,40 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
         _ if has_writer => Batcher::Leaves(Vec::new()),
         _ => Batcher::Drop,
     };
-    // What the writing thread encodes itself.
+    // With one worker, the batches the writing thread encodes itself.
     let mut own_batcher = match &encoder {
-        Some(e) if !workers_encode => Batcher::Encode(Box::new(e.another()), 0),
-        _ => Batcher::Drop,
+        Some(e) if !workers_encode => Some(Batcher::Encode(Box::new(e.another()), 0)),
+        _ => None,
     };
     // Takes what the lots produce, in lot order: each batch into the writer
     // as it comes, then the lot's prints, diagnostics and reports.
     let mut take = |i: usize, taken: Taken<Piece, (LotOutput, Option<RtError>)>| {
-        let (out, error) = match taken {
-            Taken::Piece(piece) => {
-                let export = |e| Failure::Usage(format!("export failed: {e}"));
-                let Some(w) = writer.as_mut() else {
-                    return Ok(());
-                };
-                match piece {
-                    Piece::Leaves(batch) if matches!(own_batcher, Batcher::Encode(..)) => {
-                        let mut result = Ok(());
-                        for leaf in batch {
-                            own_batcher.add(leaf, &mut |piece| {
-                                if let (Piece::Encoded(b, n), Ok(())) = (piece, &result) {
-                                    leaves += n;
-                                    result = w.append(b);
-                                }
-                            });
-                        }
-                        result.map_err(export)?;
-                    }
-                    Piece::Leaves(batch) => {
-                        leaves += batch.len();
-                        for leaf in batch {
-                            w.add_placed(&leaf.mesh, Some(&leaf.transform), &leaf.materials)
-                                .map_err(export)?;
-                        }
-                    }
-                    Piece::Encoded(batch, n) => {
-                        leaves += n;
-                        w.append(batch).map_err(export)?;
-                    }
-                }
-                return Ok(());
+        let export = |e| Failure::Usage(format!("export failed: {e}"));
+        let mut result = Ok(());
+        let mut write = |piece| {
+            if let (Some(w), Ok(())) = (writer.as_mut(), &result) {
+                result = write_piece(w, piece, &mut leaves);
             }
-            Taken::Done(r) => r,
         };
-        if let Some(w) = writer.as_mut() {
-            let mut result = Ok(());
-            own_batcher.flush(&mut |piece| {
-                if let (Piece::Encoded(b, n), Ok(())) = (piece, &result) {
-                    leaves += n;
-                    result = w.append(b);
+        let (out, error) = match (taken, &mut own_batcher) {
+            (Taken::Piece(Piece::Leaves(batch)), Some(own)) => {
+                for leaf in batch {
+                    own.add(leaf, &mut write);
                 }
-            });
-            result.map_err(|e| Failure::Usage(format!("export failed: {e}")))?;
-        }
+                return result.map_err(export);
+            }
+            (Taken::Piece(piece), _) => {
+                write(piece);
+                return result.map_err(export);
+            }
+            (Taken::Done(r), own) => {
+                if let Some(own) = own {
+                    own.flush(&mut write);
+                }
+                result.map_err(export)?;
+                r
+            }
+        };
         {
             use std::io::Write;
             let mut stdout = std::io::stdout().lock();
@@ -679,6 +660,26 @@ fn collect_scene(
         records,
         options.context_use.unwrap_or_default(),
     ))
+}
+
+/// Writes a piece of a lot's output, counting its leaves.
+fn write_piece(
+    w: &mut ModelWriter,
+    piece: Piece,
+    leaves: &mut usize,
+) -> Result<(), cga_export::ExportError> {
+    match piece {
+        Piece::Leaves(batch) => {
+            *leaves += batch.len();
+            batch.iter().try_for_each(|leaf| {
+                w.add_placed(&leaf.mesh, Some(&leaf.transform), &leaf.materials)
+            })
+        }
+        Piece::Encoded(batch, n) => {
+            *leaves += n;
+            w.append(batch)
+        }
+    }
 }
 
 /// A piece of a lot's output on its way to the writing thread.

@@ -43,11 +43,6 @@ pub struct Encoded {
 }
 
 impl Encoded {
-    /// Bytes of vertex data the batch holds.
-    pub fn bytes(&self) -> usize {
-        self.bytes
-    }
-
     /// Whether nothing was encoded (and nothing failed).
     pub fn is_empty(&self) -> bool {
         self.faces == 0 && self.skipped_non_finite == 0 && self.error.is_none()

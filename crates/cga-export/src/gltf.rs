@@ -423,7 +423,8 @@ impl GltfWriter {
     }
 
     /// Writes out the data held if it is more than allowed: between input
-    /// meshes or batches, never inside one.
+    /// meshes, or between the materials of a batch, never inside a mesh
+    /// (whose vertices share one numbering).
     pub(crate) fn flush_if_full(&mut self) -> Result<(), ExportError> {
         if self.held > self.flush_bytes {
             self.flush()?;

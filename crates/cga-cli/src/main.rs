@@ -49,7 +49,7 @@ use cga_engine::generate::generate_lot_streaming;
 use cga_engine::generate::parse_value;
 use cga_engine::geo::GeoOrigin;
 use cga_engine::lot::{self, Lot};
-use cga_engine::{GenerateOptions, Limits, LotOutput, RtError};
+use cga_engine::{GenerateOptions, Limits, LotOutput, RtError, Workspaces};
 use cga_export::{ExportOptions, Format, Georeference, ModelWriter};
 use cga_syntax::{Diagnostic, SourceMap};
 
@@ -75,6 +75,11 @@ enum Command {
         /// `text` for people, `json` (one object with all diagnostics) for tools.
         #[arg(long, value_enum, default_value_t = CheckFormat::Text)]
         format: CheckFormat,
+        /// A CityEngine workspace folder (projects side by side) where paths
+        /// such as `/ESRI.lib/rules/x.cga` are looked for after the rule
+        /// file's own workspace; repeatable, then `CGA_WORKSPACE`.
+        #[arg(long = "workspace", value_name = "DIR")]
+        workspaces: Vec<PathBuf>,
     },
 }
 
@@ -95,6 +100,11 @@ struct GenerateArgs {
     /// Random seed.
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// A CityEngine workspace folder (projects side by side) where paths
+    /// such as `/ESRI.lib/rules/x.cga` are looked for after the rule
+    /// file's own workspace; repeatable, then `CGA_WORKSPACE`.
+    #[arg(long = "workspace", value_name = "DIR")]
+    workspaces: Vec<PathBuf>,
     /// Output model: .glb, .gltf or .obj.
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     output: Option<PathBuf>,
@@ -154,7 +164,11 @@ fn main() -> ExitCode {
         .stack_size(DERIVATION_STACK)
         .spawn(move || match cli.command {
             Command::Generate(args) => generate(args),
-            Command::Check { rules, format } => check(&rules, format),
+            Command::Check {
+                rules,
+                format,
+                workspaces,
+            } => check(&rules, format, &Workspaces::with_env(&workspaces)),
         });
     let result = match worker.map(|w| w.join()) {
         Ok(Ok(r)) => r,
@@ -180,22 +194,26 @@ fn report_diagnostics(diags: &[Diagnostic], sources: &SourceMap) {
 }
 
 /// Loads and resolves a rule file, reporting its diagnostics.
-fn load(path: &Path, sources: &mut SourceMap) -> Result<cga_engine::Program, Failure> {
+fn load(
+    path: &Path,
+    sources: &mut SourceMap,
+    workspaces: &Workspaces,
+) -> Result<cga_engine::Program, Failure> {
     if !path.is_file() {
         return Err(Failure::Usage(format!(
             "rule file {} not found",
             path.display()
         )));
     }
-    let loaded = cga_engine::load(path, sources);
+    let loaded = cga_engine::load_with(path, sources, workspaces);
     report_diagnostics(&loaded.diagnostics, sources);
     loaded.program.ok_or(Failure::Rules)
 }
 
-fn check(path: &Path, format: CheckFormat) -> Result<(), Failure> {
+fn check(path: &Path, format: CheckFormat, workspaces: &Workspaces) -> Result<(), Failure> {
     if format == CheckFormat::Text {
         let mut sources = SourceMap::new();
-        let program = load(path, &mut sources)?;
+        let program = load(path, &mut sources, workspaces)?;
         eprintln!(
             "{}: ok ({} rules, {} attributes, {} functions)",
             path.display(),
@@ -212,7 +230,7 @@ fn check(path: &Path, format: CheckFormat) -> Result<(), Failure> {
         )));
     }
     let mut sources = SourceMap::new();
-    let loaded = cga_engine::load(path, &mut sources);
+    let loaded = cga_engine::load_with(path, &mut sources, workspaces);
     let diagnostics: Vec<serde_json::Value> = loaded
         .diagnostics
         .iter()
@@ -367,7 +385,8 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
     };
     let (lots, geo_origin) = read_lots(&args.lots)?;
     let mut sources = SourceMap::new();
-    let program = load(&args.rules, &mut sources)?;
+    let workspaces = Workspaces::with_env(&args.workspaces);
+    let program = load(&args.rules, &mut sources, &workspaces)?;
     let rule = program
         .start_rule(args.start_rule.as_deref())
         .map_err(Failure::Usage)?;
@@ -409,7 +428,9 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
         options.attrs.push((id, parse_value(value)));
     }
 
-    let assets = cga_engine::assets::Assets::new(&sources).with_max_file_mib(args.max_asset_mib);
+    let assets = cga_engine::assets::Assets::new(&sources)
+        .with_max_file_mib(args.max_asset_mib)
+        .with_workspaces(workspaces);
     let mut writer = match (&args.output, format) {
         (Some(path), Some(format)) => {
             let root = args

@@ -1,10 +1,10 @@
 //! Finding and caching assets (geometry files, textures).
 //!
-//! Search (as CGA specifies): relative to the rule file that invokes the
-//! operation: its folder, then each ancestor's `assets/` folder and the
-//! ancestor itself (the project root); absolute workspace paths (`/lib/x.obj`)
-//! inside an ancestor or its `.ws` folder. Loaded meshes are shared between
-//! all shapes and all lots.
+//! Search (as CGA specifies; `locate.rs` holds it): relative to the rule
+//! file that invokes the operation: its folder, then each ancestor's
+//! `assets/` folder and the ancestor itself (the project root); workspace
+//! paths (`/Project/x.obj`) in the rule file's workspace, then in the
+//! workspace roots. Loaded meshes are shared between all shapes and all lots.
 
 use std::collections::HashMap;
 use std::path::PathBuf;
@@ -14,7 +14,7 @@ use cga_geometry::topology::FxHashMap;
 use cga_geometry::Mesh;
 use cga_syntax::{FileId, SourceMap};
 
-use crate::resolve::find_relative;
+use crate::locate::{self, Workspaces};
 
 /// Default largest asset file read, in MiB (`--max-asset-mib`).
 pub const DEFAULT_MAX_ASSET_MIB: u64 = 512;
@@ -22,6 +22,8 @@ pub const DEFAULT_MAX_ASSET_MIB: u64 = 512;
 pub struct Assets {
     /// The rule file of each source file id.
     files: Vec<PathBuf>,
+    /// More places for workspace paths (`/Project/...`).
+    workspaces: Workspaces,
     /// Larger asset files are not read: a warning, the model goes on.
     max_file_bytes: u64,
     meshes: Mutex<HashMap<PathBuf, Result<Arc<Mesh>, String>>>,
@@ -29,7 +31,7 @@ pub struct Assets {
     /// Answers by request (rule file, path as written), shared by all lots:
     /// a search looks at the file system several times, and Candler alone
     /// inserts 1,600 assets and names 6,000 textures per building.
-    found: Requests<Option<PathBuf>>,
+    found: Requests<Result<PathBuf, Arc<[PathBuf]>>>,
     mesh_requests: Requests<Result<Arc<Mesh>, String>>,
     texture_files: Requests<Option<Arc<str>>>,
     /// Whether a texture file has an alpha channel, by file: reading the
@@ -74,6 +76,7 @@ impl Assets {
                     })
                 })
                 .collect(),
+            workspaces: Workspaces::default(),
             meshes: Mutex::new(HashMap::new()),
             texts: Mutex::new(HashMap::new()),
             found: Default::default(),
@@ -88,6 +91,7 @@ impl Assets {
         Assets {
             max_file_bytes: DEFAULT_MAX_ASSET_MIB << 20,
             files: Vec::new(),
+            workspaces: Workspaces::default(),
             meshes: Mutex::new(HashMap::new()),
             texts: Mutex::new(HashMap::new()),
             found: Default::default(),
@@ -97,16 +101,31 @@ impl Assets {
         }
     }
 
+    /// Sets the workspace roots searched for workspace paths (`/Project/...`).
+    pub fn with_workspaces(mut self, workspaces: Workspaces) -> Assets {
+        self.workspaces = workspaces;
+        self
+    }
+
     /// The file `path` names, searched from the rule file `from` (once per
     /// rule file and path).
     pub fn resolve(&self, from: FileId, path: &str) -> Option<PathBuf> {
+        self.search_for(from, path).ok()
+    }
+
+    /// The file `path` names from the rule file `from`, or the places
+    /// searched (for a message).
+    pub fn search_for(&self, from: FileId, path: &str) -> Result<PathBuf, Arc<[PathBuf]>> {
         cached(&self.found, from, path, || {
-            let p = std::path::Path::new(path);
-            if p.is_absolute() && p.is_file() {
-                return Some(p.to_path_buf());
-            }
-            let rule_file = self.files.get(from.0 as usize)?;
-            find_relative(rule_file, path)
+            let Some(rule_file) = self.files.get(from.0 as usize) else {
+                let p = std::path::Path::new(path);
+                return if p.is_absolute() && p.is_file() {
+                    Ok(p.to_path_buf())
+                } else {
+                    Err(Arc::from(Vec::new()))
+                };
+            };
+            locate::locate(rule_file, path, &self.workspaces).map_err(Arc::from)
         })
     }
 
@@ -161,9 +180,16 @@ impl Assets {
     }
 
     fn load_mesh(&self, from: FileId, path: &str) -> Result<Arc<Mesh>, String> {
-        let file = self
-            .resolve(from, path)
-            .ok_or_else(|| format!("asset \"{path}\" not found"))?;
+        let file = self.search_for(from, path).map_err(|searched| {
+            let mut m = format!("asset \"{path}\" not found");
+            if path.starts_with('/') && !searched.is_empty() {
+                // Workspace paths: say where the project was looked for.
+                m.push_str(" (");
+                m.push_str(&locate::searched_note(&searched).replace("\n  ", " "));
+                m.push(')');
+            }
+            m
+        })?;
         self.check_size(&file)?;
         let mut cache = self.meshes.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(r) = cache.get(&file) {
@@ -228,7 +254,7 @@ impl Assets {
             return t.clone();
         }
         let t = std::fs::read(&file).ok().map(|bytes| {
-            let s = String::from_utf8_lossy(&bytes).replace("\r\n", "\n");
+            let s = crate::text_encoding::decode(&bytes).0.replace("\r\n", "\n");
             Arc::from(s.as_str())
         });
         cache.insert(file, t.clone());

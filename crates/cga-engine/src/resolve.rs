@@ -18,6 +18,7 @@ use cga_syntax::{Diagnostic, SourceMap, Span};
 use cga_value::Value;
 
 use crate::expr::{OpCall, RBlock, RBody, RExpr, RExprKind, RPart, RStmt, RuleCall};
+use crate::locate::Workspaces;
 use crate::ops::{self, ArgMode, Op, SetTarget};
 use crate::program::{
     AnnotationInfo, AttrDef, AttrId, FuncId, FunctionDef, Program, RuleDef, RuleId, RuleSet,
@@ -35,8 +36,14 @@ pub struct Loaded {
 
 /// Loads `path` and everything it imports into `sources`, parses and resolves.
 pub fn load(path: &Path, sources: &mut SourceMap) -> Loaded {
-    match std::fs::read_to_string(path) {
-        Ok(text) => load_text(path, text, sources),
+    load_with(path, sources, &Workspaces::default())
+}
+
+/// Like [`load`], with workspace roots for imports that name a project
+/// (`/Project/...`, see `locate.rs`).
+pub fn load_with(path: &Path, sources: &mut SourceMap, workspaces: &Workspaces) -> Loaded {
+    match crate::text_encoding::read_text(path) {
+        Ok(text) => load_text_with(path, text, sources, workspaces),
         Err(e) => Loaded {
             program: None,
             diagnostics: vec![plain_error(format!(
@@ -50,8 +57,19 @@ pub fn load(path: &Path, sources: &mut SourceMap) -> Loaded {
 /// Like [`load`] for rule text already in memory; `path` names it in
 /// diagnostics and is where its imports are searched from.
 pub fn load_text(path: &Path, text: String, sources: &mut SourceMap) -> Loaded {
+    load_text_with(path, text, sources, &Workspaces::default())
+}
+
+/// [`load_text`] with workspace roots.
+pub fn load_text_with(
+    path: &Path,
+    text: String,
+    sources: &mut SourceMap,
+    workspaces: &Workspaces,
+) -> Loaded {
     let mut r = Resolver {
         sources,
+        workspaces: workspaces.clone(),
         program: Program::default(),
         diags: Vec::new(),
         tables: Vec::new(),
@@ -149,6 +167,7 @@ enum Pending {
 
 struct Resolver<'s> {
     sources: &'s mut SourceMap,
+    workspaces: Workspaces,
     program: Program,
     diags: Vec<Diagnostic>,
     tables: Vec<Tables>,
@@ -354,15 +373,24 @@ impl Resolver<'_> {
 
         for item in &module.items {
             let Item::Import(decl) = item else { continue };
-            let Some(target) = self.find_import(&path, &decl.path) else {
-                self.diags.push(
-                    Diagnostic::error(
+            let target = match self.find_import(&path, &decl.path) {
+                Ok(t) => t,
+                Err(searched) => {
+                    let mut d = Diagnostic::error(
                         format!("cannot find the imported rule file \"{}\"", decl.path),
                         decl.path_span,
                     )
-                    .with_label("not found relative to this rule file or its project"),
-                );
-                continue;
+                    .with_label(if decl.path.starts_with('/') {
+                        "not found in the rule file's workspace or the --workspace folders"
+                    } else {
+                        "not found relative to this rule file or its project"
+                    });
+                    if !searched.is_empty() {
+                        d = d.with_note(crate::locate::searched_note(&searched));
+                    }
+                    self.diags.push(d);
+                    continue;
+                }
             };
             if self.stack.contains(&target) || target == path {
                 let name = |p: &Path| {
@@ -385,7 +413,7 @@ impl Resolver<'_> {
                 );
                 continue;
             }
-            let text = match std::fs::read_to_string(&target) {
+            let text = match crate::text_encoding::read_text(&target) {
                 Ok(t) => t,
                 Err(e) => {
                     self.error(
@@ -584,12 +612,9 @@ impl Resolver<'_> {
         }
     }
 
-    /// Finds an imported file: relative to the importing file, then to each
-    /// of its ancestor folders (project roots: `rules/x.cga` from inside
-    /// `rules/`), and for absolute workspace paths (`/ESRI.lib/...`) inside an
-    /// ancestor or its `.ws` workspace folder.
-    fn find_import(&self, importer: &Path, target: &str) -> Option<PathBuf> {
-        find_relative(importer, target)
+    /// Finds an imported file (`locate.rs`), or every place searched.
+    fn find_import(&self, importer: &Path, target: &str) -> Result<PathBuf, Vec<PathBuf>> {
+        crate::locate::locate(importer, target, &self.workspaces)
     }
 
     fn resolve_pending(&mut self) {
@@ -1532,6 +1557,10 @@ fn annotations(list: &[ast::Annotation]) -> Vec<AnnotationInfo> {
                 .map(|arg| match arg {
                     ast::AnnotationArg::Positional(e) => (None, literal(e)),
                     ast::AnnotationArg::Named(n, e) => (Some(n.name.clone()), literal(e)),
+                    ast::AnnotationArg::Verbatim { key, text, .. } => (
+                        key.as_ref().map(|k| k.name.clone()),
+                        Some(Value::Str(Arc::from(text.as_str()))),
+                    ),
                 })
                 .collect(),
         })
@@ -1553,38 +1582,4 @@ fn literal(e: &Expr) -> Option<Value> {
         },
         _ => None,
     }
-}
-
-/// Finds `target` for a file at `from`: relative to its folder, then
-/// relative to each ancestor folder and its `assets/` folder; absolute
-/// workspace paths (`/lib/x.cga`) inside an ancestor or its `.ws` folder.
-pub fn find_relative(from: &Path, target: &str) -> Option<PathBuf> {
-    let start = from.parent()?;
-    let rel = target.trim_start_matches('/');
-    if target.starts_with('/') {
-        let p = Path::new(target);
-        if p.is_file() {
-            return Some(p.to_path_buf());
-        }
-        for dir in start.ancestors() {
-            for c in [dir.join(rel), dir.join(".ws").join(rel)] {
-                if c.is_file() {
-                    return Some(c);
-                }
-            }
-        }
-        return None;
-    }
-    let direct = start.join(rel);
-    if direct.is_file() {
-        return Some(direct);
-    }
-    for dir in start.ancestors() {
-        for c in [dir.join("assets").join(rel), dir.join(rel)] {
-            if c.is_file() {
-                return Some(c);
-            }
-        }
-    }
-    None
 }

@@ -41,6 +41,8 @@ pub enum Item {
     Version {
         value: String,
         span: Span,
+        /// Annotations written before it (kept, without meaning).
+        annotations: Vec<Annotation>,
     },
     Import(ImportDecl),
     Attr(AttrDecl),
@@ -52,6 +54,8 @@ pub enum Item {
         name: Ident,
         extends: Option<Ident>,
         span: Span,
+        /// `@Description("...") style Night`: annotations of the style.
+        annotations: Vec<Annotation>,
     },
 }
 
@@ -69,6 +73,14 @@ pub enum AnnotationArg {
     Positional(Expr),
     /// `@Range(min=1, max=10)`, `@Handle(shape=Solid)`
     Named(Ident, Expr),
+    /// An argument that is no CGA expression (`shape=Mass^1`,
+    /// `translate={.1,0,0}` of `@Handle`), kept as written: annotations
+    /// are metadata for tools, never an error.
+    Verbatim {
+        key: Option<Ident>,
+        text: String,
+        span: Span,
+    },
 }
 
 /// `import id : "file.cga"` with every combination of the optional parts.

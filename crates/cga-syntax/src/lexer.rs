@@ -77,6 +77,9 @@ pub(crate) enum Tok {
     /// `~` (floating size prefix)
     Tilde,
     At,
+    /// `^`: not an operator of CGA, but annotations use it
+    /// (`@Handle(shape=Mass^1)`).
+    Caret,
     /// A lone dot: the end of a leaf `Name.`, or `.Lot` of a dynamic import.
     Dot,
     // Element-wise array operators.
@@ -156,6 +159,7 @@ impl Tok {
             Tok::Quote => "`'`",
             Tok::Tilde => "`~`",
             Tok::At => "`@`",
+            Tok::Caret => "`^`",
             Tok::Dot => "`.`",
             Tok::DotPlus => "`.+`",
             Tok::DotMinus => "`.-`",
@@ -310,26 +314,14 @@ pub(crate) fn lex(file: FileId, text: &str) -> Lexed {
                 if stray.is_some() {
                     flush_stray(&mut stray, i, &mut diagnostics);
                 }
-                i += 1;
-                loop {
-                    match bytes.get(i) {
-                        None | Some(b'\n') | Some(b'\r') => {
-                            diagnostics.push(
-                                Diagnostic::error("unterminated string", span(start, start + 1))
-                                    .with_label(
-                                        "this string is not closed before the end of the line",
-                                    ),
-                            );
-                            break;
-                        }
-                        Some(b'"') => {
-                            i += 1;
-                            break;
-                        }
-                        Some(b'\\') if matches!(bytes.get(i + 1), Some(b) if *b != b'\n' && *b != b'\r') => {
-                            i += 2
-                        }
-                        Some(_) => i += 1,
+                match string_end(bytes, i) {
+                    Ok(end) => i = end,
+                    Err(line_end) => {
+                        diagnostics.push(
+                            Diagnostic::error("unterminated string", span(start, start + 1))
+                                .with_label("this string is not closed before the end of the line"),
+                        );
+                        i = line_end;
                     }
                 }
                 // `i` may stop inside a multi-byte character only at a
@@ -454,6 +446,7 @@ pub(crate) fn lex(file: FileId, text: &str) -> Lexed {
                     (b'\'', _) => (Tok::Quote, 1),
                     (b'~', _) => (Tok::Tilde, 1),
                     (b'@', _) => (Tok::At, 1),
+                    (b'^', _) => (Tok::Caret, 1),
                     _ => {
                         // Not ASCII punctuation: Unicode whitespace (a
                         // non-breaking space pasted from a web page) is
@@ -492,6 +485,54 @@ pub(crate) fn lex(file: FileId, text: &str) -> Lexed {
     Lexed {
         tokens,
         diagnostics,
+    }
+}
+
+/// Where the string opened by the quote at `open` ends (after its closing
+/// quote), or, for an unterminated string, where its line ends.
+///
+/// A string may run over line breaks (real rule files have `@Enum(..., "
+/// Highlight", ...)`, a line broken inside a string, which CityEngine's
+/// compiler accepts): the string is taken to go on to the next line when it
+/// closes there and its closing quote is followed by what can follow a
+/// string (an operator, `,`, `)`, `]`, `}`, `:`, `|`, a line end) rather
+/// than by a name or another quote. An unclosed string on one line
+/// followed by more code therefore still ends at its line, with an error,
+/// instead of swallowing the code up to the next quote.
+fn string_end(bytes: &[u8], open: usize) -> Result<usize, usize> {
+    let mut i = open + 1;
+    let mut line_end = None;
+    loop {
+        match bytes.get(i) {
+            None => return Err(line_end.unwrap_or(i)),
+            Some(b'\n') | Some(b'\r') => {
+                line_end.get_or_insert(i);
+                i += 1;
+            }
+            Some(b'"') => {
+                i += 1;
+                let Some(first_break) = line_end else {
+                    return Ok(i);
+                };
+                let mut j = i;
+                while matches!(bytes.get(j), Some(b' ' | b'\t')) {
+                    j += 1;
+                }
+                let follows_well = match bytes.get(j) {
+                    None | Some(b'\n' | b'\r') => true,
+                    Some(&c) => !(is_ident_char(c) || c == b'"' || c == b'.' || c >= 0x80),
+                };
+                return if follows_well {
+                    Ok(i)
+                } else {
+                    Err(first_break)
+                };
+            }
+            Some(b'\\') if matches!(bytes.get(i + 1), Some(b) if *b != b'\n' && *b != b'\r') => {
+                i += 2
+            }
+            Some(_) => i += 1,
+        }
     }
 }
 
@@ -575,6 +616,19 @@ pub(crate) fn string_value(raw: &str) -> String {
             Some('"') => out.push('"'),
             Some('\\') => out.push('\\'),
             Some('\'') => out.push('\''),
+            // `\ue000` (the page of `isNull`): a character by its code.
+            Some('u') => {
+                let hex: String = chars.clone().take(4).collect();
+                match u32::from_str_radix(&hex, 16).ok().and_then(char::from_u32) {
+                    Some(c) if hex.len() == 4 && hex.bytes().all(|b| b.is_ascii_hexdigit()) => {
+                        out.push(c);
+                        for _ in 0..4 {
+                            chars.next();
+                        }
+                    }
+                    _ => out.push_str("\\u"),
+                }
+            }
             Some(other) => {
                 out.push('\\');
                 out.push(other);
@@ -669,6 +723,26 @@ mod tests {
         assert_eq!(string_value(r#""a\nb\t\"c\"\\ \d""#), "a\nb\t\"c\"\\ \\d");
         assert_eq!(string_value("\"überbau\""), "überbau");
         assert_eq!(string_value("\"open"), "open");
+        assert_eq!(string_value(r#""\ue000x\u00e4\uZZ""#), "\u{e000}xä\\uZZ");
+    }
+
+    #[test]
+    fn strings_over_line_breaks() {
+        // Closed on the next line and followed by `,`: one string.
+        let text = "@Enum(\"a\",\"\n b\",\"c\") attr x = 1";
+        let lexed = lex(FileId(0), text);
+        assert!(lexed.diagnostics.is_empty(), "{:?}", lexed.diagnostics);
+        let strs: Vec<&str> = lexed
+            .tokens
+            .iter()
+            .filter(|t| t.kind == Tok::Str)
+            .map(|t| &text[t.start as usize..t.end as usize])
+            .collect();
+        assert_eq!(strs, ["\"a\"", "\"\n b\"", "\"c\""]);
+        // An unclosed string followed by code: the error is on its line.
+        let lexed = lex(FileId(0), "print(\"abc)\nLot --> print(\"x\")");
+        assert_eq!(lexed.diagnostics.len(), 1);
+        assert_eq!(lexed.diagnostics[0].span.unwrap().range(), 6..7);
     }
 
     #[test]

@@ -108,6 +108,10 @@ fn annotations(out: &mut String, list: &[Annotation]) {
                 .map(|arg| match arg {
                     AnnotationArg::Positional(e) => expr(e),
                     AnnotationArg::Named(name, e) => format!("{}={}", name.name, expr(e)),
+                    AnnotationArg::Verbatim { key, text, .. } => match key {
+                        Some(k) => format!("{}={text:?}", k.name),
+                        None => format!("{text:?}"),
+                    },
                 })
                 .collect();
             let _ = write!(out, "({})", args.join(" "));

@@ -132,6 +132,14 @@ impl Parser<'_> {
             let stmt_mark = self.diags.len();
             match self.cur() {
                 Tok::Ident | Tok::Start => stmts.push(self.parse_name_stmt()),
+                // `NIL.` is a leaf named NIL, not a deletion (CityEngine
+                // keeps the shape: `split(x) { 5 : NIL | ~1 : NIL. }`).
+                Tok::Nil if self.nth(1) == Tok::Dot && self.touches(self.pos, self.pos + 1) => {
+                    let name = self.ident_here();
+                    self.bump();
+                    self.bump();
+                    stmts.push(Stmt::Leaf(name));
+                }
                 Tok::Nil => {
                     stmts.push(Stmt::Nil(self.cur_span()));
                     self.bump();

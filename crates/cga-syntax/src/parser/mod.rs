@@ -380,15 +380,6 @@ impl<'t> Parser<'t> {
             Tok::Attr => self.parse_attr(annotations).map(Item::Attr),
             Tok::Const => self.parse_definition(annotations),
             Tok::Start | Tok::Extension | Tok::Ident => self.parse_definition(annotations),
-            Tok::Version | Tok::Style if first_annotation.is_some() => {
-                let what = self.found();
-                self.error(
-                    format!("annotations cannot be attached to {what}"),
-                    first_annotation.unwrap_or_default(),
-                    "annotation without a declaration",
-                );
-                self.parse_item()
-            }
             Tok::Version => {
                 let start = self.tok_at(self.pos).start;
                 self.bump();
@@ -398,6 +389,7 @@ impl<'t> Parser<'t> {
                     Some(Item::Version {
                         value,
                         span: self.span_from(start),
+                        annotations,
                     })
                 } else {
                     self.expected(
@@ -420,6 +412,7 @@ impl<'t> Parser<'t> {
                     name,
                     extends,
                     span: self.span_from(start),
+                    annotations,
                 })
             }
             Tok::Eof if first_annotation.is_some() => {
@@ -476,14 +469,7 @@ impl<'t> Parser<'t> {
                 if !self.eat(Tok::RParen) {
                     loop {
                         let mark = self.diags.len();
-                        if Self::is_name(self.cur()) && self.nth(1) == Tok::Eq {
-                            let key = self.ident_here();
-                            self.bump();
-                            self.bump();
-                            args.push(AnnotationArg::Named(key, self.parse_expr()));
-                        } else {
-                            args.push(AnnotationArg::Positional(self.parse_expr()));
-                        }
+                        args.push(self.parse_annotation_arg(open));
                         if self.eat(Tok::Comma) {
                             continue;
                         }
@@ -507,6 +493,52 @@ impl<'t> Parser<'t> {
             });
         }
         annotations
+    }
+
+    /// One argument of an annotation: `value` or `key=value`. A value that
+    /// is not a CGA expression up to the next `,` or `)` is kept as written
+    /// ([`AnnotationArg::Verbatim`]), without an error.
+    fn parse_annotation_arg(&mut self, open: usize) -> AnnotationArg {
+        let key = if Self::is_name(self.cur()) && self.nth(1) == Tok::Eq {
+            let key = self.ident_here();
+            self.bump();
+            self.bump();
+            Some(key)
+        } else {
+            None
+        };
+        let (mark, at, bail) = (self.diags.len(), self.pos, self.bail);
+        let value = self.parse_expr();
+        if self.diags.len() == mark && matches!(self.cur(), Tok::Comma | Tok::RParen) {
+            return match key {
+                Some(k) => AnnotationArg::Named(k, value),
+                None => AnnotationArg::Positional(value),
+            };
+        }
+        // Not an expression: back to its start, then over balanced
+        // brackets to the `,` or `)` that ends it (never past the
+        // annotation's own closing parenthesis).
+        self.diags.truncate(mark);
+        self.pos = at;
+        self.bail = bail;
+        let end = self.partner_of(open).unwrap_or(usize::MAX);
+        while self.pos < end && !matches!(self.cur(), Tok::Comma | Tok::RParen | Tok::Eof) {
+            match self.partner_of(self.pos) {
+                Some(close) if close > self.pos && close < end => self.pos = close + 1,
+                _ => self.bump(),
+            }
+        }
+        let start = self.tok_at(at).start;
+        let stop = if self.pos > at {
+            self.tok_at(self.pos - 1).end
+        } else {
+            start
+        };
+        AnnotationArg::Verbatim {
+            key,
+            text: self.text[start as usize..stop as usize].to_string(),
+            span: Span::new(self.file, start, stop),
+        }
     }
 
     /// After a list element that is not followed by a separator or the

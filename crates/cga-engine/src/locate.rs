@@ -1,0 +1,165 @@
+//! Where a path written in a rule file (an import, an asset, a texture, a
+//! file a built-in reads) is looked for. The one place that decides it:
+//! [`candidates`] lists the places in search order from the rule file, the
+//! path as written and the workspace roots alone (no file system), and
+//! [`locate`] takes the first that exists.
+//!
+//! A path that starts with `/` names a project of the CityEngine workspace
+//! (`/ESRI.lib/rules/Plants/Plant_Loader.cga`: the file
+//! `rules/Plants/Plant_Loader.cga` of the project `ESRI.lib`). A workspace
+//! holds its projects side by side, so the project is looked for beside the
+//! rule file's own project: in each ancestor folder of the rule file,
+//! nearest first (and in its `.ws` folder, where rule packages keep the
+//! files of other projects), then in each workspace root given by the user
+//! (`--workspace DIR`, then the folders of `CGA_WORKSPACE`). An absolute
+//! path of this machine that exists is taken as it is.
+//!
+//! Any other path is relative to the rule file: its folder first, then each
+//! ancestor's `assets/` folder and the ancestor itself (the project root,
+//! so that `assets/x.obj` and `rules/x.cga` work from inside `rules/`).
+
+use std::path::{Path, PathBuf};
+
+/// The environment variable with more workspace roots (a path list, as
+/// `PATH` is written on this platform).
+pub const WORKSPACE_ENV: &str = "CGA_WORKSPACE";
+
+/// The workspace roots a user named, searched after the rule file's own
+/// workspace for paths that start with `/`.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Workspaces {
+    pub roots: Vec<PathBuf>,
+}
+
+impl Workspaces {
+    pub fn new(roots: Vec<PathBuf>) -> Workspaces {
+        Workspaces { roots }
+    }
+
+    /// `dirs` (the `--workspace` options, in order), then the folders of
+    /// the `CGA_WORKSPACE` environment variable.
+    pub fn with_env(dirs: &[PathBuf]) -> Workspaces {
+        let mut roots = dirs.to_vec();
+        if let Some(list) = std::env::var_os(WORKSPACE_ENV) {
+            roots.extend(std::env::split_paths(&list).filter(|p| !p.as_os_str().is_empty()));
+        }
+        Workspaces { roots }
+    }
+}
+
+/// Every place `target`, written in the rule file `from`, may be, in search
+/// order. Pure: the file system is not consulted.
+pub fn candidates(from: &Path, target: &str, workspaces: &Workspaces) -> Vec<PathBuf> {
+    let folder = from.parent().unwrap_or(Path::new(""));
+    let mut out = Vec::new();
+    let mut push = |p: PathBuf| {
+        if !out.contains(&p) {
+            out.push(p);
+        }
+    };
+    let target = target.trim();
+    if target.is_empty() {
+        return out;
+    }
+    if let Some(rel) = target.strip_prefix(['/', '\\']) {
+        let rel = rel.trim_start_matches(['/', '\\']);
+        if !rel.is_empty() {
+            push(PathBuf::from(target));
+            for dir in folder.ancestors() {
+                push(dir.join(rel));
+                push(dir.join(".ws").join(rel));
+            }
+            for root in &workspaces.roots {
+                push(root.join(rel));
+            }
+        }
+        return out;
+    }
+    let own = Path::new(target);
+    if own.is_absolute() {
+        // A path of this machine (`C:\...` on Windows).
+        push(own.to_path_buf());
+        return out;
+    }
+    push(folder.join(target));
+    for dir in folder.ancestors() {
+        push(dir.join("assets").join(target));
+        push(dir.join(target));
+    }
+    out
+}
+
+/// The file `target` names from the rule file `from`, or every place that
+/// was searched.
+pub fn locate(from: &Path, target: &str, workspaces: &Workspaces) -> Result<PathBuf, Vec<PathBuf>> {
+    let places = candidates(from, target, workspaces);
+    match places.iter().find(|p| is_file(p)) {
+        Some(found) => Ok(found.clone()),
+        None => Err(places),
+    }
+}
+
+/// The one file-existence check of the search.
+fn is_file(path: &Path) -> bool {
+    path.is_file()
+}
+
+/// A not-found message's list of the places searched, one per line.
+pub fn searched_note(places: &[PathBuf]) -> String {
+    let mut note = String::from("searched:");
+    for p in places {
+        note.push_str("\n  ");
+        note.push_str(&p.display().to_string());
+    }
+    note
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn workspace_paths_search_ancestors_then_roots() {
+        let ws = Workspaces::new(vec![PathBuf::from("/elsewhere/ws")]);
+        let c = candidates(
+            Path::new("/w/Proj/rules/a.cga"),
+            "/ESRI.lib/rules/x.cga",
+            &ws,
+        );
+        let shown: Vec<String> = c.iter().map(|p| p.display().to_string()).collect();
+        assert_eq!(
+            shown,
+            [
+                "/ESRI.lib/rules/x.cga",
+                "/w/Proj/rules/ESRI.lib/rules/x.cga",
+                "/w/Proj/rules/.ws/ESRI.lib/rules/x.cga",
+                "/w/Proj/ESRI.lib/rules/x.cga",
+                "/w/Proj/.ws/ESRI.lib/rules/x.cga",
+                "/w/ESRI.lib/rules/x.cga",
+                "/w/.ws/ESRI.lib/rules/x.cga",
+                "/.ws/ESRI.lib/rules/x.cga",
+                "/elsewhere/ws/ESRI.lib/rules/x.cga",
+            ]
+        );
+    }
+
+    #[test]
+    fn relative_paths_search_the_folder_then_assets_and_project_roots() {
+        let c = candidates(
+            Path::new("/w/Proj/rules/a.cga"),
+            "win/w.obj",
+            &Workspaces::default(),
+        );
+        let shown: Vec<String> = c.iter().map(|p| p.display().to_string()).collect();
+        assert_eq!(
+            shown[..4],
+            [
+                "/w/Proj/rules/win/w.obj",
+                "/w/Proj/rules/assets/win/w.obj",
+                "/w/Proj/assets/win/w.obj",
+                "/w/Proj/win/w.obj",
+            ]
+        );
+        assert!(candidates(Path::new("/a/b.cga"), "  ", &Workspaces::default()).is_empty());
+    }
+}

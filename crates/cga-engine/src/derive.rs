@@ -55,6 +55,10 @@ impl Default for Limits {
 pub struct RtError {
     pub message: String,
     pub span: Option<Span>,
+    /// An operation got NaN or an infinity: the operation is skipped with
+    /// a warning and the derivation goes on (CityEngine generates such
+    /// models), instead of the lot stopping.
+    pub non_finite: bool,
 }
 
 impl RtError {
@@ -62,6 +66,15 @@ impl RtError {
         RtError {
             message: message.into(),
             span: Some(span),
+            non_finite: false,
+        }
+    }
+
+    /// An error about a non-finite number (see [`RtError::non_finite`]).
+    pub fn non_finite(message: impl Into<String>, span: Span) -> RtError {
+        RtError {
+            non_finite: true,
+            ..RtError::new(message, span)
         }
     }
 
@@ -76,6 +89,32 @@ impl RtError {
                 notes: Vec::new(),
             },
         }
+    }
+}
+
+/// The first argument of an operation that is NaN or infinite, for the
+/// operations that cannot use one (`print`, `report` and `set` take any
+/// value).
+fn non_finite_arg(op: ops::Op, args: &[Arg]) -> Option<usize> {
+    if matches!(op, ops::Op::Print | ops::Op::Report | ops::Op::Set(_)) {
+        return None;
+    }
+    args.iter()
+        .position(|a| matches!(a.value, Value::Float(x) if !x.is_finite()))
+}
+
+/// An operation's name as written in CGA (`Op::PrimitiveCube`:
+/// `primitiveCube`).
+fn op_name(op: ops::Op) -> String {
+    let debug = match op {
+        ops::Op::Insert => "i".to_string(),
+        ops::Op::Set(_) => "set".to_string(),
+        other => format!("{other:?}"),
+    };
+    let mut chars = debug.chars();
+    match chars.next() {
+        Some(c) => c.to_lowercase().chain(chars).collect(),
+        None => debug,
     }
 }
 
@@ -101,7 +140,7 @@ impl Arg {
     pub fn num(&self) -> Result<f64, RtError> {
         match &self.value {
             Value::Float(x) if x.is_finite() => Ok(*x),
-            Value::Float(x) => Err(RtError::new(
+            Value::Float(x) => Err(RtError::non_finite(
                 format!(
                     "expected a finite number, found {}",
                     crate::values::to_text(&Value::Float(*x))
@@ -955,10 +994,37 @@ impl<'a> Interp<'a> {
                         }
                     }
                 }
-                let r = ops::exec(self, st, call, &args, frame);
+                let skip = non_finite_arg(call.op, &args);
+                let r = match skip {
+                    Some(k) => Err(RtError::non_finite(
+                        format!(
+                            "argument {} is {}",
+                            k + 1,
+                            crate::values::to_text(&args[k].value)
+                        ),
+                        args[k].span,
+                    )),
+                    None => ops::exec(self, st, call, &args, frame),
+                };
                 args.clear();
                 self.arg_pool.push(args);
-                r?;
+                if let Err(e) = r {
+                    if !e.non_finite {
+                        return Err(e);
+                    }
+                    // CityEngine generates the model: the operation is
+                    // skipped, the shape goes on as it was.
+                    let rule = self.program.symbol(st.shape.name).to_string();
+                    let op = op_name(call.op);
+                    let at = e.span.unwrap_or(call.span);
+                    self.warn_once(at, || {
+                        format!(
+                            "`{op}` in rule `{rule}` skipped: {} (a division by zero, or a missing asset's size?)",
+                            e.message
+                        )
+                    });
+                    return Ok(());
+                }
                 let faces = st.shape.geometry.raw().0.faces.len();
                 if faces > self.limits.max_faces {
                     return Err(RtError::new(

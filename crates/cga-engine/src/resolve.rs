@@ -78,10 +78,12 @@ pub fn load_text_with(
         stack: Vec::new(),
         pending: Vec::new(),
         symbols: HashMap::new(),
+        type_checks: Vec::new(),
     };
     let main = r.parse_file(path, text);
     r.instantiate(main, String::new(), None);
     r.resolve_pending();
+    r.check_types();
     if let Some(t) = r.tables.first() {
         let mut attrs: Vec<_> = t.attrs.iter().map(|(n, &id)| (n.clone(), id)).collect();
         attrs.sort();
@@ -177,6 +179,9 @@ struct Resolver<'s> {
     stack: Vec<PathBuf>,
     pending: Vec<Pending>,
     symbols: HashMap<Arc<str>, u32>,
+    /// Binary operations whose operand types may be known before deriving
+    /// (constants, attributes): checked once every attribute is resolved.
+    type_checks: Vec<(ast::BinaryOp, RExpr, RExpr, Span)>,
 }
 
 /// The items of a module as one style sees them: the items of the Default
@@ -230,6 +235,102 @@ fn style_items<'m>(module: &'m ast::Module, style: Option<&str>) -> Vec<&'m Item
         }
     }
     items
+}
+
+/// The candidate closest to `name` by edit distance, if close enough to be a
+/// likely typo (1 edit for short names, up to 3 for long ones).
+fn closest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<String> {
+    let len = name.chars().count();
+    let allowed = match len {
+        0..=3 => 1,
+        4..=6 => 2,
+        _ => 3,
+    };
+    candidates
+        .into_iter()
+        // The edit distance is at least the difference in length: skip the
+        // candidates that cannot be close before computing it.
+        .filter(|c| c.chars().count().abs_diff(len) <= allowed)
+        .map(|c| (strsim::damerau_levenshtein(name, c), c))
+        .filter(|&(d, c)| d <= allowed && d < c.len())
+        .min()
+        .map(|(_, c)| c.to_string())
+}
+
+/// Whether the type of `e` may be known before deriving: a constant, an
+/// attribute, or operators over them.
+fn type_checkable(e: &RExpr) -> bool {
+    match &e.kind {
+        RExprKind::Const(_) | RExprKind::Attr(_) => true,
+        RExprKind::Unary { operand, .. } => type_checkable(operand),
+        RExprKind::Binary { lhs, rhs, .. } => type_checkable(lhs) && type_checkable(rhs),
+        _ => false,
+    }
+}
+
+/// A value of the scalar type `e` certainly has (`0`, `false` or `""`):
+/// constants, attributes whose default has a known type (an attribute keeps
+/// its type whatever it is set to), and operators over them. `None` when
+/// the type is not known or is an array.
+fn static_scalar(program: &Program, e: &RExpr, depth: usize) -> Option<Value> {
+    if depth > 16 {
+        return None;
+    }
+    let scalar = |v: &Value| match v {
+        Value::Float(_) => Some(Value::Float(1.0)),
+        Value::Bool(_) => Some(Value::Bool(false)),
+        Value::Str(_) => Some(Value::Str(Arc::from(""))),
+        _ => None,
+    };
+    match &e.kind {
+        RExprKind::Const(v) => scalar(v),
+        RExprKind::Attr(id) => {
+            static_scalar(program, &program.attrs[*id as usize].default, depth + 1)
+        }
+        RExprKind::Unary {
+            op,
+            elementwise: false,
+            operand,
+        } => {
+            let v = static_scalar(program, operand, depth + 1)?;
+            values::unary(*op, false, &v).ok().as_ref().and_then(scalar)
+        }
+        RExprKind::Binary {
+            op,
+            elementwise: false,
+            lhs,
+            rhs,
+        } => {
+            let a = static_scalar(program, lhs, depth + 1)?;
+            let b = static_scalar(program, rhs, depth + 1)?;
+            values::binary(*op, false, &a, &b)
+                .ok()
+                .as_ref()
+                .and_then(scalar)
+        }
+        _ => None,
+    }
+}
+
+/// The CGA version a file is written for (`version "2014.1"`); without a
+/// `version` statement, 2009.1 (version.md).
+fn module_version(module: &ast::Module) -> (u32, u32) {
+    module
+        .items
+        .iter()
+        .find_map(|item| match item {
+            Item::Version { value, .. } => {
+                let mut parts = value.trim().split('.');
+                let major = parts.next()?.trim().parse().ok()?;
+                let minor = parts
+                    .next()
+                    .and_then(|m| m.trim().parse().ok())
+                    .unwrap_or(0);
+                Some((major, minor))
+            }
+            _ => None,
+        })
+        .unwrap_or((2009, 1))
 }
 
 /// Whether two items define the same attribute, function or rule (name and
@@ -323,47 +424,16 @@ impl Resolver<'_> {
             .and_then(|(_, d)| d.styles.as_ref())
             .and_then(|list| list.first())
             .map(|s| s.name.clone());
+        let version = module_version(&module);
         for item in style_items(&module, style.as_deref()) {
             match item {
+                Item::Attr(decl) if !decl.params.is_empty() => {
+                    self.declare_attr_with_params(rs, decl, version)
+                }
                 Item::Attr(decl) => {
                     self.declare_attr(rs, decl, importer.as_ref().map(|i| i.0), &overrides)
                 }
-                Item::Function(decl) => {
-                    let id = self.program.functions.len() as FuncId;
-                    self.program.functions.push(FunctionDef {
-                        name: decl.name.name.clone(),
-                        ruleset: rs,
-                        arity: decl.params.len(),
-                        is_const: decl.is_const,
-                        frame_size: decl.params.len() + decl.locals.len(),
-                        locals: Vec::new(),
-                        body: placeholder(decl.span),
-                        span: decl.name.span,
-                    });
-                    let same = self.tables[rs as usize]
-                        .funcs
-                        .entry(decl.name.name.clone())
-                        .or_default();
-                    let dup = same
-                        .iter()
-                        .any(|&f| self.program.functions[f as usize].arity == decl.params.len());
-                    same.push(id);
-                    if dup {
-                        self.error(
-                            format!(
-                                "function `{}` with {} parameters is defined twice",
-                                decl.name.name,
-                                decl.params.len()
-                            ),
-                            decl.name.span,
-                        );
-                    }
-                    self.pending.push(Pending::Function {
-                        id,
-                        ruleset: rs,
-                        decl: decl.clone(),
-                    });
-                }
+                Item::Function(decl) => self.declare_function(rs, decl),
                 Item::Rule(decl) => {
                     self.declare_rule(rs, decl, importer.as_ref().map(|i| i.0), &overrides)
                 }
@@ -476,6 +546,81 @@ impl Resolver<'_> {
             list.retain(|&r| rules[r as usize].arity != arity);
             list.push(id);
         }
+    }
+
+    fn declare_function(&mut self, rs: RuleSetId, decl: &ast::FunctionDecl) {
+        let id = self.program.functions.len() as FuncId;
+        self.program.functions.push(FunctionDef {
+            name: decl.name.name.clone(),
+            ruleset: rs,
+            arity: decl.params.len(),
+            is_const: decl.is_const,
+            frame_size: decl.params.len() + decl.locals.len(),
+            locals: Vec::new(),
+            body: placeholder(decl.span),
+            span: decl.name.span,
+        });
+        let same = self.tables[rs as usize]
+            .funcs
+            .entry(decl.name.name.clone())
+            .or_default();
+        let dup = same
+            .iter()
+            .any(|&f| self.program.functions[f as usize].arity == decl.params.len());
+        same.push(id);
+        if dup {
+            self.error(
+                format!(
+                    "function `{}` with {} parameters is defined twice",
+                    decl.name.name,
+                    decl.params.len()
+                ),
+                decl.name.span,
+            );
+        }
+        self.pending.push(Pending::Function {
+            id,
+            ruleset: rs,
+            decl: decl.clone(),
+        });
+    }
+
+    /// `attr P(idx) = e`: CGA allowed attributes with parameters before
+    /// 2019.1 (indexed object attributes; `streetWidth(i)` still is one).
+    /// Lots carry no such arrays here, so it is a function of its
+    /// parameters with the default as its body. In files of 2019.1 or later
+    /// it is an error, as in CityEngine.
+    fn declare_attr_with_params(
+        &mut self,
+        rs: RuleSetId,
+        decl: &ast::AttrDecl,
+        version: (u32, u32),
+    ) {
+        if version >= (2019, 1) && decl.name.name != "streetWidth" {
+            self.diags.push(
+                Diagnostic::error(
+                    format!(
+                        "attribute `{}` has parameters, which CGA allows only before version 2019.1 (this file is version {}.{})",
+                        decl.name.name, version.0, version.1
+                    ),
+                    decl.name.span,
+                )
+                .with_label("use a function `name(params) = ...` instead"),
+            );
+            return;
+        }
+        self.declare_function(
+            rs,
+            &ast::FunctionDecl {
+                annotations: decl.annotations.clone(),
+                is_const: false,
+                name: decl.name.clone(),
+                params: decl.params.clone(),
+                locals: decl.locals.clone(),
+                value: decl.value.clone(),
+                span: decl.span,
+            },
+        );
     }
 
     fn declare_attr(
@@ -675,6 +820,32 @@ impl Resolver<'_> {
         }
     }
 
+    /// Reports the binary operations that fail whatever the values, because
+    /// their operand types are known and the operator does not apply to
+    /// them (`floors == "six"` for a float attribute): `cga check` finds
+    /// what deriving would stop on.
+    fn check_types(&mut self) {
+        for (op, lhs, rhs, span) in std::mem::take(&mut self.type_checks) {
+            let (Some(a), Some(b)) = (
+                static_scalar(&self.program, &lhs, 0),
+                static_scalar(&self.program, &rhs, 0),
+            ) else {
+                continue;
+            };
+            if let Err(message) = values::binary(op, false, &a, &b) {
+                self.diags.push(
+                    Diagnostic::error(format!("type mismatch: {message}"), span).with_label(
+                        format!(
+                            "{} and {} do not combine with this operator",
+                            a.type_name(),
+                            b.type_name()
+                        ),
+                    ),
+                );
+            }
+        }
+    }
+
     fn resolve_locals(&mut self, cx: &mut Cx, locals: &[ast::LocalVar]) -> Vec<RExpr> {
         let mut out = Vec::with_capacity(locals.len());
         for l in locals {
@@ -764,21 +935,18 @@ impl Resolver<'_> {
                 candidates.extend(ops::ALL_OPERATIONS);
             }
         }
-        let len = name.chars().count();
-        let allowed = match len {
-            0..=3 => 1,
-            4..=6 => 2,
-            _ => 3,
-        };
-        candidates
-            .into_iter()
-            // The edit distance is at least the difference in length: skip the
-            // candidates that cannot be close before computing it.
-            .filter(|c| c.chars().count().abs_diff(len) <= allowed)
-            .map(|c| (strsim::damerau_levenshtein(name, c), c))
-            .filter(|&(d, c)| d <= allowed && d < c.len())
-            .min()
-            .map(|(_, c)| c.to_string())
+        closest(name, candidates)
+    }
+
+    /// The rule whose name is closest to `name` (a likely typo), if any.
+    fn suggest_rule(&self, rs: RuleSetId, name: &str) -> Option<String> {
+        let rules: Vec<&str> = self.tables[rs as usize]
+            .rules
+            .keys()
+            .map(|s| s.as_str())
+            .filter(|r| *r != name)
+            .collect();
+        closest(name, rules)
     }
 
     fn unknown(&mut self, what: &str, ident: &ast::Ident, rs: RuleSetId, kind: NameKind) {
@@ -831,12 +999,19 @@ impl Resolver<'_> {
                 elementwise,
                 lhs,
                 rhs,
-            } => RExprKind::Binary {
-                op: *op,
-                elementwise: *elementwise,
-                lhs: Box::new(self.expr(cx, lhs)),
-                rhs: Box::new(self.expr(cx, rhs)),
-            },
+            } => {
+                let lhs = self.expr(cx, lhs);
+                let rhs = self.expr(cx, rhs);
+                if !*elementwise && type_checkable(&lhs) && type_checkable(&rhs) {
+                    self.type_checks.push((*op, lhs.clone(), rhs.clone(), span));
+                }
+                RExprKind::Binary {
+                    op: *op,
+                    elementwise: *elementwise,
+                    lhs: Box::new(lhs),
+                    rhs: Box::new(rhs),
+                }
+            }
             ExprKind::Array(rows) => RExprKind::Array(
                 rows.iter()
                     .map(|r| r.iter().map(|x| self.expr(cx, x)).collect())
@@ -1337,7 +1512,19 @@ impl Resolver<'_> {
             };
         }
         if call.args.is_none() && call.import_overrides.is_none() {
-            // A rule name without a rule: a leaf shape of that name.
+            // A rule name without a rule: a leaf shape of that name, as in
+            // CityEngine. A name close to a rule's is most likely a typo:
+            // say so (`Facde` for `Facade`).
+            if let Some(close) = self.suggest_rule(cx.rs, name) {
+                self.diags.push(
+                    Diagnostic::warning(
+                        format!("rule `{name}` is not defined; the shape becomes a leaf"),
+                        call.name.span,
+                    )
+                    .with_label("no rule of this name")
+                    .with_note(format!("help: did you mean `{close}`?")),
+                );
+            }
             return RStmt::Leaf(self.symbol(name));
         }
         let arities = self.rule_arities(cx.rs, name);
@@ -1346,33 +1533,42 @@ impl Resolver<'_> {
             .next()
             .and_then(|n| n.chars().next())
             .is_some_and(|c| c.is_uppercase());
-        if arities.is_empty() && looks_like_rule {
-            // A rule that is not defined here (an importing file may define
-            // it, `imp.Rule(x) --> ...`): a leaf shape, as in CityEngine.
+        if !arities.is_empty() {
+            // `Rule(x)` where only `Rule` (or `Rule(a, b)`) exists: no rule
+            // has this signature, so, as for an undefined rule, the shape
+            // becomes a leaf (CityEngine warns "undefined rule").
+            let _ = call.args.iter().flatten().map(|a| self.expr(cx, a)).count();
             self.diags.push(
                 Diagnostic::warning(
-                    format!("rule `{name}` is not defined; the shape becomes a leaf"),
+                    format!(
+                        "rule `{name}` takes {} parameter(s), called with {arity}: no such rule, the shape becomes a leaf",
+                        arities
+                            .iter()
+                            .map(|a| a.to_string())
+                            .collect::<Vec<_>>()
+                            .join(" or ")
+                    ),
                     call.name.span,
                 )
-                .with_label("no rule of this name"),
+                .with_label("no rule with this number of parameters"),
             );
             return RStmt::Leaf(self.symbol(name));
         }
-        if !arities.is_empty() {
-            self.error(
-                format!(
-                    "rule `{name}` takes {} parameter(s), called with {arity}",
-                    arities
-                        .iter()
-                        .map(|a| a.to_string())
-                        .collect::<Vec<_>>()
-                        .join(" or ")
-                ),
-                span,
-            );
-        } else {
-            self.unknown("operation or rule", &call.name, cx.rs, NameKind::Statement);
+        if looks_like_rule {
+            // A rule that is not defined here (an importing file may define
+            // it, `imp.Rule(x) --> ...`): a leaf shape, as in CityEngine.
+            let mut d = Diagnostic::warning(
+                format!("rule `{name}` is not defined; the shape becomes a leaf"),
+                call.name.span,
+            )
+            .with_label("no rule of this name");
+            if let Some(close) = self.suggest_rule(cx.rs, name) {
+                d = d.with_note(format!("help: did you mean `{close}`?"));
+            }
+            self.diags.push(d);
+            return RStmt::Leaf(self.symbol(name));
         }
+        self.unknown("operation or rule", &call.name, cx.rs, NameKind::Statement);
         RStmt::Nil
     }
 

@@ -118,6 +118,10 @@ pub enum ImportOverride {
 pub struct AttrDecl {
     pub annotations: Vec<Annotation>,
     pub name: Ident,
+    /// `attr streetWidth(i) = ...`: attributes with parameters, which CGA
+    /// allowed before 2019.1 (and still allows for `streetWidth`); the
+    /// resolver decides from the file's `version`.
+    pub params: Vec<Param>,
     pub locals: Vec<LocalVar>,
     pub value: Expr,
     pub span: Span,

@@ -808,15 +808,11 @@ impl<'t> Parser<'t> {
         let start = self.tok_at(self.pos).start;
         self.bump();
         let name = self.expect_name("the attribute name after `attr`")?;
-        if self.cur() == Tok::LParen {
-            let span = self.cur_span();
-            self.error(
-                "attributes cannot have parameters",
-                span,
-                "use a function `name(params) = ...` instead",
-            );
-            self.parse_params();
-        }
+        let params = if self.cur() == Tok::LParen {
+            self.parse_params()
+        } else {
+            Vec::new()
+        };
         let mark = self.diags.len();
         let locals = self.parse_with();
         if !self.eat(Tok::Eq) {
@@ -829,6 +825,7 @@ impl<'t> Parser<'t> {
         Some(AttrDecl {
             annotations,
             name,
+            params,
             locals,
             value,
             span: self.span_from(start),

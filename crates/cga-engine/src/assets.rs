@@ -7,7 +7,7 @@
 //! workspace roots. Loaded meshes are shared between all shapes and all lots.
 
 use std::collections::HashMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
 use cga_geometry::topology::FxHashMap;
@@ -34,6 +34,8 @@ pub struct Assets {
     found: Requests<Result<PathBuf, Arc<[PathBuf]>>>,
     mesh_requests: Requests<Result<Arc<Mesh>, String>>,
     texture_files: Requests<Option<Arc<str>>>,
+    /// `fileSearch` answers by rule file and query: a search lists folders.
+    searches: Requests<Vec<String>>,
     /// Whether a texture file has an alpha channel, by file: reading the
     /// image's header once for all lots (a city reads it once, not per lot).
     alpha: Mutex<FxHashMap<Arc<str>, bool>>,
@@ -82,6 +84,7 @@ impl Assets {
             found: Default::default(),
             mesh_requests: Default::default(),
             texture_files: Default::default(),
+            searches: Default::default(),
             alpha: Default::default(),
         }
     }
@@ -97,6 +100,7 @@ impl Assets {
             found: Default::default(),
             mesh_requests: Default::default(),
             texture_files: Default::default(),
+            searches: Default::default(),
             alpha: Default::default(),
         }
     }
@@ -157,6 +161,19 @@ impl Assets {
         cached(&self.mesh_requests, from, path, || {
             self.load_mesh(from, path)
         })
+    }
+
+    /// Whether `mesh` is an asset's own geometry as loaded (a built-in or a
+    /// file), which `geometry.isInstanced` asks.
+    pub fn is_asset_mesh(&self, mesh: &Arc<Mesh>) -> bool {
+        let loaded = self.meshes.lock().unwrap_or_else(|e| e.into_inner());
+        loaded
+            .values()
+            .any(|m| m.as_ref().is_ok_and(|m| Arc::ptr_eq(m, mesh)))
+            || ["cube", "quad", "disk", "sphere", "cylinder", "cone"]
+                .iter()
+                .filter_map(|n| builtin_geometry(n))
+                .any(|m| Arc::ptr_eq(&m, mesh))
     }
 
     /// Sets the largest asset file that is read, in MiB.
@@ -263,40 +280,87 @@ impl Assets {
 
     /// Files of the rule file's project matching a search query (`*` and `?`
     /// wildcards, `$regex`, whitespace = and), as paths relative to the
-    /// project's `assets/` folder (or to the project folder), sorted.
+    /// project's `assets/` folder (or to the project folder), sorted. A
+    /// query that starts with `/` names workspace paths (`/Project/assets/
+    /// *.obj`): it is matched against the files of the rule file's
+    /// workspace (the folder holding its project) and of the workspace
+    /// roots, which are answered as workspace paths. Once per rule file and
+    /// query.
     pub fn search(&self, from: FileId, query: &str) -> Vec<String> {
+        cached(&self.searches, from, query, || {
+            self.search_files(from, query)
+        })
+    }
+
+    fn search_files(&self, from: FileId, query: &str) -> Vec<String> {
         let Some(rule_file) = self.files.get(from.0 as usize) else {
             return Vec::new();
         };
         let root = project_root(rule_file);
-        let mut files = Vec::new();
-        list_files(&root, &mut files, 0);
         let terms: Vec<fancy_regex::Regex> = query
             .split_whitespace()
             .filter_map(|t| {
+                let t = t.trim_matches('\'');
                 let pattern = match t.strip_prefix('$') {
                     Some(re) => re.to_string(),
-                    None => wildcard_regex(t.trim_matches('\'')),
+                    None => wildcard_regex(t),
                 };
-                fancy_regex::Regex::new(&format!("^(?:.*/)?{pattern}$")).ok()
+                let anchored = if t.starts_with('/') {
+                    format!("^{pattern}$")
+                } else {
+                    format!("^(?:.*/)?{pattern}$")
+                };
+                fancy_regex::Regex::new(&anchored).ok()
             })
             .collect();
-        let assets = root.join("assets");
-        let mut found: Vec<String> = files
-            .into_iter()
-            .filter_map(|f| {
-                let rel = f
-                    .strip_prefix(&assets)
-                    .or_else(|_| f.strip_prefix(&root))
-                    .ok()?
-                    .to_string_lossy()
-                    .replace('\\', "/");
-                terms
-                    .iter()
-                    .all(|re| re.is_match(&rel).unwrap_or(false))
-                    .then_some(rel)
-            })
-            .collect();
+        let matches = |rel: &str| terms.iter().all(|re| re.is_match(rel).unwrap_or(false));
+        let mut found: Vec<String> = Vec::new();
+        if query.trim_start().trim_start_matches('\'').starts_with('/') {
+            // Workspace paths: the project named first, when it has no
+            // wildcard, is the only folder listed.
+            let first = query
+                .trim_start()
+                .trim_start_matches(['\'', '/'])
+                .split(['/', ' '])
+                .next()
+                .unwrap_or("");
+            let mut workspaces: Vec<PathBuf> =
+                root.parent().map(Path::to_path_buf).into_iter().collect();
+            workspaces.extend(self.workspaces.roots.iter().cloned());
+            for ws in workspaces {
+                let mut files = Vec::new();
+                if !first.is_empty() && !first.contains(['*', '?', '$']) {
+                    list_files(&ws.join(first), &mut files, 0);
+                } else {
+                    list_files(&ws, &mut files, 0);
+                }
+                for f in files {
+                    let Ok(rel) = f.strip_prefix(&ws) else {
+                        continue;
+                    };
+                    let path = format!("/{}", rel.to_string_lossy().replace('\\', "/"));
+                    if matches(&path) && !found.contains(&path) {
+                        found.push(path);
+                    }
+                }
+            }
+        } else {
+            let mut files = Vec::new();
+            list_files(&root, &mut files, 0);
+            let assets = root.join("assets");
+            found = files
+                .into_iter()
+                .filter_map(|f| {
+                    let rel = f
+                        .strip_prefix(&assets)
+                        .or_else(|_| f.strip_prefix(&root))
+                        .ok()?
+                        .to_string_lossy()
+                        .replace('\\', "/");
+                    matches(&rel).then_some(rel)
+                })
+                .collect();
+        }
         found.sort();
         found
     }

@@ -1096,7 +1096,10 @@ impl<'a> Interp<'a> {
             RStmt::Unsupported { name, span } => {
                 let name = name.clone();
                 self.warn_once(*span, || {
-                    format!("operation `{name}` is not supported yet; the shape is left unchanged")
+                    format!(
+                        "operation `{name}` {}; the shape is left unchanged",
+                        ops::not_run_reason(&name)
+                    )
                 });
                 Ok(())
             }

@@ -27,8 +27,19 @@ impl Interp<'_> {
                 for a in args {
                     values.push(self.eval(a, frame, shape)?);
                 }
-                (b.f)(&values)
-                    .map_err(|m| RtError::new(format!("{}: {}", b.name, m.message), e.span))
+                (b.f)(&values).map_err(|m| {
+                    // Most built-ins name themselves in their messages.
+                    let named = m
+                        .message
+                        .strip_prefix(b.name)
+                        .is_some_and(|rest| rest.starts_with(':'));
+                    let message = if named {
+                        m.message
+                    } else {
+                        format!("{}: {}", b.name, m.message)
+                    };
+                    RtError::new(message, e.span)
+                })
             }
             RExprKind::Shape(f, args) => {
                 let mut values = Vec::with_capacity(args.len());

@@ -36,6 +36,12 @@ pub enum FileFn {
     AssetsSortRatio,
     /// `imagesSortRatio(files, axes)`.
     ImagesSortRatio,
+    /// The utility library's asset and image pickers (`assetBestSize`,
+    /// `imageApproxRatio`, ...): a file found by a search query, chosen by
+    /// how its size or ratio fits the scope.
+    Pick(Pick),
+    /// `listRandom(stringList)`: a random item.
+    ListRandom,
     /// `assetMetadata(file, key, default)`.
     AssetMetadata,
     /// `sel(string)`: a selector from a string.
@@ -46,6 +52,40 @@ pub enum FileFn {
     /// empty result of the function's type, so that rule files using them
     /// still generate.
     Unsupported(Unsupported),
+}
+
+/// How a utility picker chooses among the files of its search query, ranked
+/// as `assetsSortSize`, `assetsSortRatio` or `imagesSortRatio` rank them
+/// (celib/asset*.md, celib/image*.md).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pick {
+    /// `assetBestSize(query, axes)`: the best size fit.
+    BestSize,
+    /// `assetApproxSize(query, axes, n)`: one of the n best size fits.
+    ApproxSize,
+    /// `assetFitSize(query, axes, maxScaleError)`: any file within the
+    /// scale error (all files for 0).
+    FitSize,
+    /// `assetBestRatio(query, axes)`.
+    BestRatio,
+    /// `assetApproxRatio(query, axes, n)`.
+    ApproxRatio,
+    /// `imageBestRatio(query, axes)`: among files that share the best
+    /// ratio, a random one (the page says so).
+    ImageBestRatio,
+    /// `imageApproxRatio(query, axes, n)`.
+    ImageApproxRatio,
+}
+
+impl Pick {
+    /// The sort function whose ranking the picker uses.
+    fn ranking(self) -> FileFn {
+        match self {
+            Pick::BestSize | Pick::ApproxSize | Pick::FitSize => FileFn::AssetsSortSize,
+            Pick::BestRatio | Pick::ApproxRatio => FileFn::AssetsSortRatio,
+            Pick::ImageBestRatio | Pick::ImageApproxRatio => FileFn::ImagesSortRatio,
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -84,6 +124,14 @@ pub fn lookup(name: &str, arity: usize) -> Option<FileFn> {
         ("assetsSortRatio", 2) => FileFn::AssetsSortRatio,
         ("imagesSortRatio", 2) => FileFn::ImagesSortRatio,
         ("assetMetadata", 3) => FileFn::AssetMetadata,
+        ("assetBestSize", 2) => FileFn::Pick(Pick::BestSize),
+        ("assetApproxSize", 3) => FileFn::Pick(Pick::ApproxSize),
+        ("assetFitSize", 3) => FileFn::Pick(Pick::FitSize),
+        ("assetBestRatio", 2) => FileFn::Pick(Pick::BestRatio),
+        ("assetApproxRatio", 3) => FileFn::Pick(Pick::ApproxRatio),
+        ("imageBestRatio", 2) => FileFn::Pick(Pick::ImageBestRatio),
+        ("imageApproxRatio", 3) => FileFn::Pick(Pick::ImageApproxRatio),
+        ("listRandom", 1) => FileFn::ListRandom,
         ("sel", 1) => FileFn::Sel,
         ("getTreeKey", 0) => FileFn::TreeKey,
         ("assetNamingInfo", 2) => FileFn::Unsupported(Unsupported::Str("assetNamingInfo")),
@@ -254,6 +302,19 @@ impl Interp<'_> {
             FileFn::AssetsSortSize | FileFn::AssetsSortRatio | FileFn::ImagesSortRatio => {
                 self.sort_files(f, args, shape, at)?
             }
+            FileFn::Pick(pick) => self.pick_file(pick, args, shape, at)?,
+            FileFn::ListRandom => {
+                // A `;`-separated list whose last item is terminated too
+                // (celib/listRandom.md); empty items are no items.
+                let list = text(&args[0], at)?;
+                let items: Vec<&str> = list.split(';').filter(|s| !s.is_empty()).collect();
+                if items.is_empty() {
+                    Value::str("")
+                } else {
+                    let i = (shape.next_random() * items.len() as f64) as usize;
+                    Value::str(items[i.min(items.len() - 1)])
+                }
+            }
             // Only OBJ assets are read, and OBJ carries no metadata: the
             // default value is the answer.
             FileFn::AssetMetadata => {
@@ -308,7 +369,6 @@ impl Interp<'_> {
         shape: &Shape,
         at: &RExpr,
     ) -> Result<Value, RtError> {
-        let file = at.span.file;
         let (files, as_list): (Vec<Arc<str>>, bool) = match &args[0] {
             Value::Str(s) => (
                 s.split(';')
@@ -328,7 +388,37 @@ impl Interp<'_> {
                 ))
             }
         };
-        let axes_text = text(&args[1], at)?;
+        let max_error = match f {
+            FileFn::AssetsSortSize => num(&args[2], at)?,
+            _ => 0.0,
+        };
+        let ranked = self.rank_files(f, &files, text(&args[1], at)?, shape, at)?;
+        let kept: Vec<Arc<str>> = ranked
+            .into_iter()
+            .filter(|&(e, _)| max_error <= 0.0 || e <= max_error)
+            .map(|(_, i)| files[i].clone())
+            .collect();
+        Ok(if as_list {
+            Value::Str(Arc::from(
+                kept.iter().map(|s| format!("{s};")).collect::<String>(),
+            ))
+        } else {
+            Value::StrArray(Arc::new(Array::row(kept)))
+        })
+    }
+
+    /// The files ranked by how far each is from fitting the scope (its
+    /// misfit and its index in `files`), best first; ties keep the given
+    /// order, unreadable files come last.
+    fn rank_files(
+        &mut self,
+        f: FileFn,
+        files: &[Arc<str>],
+        axes_text: &str,
+        shape: &Shape,
+        at: &RExpr,
+    ) -> Result<Vec<(f64, usize)>, RtError> {
+        let file = at.span.file;
         let axes: Vec<usize> = axes_text
             .chars()
             .map(|c| match c {
@@ -370,10 +460,6 @@ impl Interp<'_> {
                 }
             })
             .collect();
-        let max_error = match f {
-            FileFn::AssetsSortSize => num(&args[2], at)?,
-            _ => 0.0,
-        };
         // How far a file is from fitting: for sizes, the largest relative
         // scaling it needs along the axes; for ratios, the largest factor
         // (as a logarithm) between its axis ratios and the scope's.
@@ -419,18 +505,66 @@ impl Interp<'_> {
             }
         }
         ranked.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let kept: Vec<Arc<str>> = ranked
+        Ok(ranked)
+    }
+
+    /// The utility library's pickers: the files of the search query
+    /// (`fileSearch`), ranked as the sort function ranks them, then the
+    /// best, one of the n best, or one within the scale error, drawn from
+    /// the shape's random stream. No file found: `""`.
+    fn pick_file(
+        &mut self,
+        pick: Pick,
+        args: &[Value],
+        shape: &Shape,
+        at: &RExpr,
+    ) -> Result<Value, RtError> {
+        let query = text(&args[0], at)?;
+        let axes = text(&args[1], at)?;
+        let files: Vec<Arc<str>> = self
+            .assets
+            .search(at.span.file, query)
             .into_iter()
-            .filter(|&(e, _)| max_error <= 0.0 || e <= max_error)
-            .map(|(_, i)| files[i].clone())
+            .map(|s| Arc::from(s.as_str()))
             .collect();
-        Ok(if as_list {
-            Value::Str(Arc::from(
-                kept.iter().map(|s| format!("{s};")).collect::<String>(),
-            ))
-        } else {
-            Value::StrArray(Arc::new(Array::row(kept)))
-        })
+        let ranked = self.rank_files(pick.ranking(), &files, axes, shape, at)?;
+        if ranked.is_empty() {
+            self.warn_once(at.span, || {
+                format!("no file matches \"{query}\"; the result is \"\"")
+            });
+            return Ok(Value::str(""));
+        }
+        let choices: Vec<usize> = match pick {
+            Pick::BestSize | Pick::BestRatio => vec![ranked[0].1],
+            Pick::ImageBestRatio => ranked
+                .iter()
+                .take_while(|(e, _)| *e <= ranked[0].0)
+                .map(|&(_, i)| i)
+                .collect(),
+            Pick::ApproxSize | Pick::ApproxRatio | Pick::ImageApproxRatio => {
+                let n = num(&args[2], at)?;
+                let n = if n.is_finite() {
+                    n.floor().max(1.0) as usize
+                } else {
+                    1
+                };
+                ranked.iter().take(n).map(|&(_, i)| i).collect()
+            }
+            Pick::FitSize => {
+                let max_error = num(&args[2], at)?;
+                ranked
+                    .iter()
+                    .filter(|&&(e, _)| max_error <= 0.0 || e <= max_error)
+                    .map(|&(_, i)| i)
+                    .collect()
+            }
+        };
+        let chosen = match choices.len() {
+            0 => return Ok(Value::str("")),
+            1 => choices[0],
+            n => choices[((shape.next_random() * n as f64) as usize).min(n - 1)],
+        };
+        Ok(Value::Str(files[chosen].clone()))
     }
 
     /// `convert(coordinate, from, to, type, x, y, z)` and

@@ -67,6 +67,27 @@ impl MatField {
     /// Parses `material.color.r`, `material.colormap.su`, ... (with the `material.` prefix).
     pub fn parse(name: &str) -> Option<MatField> {
         let rest = name.strip_prefix("material.")?;
+        // Names of before 2011.1 (cga_changelog.md): `material.bump` became
+        // `bumpValue`, `map3`/`map4`/`map5` the specular, opacity and
+        // normal maps.
+        let renamed;
+        let rest = match rest.split_once('.').map_or((rest, ""), |(h, t)| (h, t)) {
+            ("bump", "") => "bumpValue",
+            (old @ ("map3" | "map4" | "map5"), tail) => {
+                let new = match old {
+                    "map3" => "specularmap",
+                    "map4" => "opacitymap",
+                    _ => "normalmap",
+                };
+                renamed = if tail.is_empty() {
+                    new.to_string()
+                } else {
+                    format!("{new}.{tail}")
+                };
+                renamed.as_str()
+            }
+            _ => rest,
+        };
         let rgb = |s: &str| match s {
             "r" => Some(0u8),
             "g" => Some(1),

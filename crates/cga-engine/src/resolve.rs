@@ -1129,11 +1129,48 @@ impl Resolver<'_> {
                 span,
             );
             return placeholder(span);
+        } else if let Some(arities) = self.known_arities(cx.rs, &name.name) {
+            // A known function called with the wrong number of arguments.
+            self.error(
+                format!("`{}` takes {arities} arguments, found {n}", name.name),
+                span,
+            );
+            return placeholder(span);
         } else {
             self.unknown("function", name, cx.rs, NameKind::Value);
             return placeholder(span);
         };
         RExpr { kind, span }
+    }
+
+    /// The argument counts a user function or shape function called `name`
+    /// takes (`1 or 3`), if there is one.
+    fn known_arities(&self, rs: RuleSetId, name: &str) -> Option<String> {
+        let mut counts: Vec<usize> = match self.tables[rs as usize].funcs.get(name) {
+            Some(ids) => ids
+                .iter()
+                .map(|&f| self.program.functions[f as usize].arity)
+                .collect(),
+            None => (0..=10)
+                .filter(|&k| shape_fns::lookup(name, k).is_some())
+                .collect(),
+        };
+        counts.sort_unstable();
+        counts.dedup();
+        match counts.as_slice() {
+            [] => None,
+            [one] => Some(one.to_string()),
+            [first, .., last] if counts.windows(2).all(|w| w[1] == w[0] + 1) => {
+                Some(format!("{first} to {last}"))
+            }
+            _ => Some(
+                counts
+                    .iter()
+                    .map(|c| c.to_string())
+                    .collect::<Vec<_>>()
+                    .join(" or "),
+            ),
+        }
     }
 
     /// A block head (split size or comp selector): names that are not values

@@ -51,6 +51,9 @@ pub enum Quadrant {
     Bottom,
     /// Any of front, back, left, right (only as a selector: `object.side`).
     Side,
+    /// Back, left or right: the deprecated `noStreetSide` (only as a
+    /// selector).
+    SideNotFront,
 }
 
 /// The class of the angle between a normal and the xz-plane.
@@ -129,6 +132,11 @@ impl Selector {
             return Some(S::Quadrant(Space::World, q));
         }
         Some(match name {
+            // Deprecated since 2012.1 (cga_changelog.md) for the street.*
+            // selectors; without street data the side facing the street is
+            // the front, as street.front falls back to object.front.
+            "streetSide" => S::Quadrant(Space::Object, Front),
+            "noStreetSide" => S::Quadrant(Space::Object, SideNotFront),
             "horizontal" => S::Slope(Slope::Horizontal),
             "aslant" => S::Slope(Slope::Aslant),
             "vertical" => S::Slope(Slope::Vertical),
@@ -210,6 +218,7 @@ fn quadrant_matches(sel: Quadrant, q: Quadrant) -> bool {
             q,
             Quadrant::Front | Quadrant::Back | Quadrant::Left | Quadrant::Right
         ),
+        Quadrant::SideNotFront => matches!(q, Quadrant::Back | Quadrant::Left | Quadrant::Right),
         _ => sel == q,
     }
 }

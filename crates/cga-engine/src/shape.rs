@@ -408,8 +408,30 @@ fn splitmix64(state: &mut u64) -> u64 {
 /// Rotation matrix of CGA Euler angles in degrees: x first, then y, then z
 /// (`R = Rz * Ry * Rx` applied to column vectors).
 pub fn euler_to_mat(angles: DVec3) -> DMat3 {
-    let r = angles * (std::f64::consts::PI / 180.0);
-    DMat3::from_rotation_z(r.z) * DMat3::from_rotation_y(r.y) * DMat3::from_rotation_x(r.x)
+    let (sx, cx) = sin_cos_degrees(angles.x);
+    let (sy, cy) = sin_cos_degrees(angles.y);
+    let (sz, cz) = sin_cos_degrees(angles.z);
+    let rx = DMat3::from_cols(DVec3::X, DVec3::new(0.0, cx, sx), DVec3::new(0.0, -sx, cx));
+    let ry = DMat3::from_cols(DVec3::new(cy, 0.0, -sy), DVec3::Y, DVec3::new(sy, 0.0, cy));
+    let rz = DMat3::from_cols(DVec3::new(cz, sz, 0.0), DVec3::new(-sz, cz, 0.0), DVec3::Z);
+    rz * ry * rx
+}
+
+/// Sine and cosine of an angle in degrees, exact for multiples of 90°: a
+/// quarter turn (`r(0, 90, 0)`, a side face's scope) must not leave
+/// `cos(pi/2) = 6e-17` in the axes, which shows as noise such as
+/// `1.2e-15` in printed coordinates.
+fn sin_cos_degrees(deg: f64) -> (f64, f64) {
+    if deg.is_finite() && deg % 90.0 == 0.0 {
+        match (deg / 90.0).rem_euclid(4.0) as u8 {
+            0 => (0.0, 1.0),
+            1 => (1.0, 0.0),
+            2 => (0.0, -1.0),
+            _ => (-1.0, 0.0),
+        }
+    } else {
+        deg.to_radians().sin_cos()
+    }
 }
 
 /// `mat_to_euler(pivot_axes^T * axes)`, remembered for the last inputs:

@@ -60,6 +60,8 @@ pub fn arg_is_selector(name: &str, pos: usize) -> bool {
         "assetInfo" | "imageInfo" => pos == 1,
         "getGeoCoord" => pos == 0,
         "assetsSortSize" | "assetsSortRatio" | "imagesSortRatio" => pos == 1,
+        "assetBestSize" | "assetApproxSize" | "assetFitSize" | "assetBestRatio"
+        | "assetApproxRatio" | "imageBestRatio" | "imageApproxRatio" => pos == 1,
         "assetNamingInfo" | "assetNamingInfos" => pos == 1,
         "getMaterial" => pos < 2,
         _ => false,
@@ -98,6 +100,11 @@ pub enum GeometryFn {
     Tags,
     /// `geometry.hasTags([query [, components]])`.
     HasTags,
+    /// `geometry.groups()`: the group names, in the order of `comp(g)`.
+    Groups,
+    /// `geometry.isInstanced()`: the geometry is an inserted asset, not
+    /// changed since `i()` (only placed: `t`, `r`, `s` keep it).
+    IsInstanced,
 }
 
 /// The shape function called `name` with `arity` arguments, if any.
@@ -167,6 +174,8 @@ pub fn lookup(name: &str, arity: usize) -> Option<ShapeFn> {
             "materials" => (Materials, &[0]),
             "tags" => (Tags, &[0, 1, 2]),
             "hasTags" => (HasTags, &[0, 1, 2]),
+            "groups" => (Groups, &[0]),
+            "isInstanced" => (IsInstanced, &[0]),
             _ => return None,
         };
         return arities.contains(&arity).then_some(ShapeFn::Geometry(f));
@@ -182,6 +191,11 @@ pub fn lookup(name: &str, arity: usize) -> Option<ShapeFn> {
         ("trim.vertical", 0) => ShapeFn::TrimVertical,
         ("initialShape.name", 0) => ShapeFn::InitialShapeName,
         ("initialShape.startRule", 0) => ShapeFn::InitialShapeStartRule,
+        // Deprecated names CGA still reads (cga_changelog.md): the start
+        // rule's old name (2010.1), and `uid`, replaced by getTreeKey
+        // (2015.0).
+        ("initialShape.symbol", 0) => ShapeFn::InitialShapeStartRule,
+        ("uid", 0) => ShapeFn::File(crate::file_fns::FileFn::TreeKey),
         ("rand", 0..=2) => ShapeFn::Rand,
         ("p", 1) => ShapeFn::P,
         ("print", 1) => ShapeFn::Print,
@@ -423,6 +437,40 @@ mod eval {
             })
         }
 
+        /// The geometry functions that read the stored mesh as it is (tags,
+        /// groups, whether it is an asset's).
+        fn stored_mesh_fn(
+            &mut self,
+            g: GeometryFn,
+            args: &[Value],
+            shape: &Shape,
+            at: &RExpr,
+        ) -> Result<Value, RtError> {
+            let (mesh, _) = shape.geometry.raw();
+            Ok(match g {
+                // The shape still holds the asset's own mesh (placing it
+                // only changes the lazy map); any change made a new mesh.
+                GeometryFn::IsInstanced => Value::Bool(self.assets.is_asset_mesh(mesh)),
+                GeometryFn::Groups => {
+                    let mut used = vec![false; mesh.groups.len()];
+                    for f in &mesh.faces {
+                        if let Some(u) = used.get_mut(f.group as usize) {
+                            *u = true;
+                        }
+                    }
+                    let names: Vec<Arc<str>> = mesh
+                        .groups
+                        .iter()
+                        .zip(&used)
+                        .filter(|(_, &u)| u)
+                        .map(|(g, _)| Arc::from(g.as_str()))
+                        .collect();
+                    Value::StrArray(Arc::new(cga_value::Array::row(names)))
+                }
+                _ => tags_fn(g, args, shape, at)?,
+            })
+        }
+
         fn geometry_fn(
             &mut self,
             g: GeometryFn,
@@ -432,9 +480,15 @@ mod eval {
         ) -> Result<Value, RtError> {
             use cga_geometry::measure as m;
             use cga_geometry::Topology;
-            if matches!(g, GeometryFn::Tags | GeometryFn::HasTags) {
-                // Tags need no coordinates: the stored mesh serves.
-                return tags_fn(g, args, shape, at);
+            if matches!(
+                g,
+                GeometryFn::Tags
+                    | GeometryFn::HasTags
+                    | GeometryFn::Groups
+                    | GeometryFn::IsInstanced
+            ) {
+                // No coordinates needed: the stored mesh serves.
+                return self.stored_mesh_fn(g, args, shape, at);
             }
             // Measures are taken in object coordinates: scaling is lazy, so the
             // stored mesh alone would give wrong areas.
@@ -579,7 +633,10 @@ mod eval {
                         }
                     }
                 }
-                GeometryFn::Tags | GeometryFn::HasTags => tags_fn(g, args, shape, at)?,
+                GeometryFn::Tags
+                | GeometryFn::HasTags
+                | GeometryFn::Groups
+                | GeometryFn::IsInstanced => self.stored_mesh_fn(g, args, shape, at)?,
                 GeometryFn::Du | GeometryFn::Dv => {
                     let set = uv_set(0)?;
                     let unit = matches!(args.get(1), Some(Value::Str(s)) if &**s == "unitSpace");

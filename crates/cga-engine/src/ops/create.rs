@@ -305,6 +305,15 @@ fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {
                     "world.up.flatTop",
                     "face.normal",
                     "vertex.normal",
+                    // Older forms (cga_changelog.md, 2009.2): `world.x|y|z`
+                    // extrude along a world axis, and the deprecated `x|y|z`
+                    // are read the same way.
+                    "world.x",
+                    "world.y",
+                    "world.z",
+                    "x",
+                    "y",
+                    "z",
                 ],
             )?,
             d.num()?,
@@ -317,7 +326,9 @@ fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {
     }
     let mesh = shape.take_object_mesh();
     let how = match kind {
-        "world.up" => Extrusion::Direction(DVec3::Y),
+        "world.up" | "world.y" | "y" => Extrusion::Direction(DVec3::Y),
+        "world.x" | "x" => Extrusion::Direction(DVec3::X),
+        "world.z" | "z" => Extrusion::Direction(DVec3::Z),
         "world.up.flatTop" => Extrusion::DirectionFlatTop(DVec3::Y),
         "vertex.normal" => Extrusion::VertexNormal,
         _ => Extrusion::FaceNormal,

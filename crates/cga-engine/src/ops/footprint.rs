@@ -740,14 +740,22 @@ fn envelope(
     call: &OpCall,
     args: &[Arg],
 ) -> Result<(), RtError> {
-    let direction = selector(&args[0], &["normal", "world.up"])?;
-    let max_height = args[1].num()?;
+    // The signatures without a direction (deprecated in 2013.0, still read)
+    // erect along the face normal.
+    let (direction, rest): (&str, &[Arg]) = match &args[0].value {
+        Value::Str(_) => (selector(&args[0], &["normal", "world.up"])?, &args[1..]),
+        _ => ("normal", args),
+    };
+    let Some((max_height, pairs)) = rest.split_first() else {
+        return Err(RtError::new("`envelope` needs a maximum height", call.span));
+    };
+    let max_height = max_height.num()?;
     let mesh = st.shape.geometry.local().clone();
     if mesh.faces.is_empty() {
         return Ok(());
     }
     let n = face_edge_count(&mesh);
-    let (base, angle) = match &args[2..] {
+    let (base, angle) = match pairs {
         [b, a] if matches!(b.value, Value::FloatArray(_)) || matches!(a.value, Value::FloatArray(_)) => {
             (per_edge(b, n, 0.0)?, per_edge(a, n, 90.0)?)
         }

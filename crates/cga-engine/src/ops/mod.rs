@@ -167,7 +167,8 @@ pub fn arg_mode(name: &str, arity: usize, pos: usize) -> ArgMode {
         ("setupProjection", _, 1) => Selector,
         ("normalizeUV", _, 1 | 2) => Selector,
         ("offset", 2, 1) => Selector,
-        ("envelope", _, 0) => Selector,
+        // Maybe: the deprecated forms without a direction start with the height.
+        ("envelope", _, 0) => Maybe,
         ("setback" | "setbackPerEdge" | "setbackToArea" | "shapeL" | "shapeU" | "shapeO", _, _) => {
             Maybe
         }
@@ -176,6 +177,9 @@ pub fn arg_mode(name: &str, arity: usize, pos: usize) -> ArgMode {
         ("scatter" | "rectify" | "cleanupGeometry" | "setNormals" | "mirror", _, _) => Maybe,
         ("trim" | "taper" | "reduceGeometry" | "insertAlongUV", _, _) => Maybe,
         ("tag" | "deleteTags", 2, 1) => Selector,
+        // Operations that are not run: their selector words must not be
+        // unknown names.
+        ("roof" | "setupUV" | "bakeUV" | "setTagsFromEdgeAttrs", _, _) => Maybe,
         _ => Expr,
     }
 }
@@ -227,7 +231,8 @@ pub fn lookup(name: &str) -> Option<OpInfo> {
         "reverseNormals" => info(Op::ReverseNormals, 0, 0),
         "setupProjection" => info(Op::SetupProjection, 4, 7),
         "projectUV" => info(Op::ProjectUV, 1, 1),
-        "translateUV" => info(Op::TranslateUV, 3, 3),
+        // `offsetUV` is translateUV's name before 2009.3 (cga_changelog.md).
+        "translateUV" | "offsetUV" => info(Op::TranslateUV, 3, 3),
         "scaleUV" => info(Op::ScaleUV, 3, 3),
         "rotateUV" => info(Op::RotateUV, 2, 2),
         "normalizeUV" => info(Op::NormalizeUV, 3, 3),
@@ -275,7 +280,7 @@ pub fn lookup(name: &str) -> Option<OpInfo> {
         "splitAndSetbackPerimeter" => with_block(Op::SplitAndSetbackPerimeter, 1, 3),
         "innerRectangle" => with_block(Op::InnerRectangle, 1, 1),
         "innerRect" => info(Op::InnerRect, 0, 0),
-        "envelope" => info(Op::Envelope, 4, 10),
+        "envelope" => info(Op::Envelope, 3, 10),
         "taper" => info(Op::Taper, 1, 1),
         "footprint" => info(Op::Footprint, 0, 0),
         "convexify" => info(Op::Convexify, 0, 1),
@@ -293,10 +298,22 @@ pub fn lookup(name: &str) -> Option<OpInfo> {
     }
 }
 
+/// Why an operation of [`ALL_OPERATIONS`] that [`lookup`] does not know is
+/// not run (the warning's wording).
+pub fn not_run_reason(name: &str) -> &'static str {
+    match name {
+        // cga_changelog.md, 2009.3: `roof` gave way to roofGable/roofHip/
+        // roofPyramid/roofShed, setupUV/bakeUV to setupProjection/projectUV.
+        "roof" | "setupUV" | "bakeUV" => "was deprecated in CGA 2009.3 and is not run",
+        _ => "is not supported yet",
+    }
+}
+
 /// Every operation of CGA, implemented here or not: a call of one of these
 /// that the engine does not run yet is a warning, not an error.
 pub const ALL_OPERATIONS: &[&str] = &[
     "alignScopeToAxes",
+    "bakeUV",
     "alignScopeToGeometry",
     "alignScopeToGeometryBBox",
     "center",
@@ -324,6 +341,7 @@ pub const ALL_OPERATIONS: &[&str] = &[
     "modify",
     "normalizeUV",
     "offset",
+    "offsetUV",
     "primitiveCone",
     "primitiveCube",
     "primitiveCylinder",
@@ -339,6 +357,7 @@ pub const ALL_OPERATIONS: &[&str] = &[
     "resetGeometry",
     "resetMaterial",
     "reverseNormals",
+    "roof",
     "roofGable",
     "roofHip",
     "roofPyramid",
@@ -355,6 +374,7 @@ pub const ALL_OPERATIONS: &[&str] = &[
     "setNormals",
     "setPivot",
     "setTagsFromEdgeAttrs",
+    "setupUV",
     "setback",
     "setbackPerEdge",
     "setbackToArea",

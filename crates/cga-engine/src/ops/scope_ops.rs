@@ -94,7 +94,13 @@ pub fn exec(
             align_pivot_and_scope(shape, axes);
         }
         Op::SetPivot => {
-            let map = selector(&args[0], &["xyz", "yzx", "zxy"])?;
+            // `yUp`/`zUp` were dropped in 2010.1 for `xyz`/`yzx`
+            // (cga_changelog.md); older files still use them.
+            let map = match selector(&args[0], &["xyz", "yzx", "zxy", "yUp", "zUp"])? {
+                "yUp" => "xyz",
+                "zUp" => "yzx",
+                other => other,
+            };
             let corner = args[1].num()?.round().clamp(0.0, 7.0) as usize;
             set_pivot(shape, map, corner);
         }
@@ -176,7 +182,10 @@ fn pick_face_edge(
                     low(a).total_cmp(&low(b))
                 })
                 .unwrap_or(0)],
-            "any" => (0..nf).collect(),
+            // `auto` (deprecated since 2010.1, still read): any face, and
+            // without an edge argument its lowest edge, the longest of
+            // those on one level (cga_changelog.md, 2009.2).
+            "any" | "auto" => (0..nf).collect(),
             other => {
                 return Err(RtError::new(
                     format!(
@@ -211,6 +220,23 @@ fn pick_face_edge(
         Some((a, false)) => {
             let f = faces[0];
             Ok((f, modulo(a.num()?, n_edges(f))))
+        }
+        None if matches!(&face_arg.value, cga_value::Value::Str(s) if &**s == "auto") => {
+            let mut best: Option<((f64, f64), usize, usize)> = None;
+            for &f in &faces {
+                for e in 0..n_edges(f) {
+                    let (p, q) = edge_len(f, e);
+                    let key = (p.y.max(q.y), -(q - p).length());
+                    let better = best.is_none_or(|((y, l), _, _)| {
+                        key.0 < y - 1e-9 || (key.0 <= y + 1e-9 && key.1 < l - 1e-12)
+                    });
+                    if better {
+                        best = Some((key, f, e));
+                    }
+                }
+            }
+            let (_, f, e) = best.unwrap_or(((0.0, 0.0), faces[0], 0));
+            Ok((f, e))
         }
         None => Ok((faces[0], 0)),
     }

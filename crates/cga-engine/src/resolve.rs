@@ -1345,6 +1345,10 @@ impl Resolver<'_> {
                     out.push(stmt);
                     i += used;
                 }
+                Stmt::Call(call) if i + 1 < stmts.len() && self.is_old_boolean(cx, call) => {
+                    out.push(self.old_boolean(cx, call, &stmts[i + 1]));
+                    i += 2;
+                }
                 s => {
                     out.push(self.stmt(cx, s));
                     i += 1;
@@ -1352,6 +1356,72 @@ impl Resolver<'_> {
             }
         }
         out
+    }
+
+    /// `subtract Rule`, `subtract(swap) Rule` (and `union`, `intersect`):
+    /// the Boolean operations' syntax before 2025.0, the current shape and
+    /// the next statement's shape as operands.
+    fn is_old_boolean(&self, cx: &Cx, call: &ast::Call) -> bool {
+        matches!(call.name.name.as_str(), "union" | "subtract" | "intersect")
+            && call.block.is_none()
+            && call.import_overrides.is_none()
+            && call.args.as_ref().is_none_or(|a| a.len() <= 1)
+            && self
+                .find_rule(
+                    cx.rs,
+                    &call.name.name,
+                    call.args.as_ref().map_or(0, |a| a.len()),
+                )
+                .is_none()
+    }
+
+    /// The old Boolean syntax as the new one (cga_changelog.md, 2025.0):
+    /// `subtract Rule` is `subtract { OperandA. | Rule }`, `subtract(swap)
+    /// Rule` is `subtract { Rule | OperandB. }`.
+    fn old_boolean(&mut self, cx: &Cx, call: &ast::Call, next: &Stmt) -> RStmt {
+        let swap = match call.args.as_deref() {
+            Some([arg]) => match &arg.kind {
+                ExprKind::Name(n) if n.name == "swap" => true,
+                _ => {
+                    self.error(
+                        format!("`{}` takes `swap` or no argument here", call.name.name),
+                        arg.span,
+                    );
+                    false
+                }
+            },
+            _ => false,
+        };
+        let span = call.span;
+        let current = |r: &mut Self, name: &str| RPart::Unlabeled {
+            body: RBody::Ops(vec![RStmt::Leaf(r.symbol(name))]),
+            span,
+        };
+        let other = RPart::Unlabeled {
+            body: RBody::Ops(vec![self.stmt(cx, next)]),
+            span,
+        };
+        let parts = if swap {
+            vec![other, current(self, "OperandB")]
+        } else {
+            vec![current(self, "OperandA"), other]
+        };
+        let op = match call.name.name.as_str() {
+            "union" => Op::Union,
+            "subtract" => Op::Subtract,
+            _ => Op::Intersect,
+        };
+        RStmt::Op(OpCall {
+            op,
+            args: Vec::new(),
+            block: Some(RBlock {
+                parts,
+                repeat: false,
+                span,
+            }),
+            remainder_block: None,
+            span,
+        })
     }
 
     /// `inline` is a keyword unless a rule of that name exists.

@@ -601,3 +601,19 @@ fn quarter_turns_leave_no_rounding_noise() {
         assert!(!p.contains('e'), "{p}");
     }
 }
+
+#[test]
+fn boolean_operations_in_their_syntax_before_2025() {
+    let cutter = "B --> s(5, 20, 5) primitiveCube()\n";
+    let vol = |body: &str| {
+        gen(&format!("Lot --> extrude(10) {body}\n{cutter}"))
+            .ok()
+            .volume()
+    };
+    let old = vol("subtract B");
+    assert_near(old, 6000.0 - 5.0 * 10.0 * 5.0, 1e-6);
+    assert_near(old, vol("subtract { A. | B }"), 1e-9);
+    // swap: the rule's shape minus the current one.
+    assert_near(vol("subtract(swap) B"), 5.0 * 10.0 * 5.0, 1e-6);
+    assert_near(vol("intersect B"), 5.0 * 10.0 * 5.0, 1e-6);
+}

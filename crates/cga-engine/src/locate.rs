@@ -17,6 +17,12 @@
 //! Any other path is relative to the rule file: its folder first, then each
 //! ancestor's `assets/` folder and the ancestor itself (the project root,
 //! so that `assets/x.obj` and `rules/x.cga` work from inside `rules/`).
+//!
+//! Rule files written on Windows separate folders with `\` and do not
+//! always match the case of the names on disk (CityEngine on Windows found
+//! such files until 2025.0): `\` is read as `/`, and when no place holds
+//! the file with the exact name, the same places are searched again
+//! ignoring the case of ASCII letters.
 
 use std::path::{Path, PathBuf};
 
@@ -57,12 +63,13 @@ pub fn candidates(from: &Path, target: &str, workspaces: &Workspaces) -> Vec<Pat
             out.push(p);
         }
     };
-    let target = target.trim();
+    let target = target.trim().replace('\\', "/");
+    let target = target.as_str();
     if target.is_empty() {
         return out;
     }
-    if let Some(rel) = target.strip_prefix(['/', '\\']) {
-        let rel = rel.trim_start_matches(['/', '\\']);
+    if let Some(rel) = target.strip_prefix('/') {
+        let rel = rel.trim_start_matches('/');
         if !rel.is_empty() {
             push(PathBuf::from(target));
             for dir in folder.ancestors() {
@@ -93,8 +100,11 @@ pub fn candidates(from: &Path, target: &str, workspaces: &Workspaces) -> Vec<Pat
 /// was searched.
 pub fn locate(from: &Path, target: &str, workspaces: &Workspaces) -> Result<PathBuf, Vec<PathBuf>> {
     let places = candidates(from, target, workspaces);
-    match places.iter().find(|p| is_file(p)) {
-        Some(found) => Ok(found.clone()),
+    if let Some(found) = places.iter().find(|p| is_file(p)) {
+        return Ok(found.clone());
+    }
+    match places.iter().find_map(|p| with_any_case(p)) {
+        Some(found) => Ok(found),
         None => Err(places),
     }
 }
@@ -102,6 +112,37 @@ pub fn locate(from: &Path, target: &str, workspaces: &Workspaces) -> Result<Path
 /// The one file-existence check of the search.
 fn is_file(path: &Path) -> bool {
     path.is_file()
+}
+
+/// The file at `path` with the case of its names' ASCII letters ignored
+/// (each missing name matched against its folder's entries), if exactly
+/// one way leads to a file.
+fn with_any_case(path: &Path) -> Option<PathBuf> {
+    let mut found = PathBuf::new();
+    for part in path.components() {
+        let next = found.join(part.as_os_str());
+        if next.exists() || !matches!(part, std::path::Component::Normal(_)) {
+            found = next;
+            continue;
+        }
+        let want = part.as_os_str().to_str()?;
+        let dir = if found.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            found.as_path()
+        };
+        let mut matches = std::fs::read_dir(dir).ok()?.flatten().filter(|e| {
+            e.file_name()
+                .to_str()
+                .is_some_and(|n| n.eq_ignore_ascii_case(want))
+        });
+        let entry = matches.next()?;
+        if matches.next().is_some() {
+            return None;
+        }
+        found.push(entry.file_name());
+    }
+    is_file(&found).then_some(found)
 }
 
 /// A not-found message's list of the places searched, one per line.
@@ -161,5 +202,25 @@ mod tests {
             ]
         );
         assert!(candidates(Path::new("/a/b.cga"), "  ", &Workspaces::default()).is_empty());
+        // Folders separated by `\\` (rule files written on Windows).
+        let c = candidates(
+            Path::new("/w/P/a.cga"),
+            "win\\w.obj",
+            &Workspaces::default(),
+        );
+        assert_eq!(c[0], Path::new("/w/P/win/w.obj"));
+    }
+
+    #[test]
+    fn names_in_another_case_are_found_when_no_exact_name_is() {
+        let dir = std::env::temp_dir().join(format!("cga-locate-case-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(dir.join("assets/Windows")).unwrap();
+        std::fs::write(dir.join("assets/Windows/Win1.OBJ"), "v 0 0 0\n").unwrap();
+        let from = dir.join("rules.cga");
+        let found = locate(&from, "windows/win1.obj", &Workspaces::default()).unwrap();
+        assert_eq!(found, dir.join("assets/Windows/Win1.OBJ"));
+        assert!(locate(&from, "windows/win2.obj", &Workspaces::default()).is_err());
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

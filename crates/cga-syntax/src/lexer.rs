@@ -543,8 +543,9 @@ fn char_at(text: &str, i: usize) -> char {
         .unwrap_or('\u{fffd}')
 }
 
+/// To the end of the line: `\n`, `\r\n` or a lone `\r` (old Mac files).
 fn skip_line(bytes: &[u8], mut i: usize) -> usize {
-    while i < bytes.len() && bytes[i] != b'\n' {
+    while i < bytes.len() && bytes[i] != b'\n' && bytes[i] != b'\r' {
         i += 1;
     }
     i

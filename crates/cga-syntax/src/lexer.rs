@@ -728,6 +728,20 @@ mod tests {
     }
 
     #[test]
+    fn comments_end_at_a_lone_carriage_return() {
+        // Old Mac files end lines with CR alone.
+        assert_eq!(
+            kinds("# comment\rLot --> X.\r"),
+            vec![
+                (Tok::Ident, "Lot"),
+                (Tok::Arrow, "-->"),
+                (Tok::Ident, "X"),
+                (Tok::Dot, "."),
+            ]
+        );
+    }
+
+    #[test]
     fn strings_over_line_breaks() {
         // Closed on the next line and followed by `,`: one string.
         let text = "@Enum(\"a\",\"\n b\",\"c\") attr x = 1";

@@ -13,43 +13,205 @@ use std::sync::{Arc, Mutex};
 use cga_geometry::topology::FxHashMap;
 use cga_geometry::Mesh;
 use cga_syntax::{FileId, SourceMap};
+use cga_world::World;
 
 use crate::locate::{self, Workspaces};
 
 /// Default largest asset file read, in MiB (`--max-asset-mib`).
 pub const DEFAULT_MAX_ASSET_MIB: u64 = 512;
 
+/// What is read from files, kept across programs: a reloaded rule file
+/// (an editor's save, a preview's regeneration) finds the meshes, texts,
+/// image facts it read before, as long as the files did not change (their
+/// size and modification time are compared on each new program's first
+/// request). Shared by every thread deriving lots.
+pub struct AssetStore {
+    world: Arc<dyn World>,
+    /// Larger asset files are not read: a warning, the model goes on.
+    max_file_bytes: u64,
+    meshes: ByFile<Result<Arc<Mesh>, String>>,
+    texts: ByFile<Option<Arc<str>>>,
+    /// Whether a texture file has an alpha channel, by file: reading the
+    /// image's header once for all lots.
+    alpha: Mutex<FxHashMap<Arc<str>, Stamped<bool>>>,
+    /// Image sizes (width, height) by file.
+    image_sizes: ByFile<Option<(u32, u32)>>,
+}
+
+/// Values read from files, by file.
+type ByFile<T> = Mutex<HashMap<PathBuf, Stamped<T>>>;
+
+/// A value read from a file, with the file's size and modification time
+/// when it was read.
+#[derive(Clone)]
+struct Stamped<T> {
+    stamp: Option<(u64, Option<std::time::SystemTime>)>,
+    value: T,
+}
+
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+impl AssetStore {
+    /// A store reading from `world`.
+    pub fn new(world: Arc<dyn World>) -> AssetStore {
+        AssetStore {
+            world,
+            max_file_bytes: DEFAULT_MAX_ASSET_MIB << 20,
+            meshes: Default::default(),
+            texts: Default::default(),
+            alpha: Default::default(),
+            image_sizes: Default::default(),
+        }
+    }
+
+    /// Sets the largest asset file that is read, in MiB.
+    pub fn with_max_file_mib(mut self, mib: u64) -> AssetStore {
+        self.max_file_bytes = mib.saturating_mul(1 << 20);
+        self
+    }
+
+    /// The world files are read from.
+    pub fn world(&self) -> &Arc<dyn World> {
+        &self.world
+    }
+
+    fn stamp(&self, file: &Path) -> Option<(u64, Option<std::time::SystemTime>)> {
+        self.world.metadata(file).map(|m| (m.len, m.modified))
+    }
+
+    /// The cached value for `file` if the file did not change since it was
+    /// read, else a new one from `make` (not made under the lock: reading
+    /// may take a while).
+    fn cached<K, T: Clone>(
+        &self,
+        cache: &Mutex<HashMap<K, Stamped<T>>>,
+        key: &K,
+        file: &Path,
+        make: impl FnOnce() -> T,
+    ) -> T
+    where
+        K: std::hash::Hash + Eq + Clone,
+    {
+        let stamp = self.stamp(file);
+        if let Some(s) = lock(cache).get(key) {
+            if s.stamp == stamp {
+                return s.value.clone();
+            }
+        }
+        let value = make();
+        lock(cache).insert(
+            key.clone(),
+            Stamped {
+                stamp,
+                value: value.clone(),
+            },
+        );
+        value
+    }
+
+    /// Refuses files larger than the limit, before reading them.
+    fn check_size(&self, file: &Path) -> Result<(), String> {
+        let len = self.world.metadata(file).map_or(0, |m| m.len);
+        if len > self.max_file_bytes {
+            return Err(format!(
+                "{} is {} MiB, larger than the asset size limit ({} MiB; raise it with --max-asset-mib)",
+                file.display(),
+                len >> 20,
+                self.max_file_bytes >> 20
+            ));
+        }
+        Ok(())
+    }
+
+    /// The geometry of the OBJ file `file`.
+    fn mesh(&self, file: &Path) -> Result<Arc<Mesh>, String> {
+        self.check_size(file)?;
+        self.cached(&self.meshes, &file.to_path_buf(), file, || {
+            load_obj(&*self.world, file).map(Arc::new)
+        })
+    }
+
+    /// The text of `file`, decoded as rule files are, with line endings
+    /// normalised.
+    fn text(&self, file: &Path) -> Option<Arc<str>> {
+        self.check_size(file).ok()?;
+        self.cached(&self.texts, &file.to_path_buf(), file, || {
+            self.world
+                .read_text(file)
+                .ok()
+                .map(|s| Arc::from(s.replace("\r\n", "\n").as_str()))
+        })
+    }
+
+    /// Whether the texture `file` has an alpha channel, asking `read` (given
+    /// the file's first bytes) the first time for each file.
+    pub fn texture_alpha(&self, file: &Arc<str>, read: impl FnOnce(&[u8]) -> bool) -> bool {
+        let path = Path::new(&**file);
+        let stamp = self.stamp(path);
+        if let Some(s) = lock(&self.alpha).get(file) {
+            if s.stamp == stamp {
+                return s.value;
+            }
+        }
+        // PNG chunks before the image data are small; 64 KiB covers them.
+        let value = self
+            .world
+            .read_prefix(path, 1 << 16)
+            .map(|head| read(&head))
+            .unwrap_or(false);
+        lock(&self.alpha).insert(file.clone(), Stamped { stamp, value });
+        value
+    }
+
+    /// Whether `mesh` is a loaded asset file's own geometry.
+    fn is_loaded_mesh(&self, mesh: &Arc<Mesh>) -> bool {
+        lock(&self.meshes)
+            .values()
+            .any(|m| m.value.as_ref().is_ok_and(|m| Arc::ptr_eq(m, mesh)))
+    }
+
+    /// Width and height of the image `file`, from its header.
+    fn image_size(&self, file: &Path) -> Option<(u32, u32)> {
+        self.cached(&self.image_sizes, &file.to_path_buf(), file, || {
+            // Headers come first, but JPEG may put large metadata before
+            // its frame header: try a prefix, then the whole file.
+            let size = |bytes: &[u8]| {
+                imagesize::blob_size(bytes)
+                    .ok()
+                    .map(|s| (s.width as u32, s.height as u32))
+            };
+            let head = self.world.read_prefix(file, 1 << 18).ok()?;
+            size(&head).or_else(|| size(&self.world.read(file).ok()?))
+        })
+    }
+}
+
+/// The assets of one program: files named in its rule files are searched
+/// from the file that names them (see the module docs), and what is found
+/// is read through the shared [`AssetStore`].
 pub struct Assets {
+    store: Arc<AssetStore>,
     /// The rule file of each source file id.
     files: Vec<PathBuf>,
     /// More places for workspace paths (`/Project/...`).
     workspaces: Workspaces,
-    /// Larger asset files are not read: a warning, the model goes on.
-    max_file_bytes: u64,
-    meshes: Mutex<HashMap<PathBuf, Result<Arc<Mesh>, String>>>,
-    texts: Mutex<HashMap<PathBuf, Option<Arc<str>>>>,
     /// Answers by request (rule file, path as written), shared by all lots:
-    /// a search looks at the file system several times, and Candler alone
-    /// inserts 1,600 assets and names 6,000 textures per building.
+    /// a search looks at the file system several times, and a building may
+    /// insert thousands of assets and name thousands of textures. A path
+    /// not found keeps the places searched, for the message.
     found: Requests<Result<PathBuf, Arc<[PathBuf]>>>,
     mesh_requests: Requests<Result<Arc<Mesh>, String>>,
     texture_files: Requests<Option<Arc<str>>>,
     /// `fileSearch` answers by rule file and query: a search lists folders.
     searches: Requests<Vec<String>>,
-    /// Whether a texture file has an alpha channel, by file: reading the
-    /// image's header once for all lots (a city reads it once, not per lot).
-    alpha: Mutex<FxHashMap<Arc<str>, bool>>,
 }
 
 /// A cache by rule file and path as written.
 type Requests<T> = Mutex<FxHashMap<u32, FxHashMap<Box<str>, T>>>;
 
 fn cached<T: Clone>(cache: &Requests<T>, from: FileId, path: &str, make: impl FnOnce() -> T) -> T {
-    fn lock<T>(
-        c: &Requests<T>,
-    ) -> std::sync::MutexGuard<'_, FxHashMap<u32, FxHashMap<Box<str>, T>>> {
-        c.lock().unwrap_or_else(|e| e.into_inner())
-    }
     if let Some(v) = lock(cache).get(&from.0).and_then(|m| m.get(path)) {
         return v.clone();
     }
@@ -63,45 +225,20 @@ fn cached<T: Clone>(cache: &Requests<T>, from: FileId, path: &str, make: impl Fn
 }
 
 impl Assets {
-    pub fn new(sources: &SourceMap) -> Assets {
+    /// The assets of the rule files in `sources`, read through `store`.
+    pub fn new(store: Arc<AssetStore>, sources: &SourceMap) -> Assets {
+        let files = sources
+            .files()
+            .map(|(_, f)| store.world.canonical(&f.path))
+            .collect();
         Assets {
-            max_file_bytes: DEFAULT_MAX_ASSET_MIB << 20,
-            // Absolute paths: searching the ancestors of `rules/a.cga` given
-            // relative to the working directory must reach the project root.
-            files: sources
-                .files()
-                .map(|(_, f)| {
-                    f.path.canonicalize().unwrap_or_else(|_| {
-                        std::env::current_dir()
-                            .map(|d| d.join(&f.path))
-                            .unwrap_or_else(|_| f.path.clone())
-                    })
-                })
-                .collect(),
+            store,
+            files,
             workspaces: Workspaces::default(),
-            meshes: Mutex::new(HashMap::new()),
-            texts: Mutex::new(HashMap::new()),
             found: Default::default(),
             mesh_requests: Default::default(),
             texture_files: Default::default(),
             searches: Default::default(),
-            alpha: Default::default(),
-        }
-    }
-
-    /// An asset set with no rule files (tests).
-    pub fn empty() -> Assets {
-        Assets {
-            max_file_bytes: DEFAULT_MAX_ASSET_MIB << 20,
-            files: Vec::new(),
-            workspaces: Workspaces::default(),
-            meshes: Mutex::new(HashMap::new()),
-            texts: Mutex::new(HashMap::new()),
-            found: Default::default(),
-            mesh_requests: Default::default(),
-            texture_files: Default::default(),
-            searches: Default::default(),
-            alpha: Default::default(),
         }
     }
 
@@ -109,6 +246,25 @@ impl Assets {
     pub fn with_workspaces(mut self, workspaces: Workspaces) -> Assets {
         self.workspaces = workspaces;
         self
+    }
+
+    /// Assets of the rule files in `sources`, read from disk with a store
+    /// of their own (tests, one-off tools).
+    pub fn on_disk(sources: &SourceMap) -> Assets {
+        Assets::new(
+            Arc::new(AssetStore::new(Arc::new(cga_world::DiskWorld))),
+            sources,
+        )
+    }
+
+    /// An asset set with no rule files (tests).
+    pub fn empty() -> Assets {
+        Assets::on_disk(&SourceMap::new())
+    }
+
+    /// The store files are read through.
+    pub fn store(&self) -> &Arc<AssetStore> {
+        &self.store
     }
 
     /// The file `path` names, searched from the rule file `from` (once per
@@ -121,16 +277,27 @@ impl Assets {
     /// searched (for a message).
     pub fn search_for(&self, from: FileId, path: &str) -> Result<PathBuf, Arc<[PathBuf]>> {
         cached(&self.found, from, path, || {
+            let world = &*self.store.world;
             let Some(rule_file) = self.files.get(from.0 as usize) else {
-                let p = std::path::Path::new(path);
-                return if p.is_absolute() && p.is_file() {
+                let p = Path::new(path);
+                return if p.is_absolute() && world.is_file(p) {
                     Ok(p.to_path_buf())
                 } else {
                     Err(Arc::from(Vec::new()))
                 };
             };
-            locate::locate(rule_file, path, &self.workspaces).map_err(Arc::from)
+            locate::locate(world, rule_file, path, &self.workspaces).map_err(Arc::from)
         })
+    }
+
+    /// Whether `mesh` is an asset's own geometry as loaded (a built-in or a
+    /// file), which `geometry.isInstanced` asks.
+    pub fn is_asset_mesh(&self, mesh: &Arc<Mesh>) -> bool {
+        self.store.is_loaded_mesh(mesh)
+            || ["cube", "quad", "disk", "sphere", "cylinder", "cone"]
+                .iter()
+                .filter_map(|n| builtin_geometry(n))
+                .any(|m| Arc::ptr_eq(&m, mesh))
     }
 
     /// The texture file `path` names, searched from the rule file `from`
@@ -138,16 +305,14 @@ impl Assets {
     /// absolute path (once per rule file and path).
     pub fn texture_file(&self, from: FileId, path: &str) -> Option<Arc<str>> {
         cached(&self.texture_files, from, path, || {
+            let world = &*self.store.world;
             // Textures of inserted assets come as paths next to the asset
             // file, which may be relative to the working folder.
             let file = self.resolve(from, path).or_else(|| {
-                let p = std::path::Path::new(path);
-                p.is_file().then(|| p.to_path_buf())
+                let p = Path::new(path);
+                world.is_file(p).then(|| p.to_path_buf())
             });
-            file.map(|f| {
-                let f = f.canonicalize().unwrap_or(f);
-                Arc::from(f.to_string_lossy().as_ref())
-            })
+            file.map(|f| Arc::from(world.canonical(&f).to_string_lossy().as_ref()))
         })
     }
 
@@ -159,123 +324,38 @@ impl Assets {
                 .ok_or_else(|| format!("there is no built-in asset \"{path}\""));
         }
         cached(&self.mesh_requests, from, path, || {
-            self.load_mesh(from, path)
+            let file = self.search_for(from, path).map_err(|searched| {
+                let mut m = format!("asset \"{path}\" not found");
+                if path.starts_with('/') && !searched.is_empty() {
+                    // Workspace paths: say where the project was looked for.
+                    m.push_str(" (");
+                    m.push_str(&locate::searched_note(&searched).replace("\n  ", " "));
+                    m.push(')');
+                }
+                m
+            })?;
+            self.store.mesh(&file)
         })
     }
 
-    /// Whether `mesh` is an asset's own geometry as loaded (a built-in or a
-    /// file), which `geometry.isInstanced` asks.
-    pub fn is_asset_mesh(&self, mesh: &Arc<Mesh>) -> bool {
-        let loaded = self.meshes.lock().unwrap_or_else(|e| e.into_inner());
-        loaded
-            .values()
-            .any(|m| m.as_ref().is_ok_and(|m| Arc::ptr_eq(m, mesh)))
-            || ["cube", "quad", "disk", "sphere", "cylinder", "cone"]
-                .iter()
-                .filter_map(|n| builtin_geometry(n))
-                .any(|m| Arc::ptr_eq(&m, mesh))
-    }
-
-    /// Sets the largest asset file that is read, in MiB.
-    pub fn with_max_file_mib(mut self, mib: u64) -> Assets {
-        self.max_file_bytes = mib.saturating_mul(1 << 20);
-        self
-    }
-
-    /// Refuses files larger than the limit, before reading them.
-    fn check_size(&self, file: &std::path::Path) -> Result<(), String> {
-        let len = std::fs::metadata(file).map(|m| m.len()).unwrap_or(0);
-        if len > self.max_file_bytes {
-            return Err(format!(
-                "{} is {} MiB, larger than the asset size limit ({} MiB; raise it with --max-asset-mib)",
-                file.display(),
-                len >> 20,
-                self.max_file_bytes >> 20
-            ));
-        }
-        Ok(())
-    }
-
-    fn load_mesh(&self, from: FileId, path: &str) -> Result<Arc<Mesh>, String> {
-        let file = self.search_for(from, path).map_err(|searched| {
-            let mut m = format!("asset \"{path}\" not found");
-            if path.starts_with('/') && !searched.is_empty() {
-                // Workspace paths: say where the project was looked for.
-                m.push_str(" (");
-                m.push_str(&locate::searched_note(&searched).replace("\n  ", " "));
-                m.push(')');
-            }
-            m
-        })?;
-        self.check_size(&file)?;
-        let mut cache = self.meshes.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some(r) = cache.get(&file) {
-            return r.clone();
-        }
-        let r = load_obj(&file).map(Arc::new);
-        cache.insert(file, r.clone());
-        r
-    }
-}
-
-/// The built-in geometry assets as unit shapes, made once.
-fn builtin_geometry(name: &str) -> Option<Arc<Mesh>> {
-    use cga_geometry::primitive as p;
-    use cga_geometry::DVec3;
-    static BUILTINS: std::sync::LazyLock<Vec<(&str, Arc<Mesh>)>> = std::sync::LazyLock::new(|| {
-        vec![
-            ("cube", Arc::new(p::builtin_cube())),
-            ("quad", Arc::new(p::quad(1.0, 1.0))),
-            ("disk", Arc::new(p::disk(16, 1.0, 1.0))),
-            ("sphere", Arc::new(p::sphere(16, 16, DVec3::ONE))),
-            ("cylinder", Arc::new(p::cylinder(16, DVec3::ONE))),
-            ("cone", Arc::new(p::cone(16, DVec3::ONE))),
-        ]
-    });
-    let name = name.strip_suffix(".obj").unwrap_or(name);
-    BUILTINS
-        .iter()
-        .find(|(n, _)| *n == name)
-        .map(|(_, m)| m.clone())
-}
-
-/// Loads an OBJ asset; its warnings (missing MTL, unknown materials) are
-/// dropped here: the asset still loads with default materials.
-fn load_obj(path: &std::path::Path) -> Result<Mesh, String> {
-    cga_geometry::load_obj(path)
-        .map(|asset| asset.mesh)
-        .map_err(|e| format!("cannot load asset {}: {e}", path.display()))
-}
-
-impl Assets {
     /// Whether the texture `file` (as [`Assets::texture_file`] found it) has
-    /// an alpha channel, asking `read` the first time for each file.
-    pub fn texture_alpha(&self, file: &Arc<str>, read: impl FnOnce(&str) -> bool) -> bool {
-        let lock = || self.alpha.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some(&a) = lock().get(file) {
-            return a;
-        }
-        // Not under the lock: reading may take a while.
-        let a = read(file);
-        lock().insert(file.clone(), a);
-        a
+    /// an alpha channel, asking `read` with the file's first bytes the
+    /// first time for each file.
+    pub fn texture_alpha(&self, file: &Arc<str>, read: impl FnOnce(&[u8]) -> bool) -> bool {
+        self.store.texture_alpha(file, read)
+    }
+
+    /// Width and height of the image `path` names, searched from `from`.
+    pub fn image_size(&self, from: FileId, path: &str) -> Option<(u32, u32)> {
+        let file = self.resolve(from, path)?;
+        self.store.image_size(&file)
     }
 
     /// The text of a file found like an asset (`readTextFile`, tables),
     /// with line endings normalised; cached.
     pub fn text(&self, from: FileId, path: &str) -> Option<Arc<str>> {
         let file = self.resolve(from, path)?;
-        self.check_size(&file).ok()?;
-        let mut cache = self.texts.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some(t) = cache.get(&file) {
-            return t.clone();
-        }
-        let t = std::fs::read(&file).ok().map(|bytes| {
-            let s = crate::text_encoding::decode(&bytes).0.replace("\r\n", "\n");
-            Arc::from(s.as_str())
-        });
-        cache.insert(file, t.clone());
-        t
+        self.store.text(&file)
     }
 
     /// Files of the rule file's project matching a search query (`*` and `?`
@@ -296,7 +376,8 @@ impl Assets {
         let Some(rule_file) = self.files.get(from.0 as usize) else {
             return Vec::new();
         };
-        let root = project_root(rule_file);
+        let world = &*self.store.world;
+        let root = project_root(world, rule_file);
         let terms: Vec<fancy_regex::Regex> = query
             .split_whitespace()
             .filter_map(|t| {
@@ -330,9 +411,9 @@ impl Assets {
             for ws in workspaces {
                 let mut files = Vec::new();
                 if !first.is_empty() && !first.contains(['*', '?', '$']) {
-                    list_files(&ws.join(first), &mut files, 0);
+                    list_files(world, &ws.join(first), &mut files, 0);
                 } else {
-                    list_files(&ws, &mut files, 0);
+                    list_files(world, &ws, &mut files, 0);
                 }
                 for f in files {
                     let Ok(rel) = f.strip_prefix(&ws) else {
@@ -346,7 +427,7 @@ impl Assets {
             }
         } else {
             let mut files = Vec::new();
-            list_files(&root, &mut files, 0);
+            list_files(world, &root, &mut files, 0);
             let assets = root.join("assets");
             found = files
                 .into_iter()
@@ -366,27 +447,67 @@ impl Assets {
     }
 }
 
+/// The built-in geometry assets as unit shapes, made once.
+fn builtin_geometry(name: &str) -> Option<Arc<Mesh>> {
+    use cga_geometry::primitive as p;
+    use cga_geometry::DVec3;
+    static BUILTINS: std::sync::LazyLock<Vec<(&str, Arc<Mesh>)>> = std::sync::LazyLock::new(|| {
+        vec![
+            ("cube", Arc::new(p::builtin_cube())),
+            ("quad", Arc::new(p::quad(1.0, 1.0))),
+            ("disk", Arc::new(p::disk(16, 1.0, 1.0))),
+            ("sphere", Arc::new(p::sphere(16, 16, DVec3::ONE))),
+            ("cylinder", Arc::new(p::cylinder(16, DVec3::ONE))),
+            ("cone", Arc::new(p::cone(16, DVec3::ONE))),
+        ]
+    });
+    let name = name.strip_suffix(".obj").unwrap_or(name);
+    BUILTINS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, m)| m.clone())
+}
+
+/// Loads an OBJ asset and its material libraries from `world`; its
+/// warnings (missing MTL, unknown materials) are dropped here: the asset
+/// still loads with default materials.
+fn load_obj(world: &dyn World, path: &Path) -> Result<Mesh, String> {
+    let bytes = world
+        .read(path)
+        .map_err(|e| format!("cannot load asset {}: {e}", path.display()))?;
+    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let text = String::from_utf8_lossy(&bytes);
+    cga_geometry::obj::parse_obj(&text, &dir, |name| {
+        let p = dir.join(name);
+        world
+            .read(&p)
+            .map(|b| String::from_utf8_lossy(&b).into_owned())
+            .map_err(|e| format!("cannot read material library '{}': {e}", p.display()))
+    })
+    .map(|asset| asset.mesh)
+    .map_err(|e| format!("cannot load asset {}: {e}", path.display()))
+}
+
 /// The project folder of a rule file: the nearest ancestor holding an
 /// `assets/` or `rules/` folder, else the rule file's folder.
-fn project_root(rule_file: &std::path::Path) -> PathBuf {
-    let dir = rule_file.parent().unwrap_or(std::path::Path::new("."));
+fn project_root(world: &dyn World, rule_file: &Path) -> PathBuf {
+    let dir = rule_file.parent().unwrap_or(Path::new("."));
     dir.ancestors()
-        .find(|d| d.join("assets").is_dir() || d.join("rules").is_dir())
+        .find(|d| world.is_dir(&d.join("assets")) || world.is_dir(&d.join("rules")))
         .unwrap_or(dir)
         .to_path_buf()
 }
 
-fn list_files(dir: &std::path::Path, out: &mut Vec<PathBuf>, depth: usize) {
+fn list_files(world: &dyn World, dir: &Path, out: &mut Vec<PathBuf>, depth: usize) {
     if depth > 16 {
         return;
     }
-    let Ok(entries) = std::fs::read_dir(dir) else {
+    let Ok(entries) = world.read_dir(dir) else {
         return;
     };
-    for e in entries.flatten() {
-        let p = e.path();
-        if p.is_dir() {
-            list_files(&p, out, depth + 1);
+    for p in entries {
+        if world.is_dir(&p) {
+            list_files(world, &p, out, depth + 1);
         } else {
             out.push(p);
         }

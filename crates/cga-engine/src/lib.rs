@@ -19,7 +19,6 @@ pub mod selectors;
 pub mod shape;
 pub mod shape_fns;
 pub mod split_layout;
-pub mod text_encoding;
 pub mod trim;
 pub mod values;
 

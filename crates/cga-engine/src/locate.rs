@@ -26,6 +26,8 @@
 
 use std::path::{Path, PathBuf};
 
+use cga_world::World;
+
 /// The environment variable with more workspace roots (a path list, as
 /// `PATH` is written on this platform).
 pub const WORKSPACE_ENV: &str = "CGA_WORKSPACE";
@@ -98,30 +100,30 @@ pub fn candidates(from: &Path, target: &str, workspaces: &Workspaces) -> Vec<Pat
 
 /// The file `target` names from the rule file `from`, or every place that
 /// was searched.
-pub fn locate(from: &Path, target: &str, workspaces: &Workspaces) -> Result<PathBuf, Vec<PathBuf>> {
+pub fn locate(
+    world: &dyn World,
+    from: &Path,
+    target: &str,
+    workspaces: &Workspaces,
+) -> Result<PathBuf, Vec<PathBuf>> {
     let places = candidates(from, target, workspaces);
-    if let Some(found) = places.iter().find(|p| is_file(p)) {
+    if let Some(found) = places.iter().find(|p| world.is_file(p)) {
         return Ok(found.clone());
     }
-    match places.iter().find_map(|p| with_any_case(p)) {
+    match places.iter().find_map(|p| with_any_case(world, p)) {
         Some(found) => Ok(found),
         None => Err(places),
     }
 }
 
-/// The one file-existence check of the search.
-fn is_file(path: &Path) -> bool {
-    path.is_file()
-}
-
 /// The file at `path` with the case of its names' ASCII letters ignored
 /// (each missing name matched against its folder's entries), if exactly
 /// one way leads to a file.
-fn with_any_case(path: &Path) -> Option<PathBuf> {
+fn with_any_case(world: &dyn World, path: &Path) -> Option<PathBuf> {
     let mut found = PathBuf::new();
     for part in path.components() {
         let next = found.join(part.as_os_str());
-        if next.exists() || !matches!(part, std::path::Component::Normal(_)) {
+        if !matches!(part, std::path::Component::Normal(_)) || world.metadata(&next).is_some() {
             found = next;
             continue;
         }
@@ -131,18 +133,18 @@ fn with_any_case(path: &Path) -> Option<PathBuf> {
         } else {
             found.as_path()
         };
-        let mut matches = std::fs::read_dir(dir).ok()?.flatten().filter(|e| {
+        let mut matches = world.read_dir(dir).ok()?.into_iter().filter(|e| {
             e.file_name()
-                .to_str()
+                .and_then(|n| n.to_str())
                 .is_some_and(|n| n.eq_ignore_ascii_case(want))
         });
         let entry = matches.next()?;
         if matches.next().is_some() {
             return None;
         }
-        found.push(entry.file_name());
+        found = entry;
     }
-    is_file(&found).then_some(found)
+    world.is_file(&found).then_some(found)
 }
 
 /// A not-found message's list of the places searched, one per line.
@@ -218,9 +220,10 @@ mod tests {
         std::fs::create_dir_all(dir.join("assets/Windows")).unwrap();
         std::fs::write(dir.join("assets/Windows/Win1.OBJ"), "v 0 0 0\n").unwrap();
         let from = dir.join("rules.cga");
-        let found = locate(&from, "windows/win1.obj", &Workspaces::default()).unwrap();
+        let world = cga_world::DiskWorld;
+        let found = locate(&world, &from, "windows/win1.obj", &Workspaces::default()).unwrap();
         assert_eq!(found, dir.join("assets/Windows/Win1.OBJ"));
-        assert!(locate(&from, "windows/win2.obj", &Workspaces::default()).is_err());
+        assert!(locate(&world, &from, "windows/win2.obj", &Workspaces::default()).is_err());
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

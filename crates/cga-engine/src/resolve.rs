@@ -16,6 +16,7 @@ use std::sync::Arc;
 use cga_syntax::ast::{self, BlockPart, Body, Expr, ExprKind, Item, Stmt};
 use cga_syntax::{Diagnostic, SourceMap, Span};
 use cga_value::Value;
+use cga_world::World;
 
 use crate::expr::{OpCall, RBlock, RBody, RExpr, RExprKind, RPart, RStmt, RuleCall};
 use crate::locate::Workspaces;
@@ -27,25 +28,46 @@ use crate::program::{
 use crate::shape_fns;
 use crate::values;
 
-/// The result of loading a rule file: the program (if it resolved without
-/// errors) and every diagnostic found.
+/// The result of loading a rule file: the program and every diagnostic
+/// found. A file with errors still gives a program of everything that
+/// could be resolved (rules, attributes, functions with their spans; what
+/// did not resolve is a placeholder), for tools that read it; only a
+/// program without errors may be derived ([`Loaded::usable`]).
 pub struct Loaded {
-    pub program: Option<Program>,
+    pub program: Program,
     pub diagnostics: Vec<Diagnostic>,
 }
 
-/// Loads `path` and everything it imports into `sources`, parses and resolves.
-pub fn load(path: &Path, sources: &mut SourceMap) -> Loaded {
-    load_with(path, sources, &Workspaces::default())
+impl Loaded {
+    /// Whether a diagnostic is an error.
+    pub fn has_errors(&self) -> bool {
+        self.diagnostics.iter().any(Diagnostic::is_error)
+    }
+
+    /// The program, if it has no errors.
+    pub fn usable(self) -> Option<Program> {
+        (!self.has_errors()).then_some(self.program)
+    }
+}
+
+/// Loads `path` and everything it imports from `world` into `sources`,
+/// parses and resolves.
+pub fn load(world: &dyn World, path: &Path, sources: &mut SourceMap) -> Loaded {
+    load_with(world, path, sources, &Workspaces::default())
 }
 
 /// Like [`load`], with workspace roots for imports that name a project
 /// (`/Project/...`, see `locate.rs`).
-pub fn load_with(path: &Path, sources: &mut SourceMap, workspaces: &Workspaces) -> Loaded {
-    match crate::text_encoding::read_text(path) {
-        Ok(text) => load_text_with(path, text, sources, workspaces),
+pub fn load_with(
+    world: &dyn World,
+    path: &Path,
+    sources: &mut SourceMap,
+    workspaces: &Workspaces,
+) -> Loaded {
+    match world.read_text(path) {
+        Ok(text) => load_text_with(world, path, text, sources, workspaces),
         Err(e) => Loaded {
-            program: None,
+            program: Program::default(),
             diagnostics: vec![plain_error(format!(
                 "cannot read rule file {}: {e}",
                 path.display()
@@ -56,18 +78,20 @@ pub fn load_with(path: &Path, sources: &mut SourceMap, workspaces: &Workspaces) 
 
 /// Like [`load`] for rule text already in memory; `path` names it in
 /// diagnostics and is where its imports are searched from.
-pub fn load_text(path: &Path, text: String, sources: &mut SourceMap) -> Loaded {
-    load_text_with(path, text, sources, &Workspaces::default())
+pub fn load_text(world: &dyn World, path: &Path, text: String, sources: &mut SourceMap) -> Loaded {
+    load_text_with(world, path, text, sources, &Workspaces::default())
 }
 
 /// [`load_text`] with workspace roots.
 pub fn load_text_with(
+    world: &dyn World,
     path: &Path,
     text: String,
     sources: &mut SourceMap,
     workspaces: &Workspaces,
 ) -> Loaded {
     let mut r = Resolver {
+        world,
         sources,
         workspaces: workspaces.clone(),
         program: Program::default(),
@@ -81,6 +105,18 @@ pub fn load_text_with(
         type_checks: Vec::new(),
     };
     let main = r.parse_file(path, text);
+    r.program.styles = std::iter::once("Default".to_string())
+        .chain(
+            r.parsed_files[main]
+                .module
+                .items
+                .iter()
+                .filter_map(|i| match i {
+                    Item::Style { name, .. } if name.name != "Default" => Some(name.name.clone()),
+                    _ => None,
+                }),
+        )
+        .collect();
     r.instantiate(main, String::new(), None);
     r.resolve_pending();
     r.check_types();
@@ -99,7 +135,6 @@ pub fn load_text_with(
     // Report in file order, whatever stage found them.
     r.diags
         .sort_by_key(|d| d.span.map(|s| (s.file.0, s.start)).unwrap_or((0, 0)));
-    let has_errors = r.diags.iter().any(|d| d.is_error());
     let mut program = r.program;
     program.symbols = {
         let mut v = vec![Arc::<str>::from(""); r.symbols.len()];
@@ -109,7 +144,7 @@ pub fn load_text_with(
         v
     };
     Loaded {
-        program: if has_errors { None } else { Some(program) },
+        program,
         diagnostics: r.diags,
     }
 }
@@ -168,6 +203,7 @@ enum Pending {
 }
 
 struct Resolver<'s> {
+    world: &'s dyn World,
     sources: &'s mut SourceMap,
     workspaces: Workspaces,
     program: Program,
@@ -382,7 +418,7 @@ impl Resolver<'_> {
     }
 
     fn parse_file(&mut self, path: &Path, text: String) -> usize {
-        let key = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
+        let key = self.world.canonical(path);
         if let Some(&idx) = self.parsed.get(&key) {
             return idx;
         }
@@ -483,7 +519,7 @@ impl Resolver<'_> {
                 );
                 continue;
             }
-            let text = match crate::text_encoding::read_text(&target) {
+            let text = match self.world.read_text(&target) {
                 Ok(t) => t,
                 Err(e) => {
                     self.error(
@@ -759,7 +795,7 @@ impl Resolver<'_> {
 
     /// Finds an imported file (`locate.rs`), or every place searched.
     fn find_import(&self, importer: &Path, target: &str) -> Result<PathBuf, Vec<PathBuf>> {
-        crate::locate::locate(importer, target, &self.workspaces)
+        crate::locate::locate(self.world, importer, target, &self.workspaces)
     }
 
     fn resolve_pending(&mut self) {

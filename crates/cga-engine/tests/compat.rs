@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 
 use cga_engine::{load, load_with, Workspaces};
 use cga_syntax::{Diagnostic, SourceMap};
+use cga_world::DiskWorld;
 use ops_common::*;
 
 /// A fresh folder for one test.
@@ -32,8 +33,8 @@ fn diagnostics(src: &str) -> (bool, Vec<Diagnostic>) {
     let path = dir.join("rules.cga");
     write(&path, src.as_bytes());
     let mut sources = SourceMap::new();
-    let loaded = load(&path, &mut sources);
-    (loaded.program.is_some(), loaded.diagnostics)
+    let loaded = load(&DiskWorld, &path, &mut sources);
+    (!loaded.has_errors(), loaded.diagnostics)
 }
 
 fn fxhash(s: &str) -> u64 {
@@ -108,8 +109,8 @@ fn workspace_paths_resolve_in_the_workspace_roots_and_name_every_place_searched(
     );
 
     let mut sources = SourceMap::new();
-    let loaded = load(&main, &mut sources);
-    assert!(loaded.program.is_none());
+    let loaded = load(&DiskWorld, &main, &mut sources);
+    assert!(loaded.has_errors());
     let d = &loaded.diagnostics[0];
     assert_eq!(
         d.message,
@@ -128,12 +129,8 @@ fn workspace_paths_resolve_in_the_workspace_roots_and_name_every_place_searched(
 
     let mut sources = SourceMap::new();
     let roots = Workspaces::new(vec![ws.clone()]);
-    let loaded = load_with(&main, &mut sources, &roots);
-    assert!(
-        loaded.program.is_some(),
-        "{:?}",
-        messages(&loaded.diagnostics)
-    );
+    let loaded = load_with(&DiskWorld, &main, &mut sources, &roots);
+    assert!(!loaded.has_errors(), "{:?}", messages(&loaded.diagnostics));
     assert!(loaded.diagnostics.is_empty());
 }
 
@@ -166,13 +163,13 @@ attr h = 3
     let path = dir.join("rules.cga");
     write(&path, src.as_bytes());
     let mut sources = SourceMap::new();
-    let loaded = load(&path, &mut sources);
+    let loaded = load(&DiskWorld, &path, &mut sources);
     assert!(
         loaded.diagnostics.is_empty(),
         "{:?}",
         messages(&loaded.diagnostics)
     );
-    let program = loaded.program.unwrap();
+    let program = loaded.program;
     let attr = &program.attrs[program.main_attr("h").unwrap() as usize];
     let names: Vec<&str> = attr.annotations.iter().map(|a| a.name.as_str()).collect();
     assert_eq!(names, ["Handle", "Enum", "Range"]);

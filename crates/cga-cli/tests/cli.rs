@@ -883,3 +883,51 @@ fn rule_packages_are_read_directly() {
         stderr(&o)
     );
 }
+
+/// `--attr` values are read in the attribute's type: a float attribute
+/// given text that is not a number is a usage error naming it; bools read
+/// as the `bool` page converts; arrays in CGA's literal form; values outside
+/// `@Range` or `@Enum` are a warning naming the lot.
+#[test]
+fn attribute_values_take_the_attribute_type_and_annotations_warn() {
+    let dir = temp_dir("attr-types");
+    let rules = rule_file(
+        &dir,
+        "a.cga",
+        "@Range(min=1, max=20)\nattr floors = 3\nattr on = true\nattr heights = [1, 2]\n\
+         @Enum(\"flat\", \"gable\")\nattr roof = \"flat\"\n\
+         Lot --> print(floors) print(on) print(heights) print(roof)\n",
+    );
+    let r = rules.to_str().unwrap();
+    let bad = run(&["generate", r, "--attr", "floors=abc"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(
+        stderr(&bad).contains("attribute `floors` is a float: `abc` is not a number"),
+        "{}",
+        stderr(&bad)
+    );
+    let o = run(&[
+        "generate",
+        r,
+        "--attr",
+        "on=f",
+        "--attr",
+        "heights=[5,5]",
+        "--attr",
+        "floors=4",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(stdout(&o), "4\nfalse\n(2)[5,5]\nflat\n");
+    let o = run(&["generate", r, "--attr", "floors=99", "--attr", "roof=dome"]);
+    assert_eq!(o.status.code(), Some(0));
+    let err = stderr(&o);
+    assert!(
+        err.contains("warning: 99 is outside the @Range of attribute `floors` (1 to 20), in lot `rect 20x30`"),
+        "{err}"
+    );
+    assert!(
+        err.contains("dome is not one of the @Enum values of attribute `roof` (flat, gable)"),
+        "{err}"
+    );
+    assert!(err.contains("a.cga:2:6"), "{err}");
+}

@@ -447,8 +447,16 @@ fn reports_are_aggregated_per_key() {
     assert_eq!(v["x_min"], 3.0);
     assert_eq!(v["x_max"], 5.0);
     assert_eq!(v["ok_n"], 2.0);
+    // Bools and strings: how often each value was reported.
+    assert_eq!(v["ok_counts"], serde_json::json!({ "true": 2.0 }));
+    assert_eq!(v["kind_counts"], serde_json::json!({ "lot": 1.0 }));
     assert_eq!(v["ok_sum"], true);
     assert_eq!(v["kind_avg"], "lot");
+    // And each lot's own reports.
+    let lots = v["lots"].as_array().unwrap();
+    assert_eq!(lots.len(), 1);
+    assert_eq!(lots[0]["id"], "rect 20x30");
+    assert_eq!(lots[0]["reports"]["x_sum"], 8.0);
 }
 
 #[test]

@@ -58,6 +58,11 @@ pub use cga_engine::geo::EARTH_RADIUS;
 pub use cga_export::DEFAULT_FLUSH_MIB;
 pub use values::parse_value;
 
+/// A value's text form, as `print()` and `str()` write it.
+pub fn value_text(value: &Value) -> String {
+    cga_engine::values::to_text(value)
+}
+
 /// The guide `docs/library.md`, whose example is compiled and run as a
 /// test.
 #[doc = include_str!("../../../docs/library.md")]

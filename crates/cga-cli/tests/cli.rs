@@ -447,8 +447,16 @@ fn reports_are_aggregated_per_key() {
     assert_eq!(v["x_min"], 3.0);
     assert_eq!(v["x_max"], 5.0);
     assert_eq!(v["ok_n"], 2.0);
+    // Bools and strings: how often each value was reported.
+    assert_eq!(v["ok_counts"], serde_json::json!({ "true": 2.0 }));
+    assert_eq!(v["kind_counts"], serde_json::json!({ "lot": 1.0 }));
     assert_eq!(v["ok_sum"], true);
     assert_eq!(v["kind_avg"], "lot");
+    // And each lot's own reports.
+    let lots = v["lots"].as_array().unwrap();
+    assert_eq!(lots.len(), 1);
+    assert_eq!(lots[0]["id"], "rect 20x30");
+    assert_eq!(lots[0]["reports"]["x_sum"], 8.0);
 }
 
 #[test]
@@ -822,4 +830,112 @@ fn assets_over_the_size_limit_are_a_warning() {
     assert_eq!(stdout(&out), "1\n", "the lot keeps its own geometry");
     let out = run(&["generate", rules.to_str().unwrap()]);
     assert_eq!(stdout(&out), "300\n");
+}
+
+/// A rule package as CityEngine shares them (here a zip archive): `cga
+/// generate` and `cga check` take it directly; its assets resolve inside it.
+#[test]
+fn rule_packages_are_read_directly() {
+    let dir = temp_dir("rpk");
+    let mut out = std::io::Cursor::new(Vec::new());
+    {
+        let mut w = zip::ZipWriter::new(&mut out);
+        let files: [(&str, &str); 3] = [
+            (
+                "rules/tower.cga",
+                "attr floors = 3\n@StartRule\nTower --> extrude(floors * 3) print(scope.sy) i(\"block.obj\") X.\n",
+            ),
+            (
+                "assets/block.obj",
+                "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n",
+            ),
+            ("bin/tower.cgb", "compiled"),
+        ];
+        for (name, text) in files {
+            w.start_file(name, zip::write::SimpleFileOptions::default())
+                .unwrap();
+            std::io::Write::write_all(&mut w, text.as_bytes()).unwrap();
+        }
+        w.finish().unwrap();
+    }
+    let package = dir.join("tower.rpk");
+    std::fs::write(&package, out.into_inner()).unwrap();
+    let pkg = package.to_str().unwrap();
+    let check = run(&["check", pkg]);
+    assert_eq!(check.status.code(), Some(0), "{}", stderr(&check));
+    assert!(stderr(&check).contains("ok (1 rules, 1 attributes, 0 functions)"));
+    let glb = dir.join("tower.glb");
+    let o = run(&[
+        "generate",
+        pkg,
+        "--attr",
+        "floors=4",
+        "-o",
+        glb.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(stdout(&o), "12\n");
+    assert!(
+        stderr(&o).contains("1 lots, 2 shapes, 1 leaf shapes, 1 faces, 2 triangles"),
+        "{}",
+        stderr(&o)
+    );
+    // A file that is not an archive is a rule error naming it.
+    let bad = dir.join("bad.rpk");
+    std::fs::write(&bad, "Lot --> X.").unwrap();
+    let o = run(&["check", bad.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("neither a 7z nor a zip archive"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+/// `--attr` values are read in the attribute's type: a float attribute
+/// given text that is not a number is a usage error naming it; bools read
+/// as the `bool` page converts; arrays in CGA's literal form; values outside
+/// `@Range` or `@Enum` are a warning naming the lot.
+#[test]
+fn attribute_values_take_the_attribute_type_and_annotations_warn() {
+    let dir = temp_dir("attr-types");
+    let rules = rule_file(
+        &dir,
+        "a.cga",
+        "@Range(min=1, max=20)\nattr floors = 3\nattr on = true\nattr heights = [1, 2]\n\
+         @Enum(\"flat\", \"gable\")\nattr roof = \"flat\"\n\
+         Lot --> print(floors) print(on) print(heights) print(roof)\n",
+    );
+    let r = rules.to_str().unwrap();
+    let bad = run(&["generate", r, "--attr", "floors=abc"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(
+        stderr(&bad).contains("attribute `floors` is a float: `abc` is not a number"),
+        "{}",
+        stderr(&bad)
+    );
+    let o = run(&[
+        "generate",
+        r,
+        "--attr",
+        "on=f",
+        "--attr",
+        "heights=[5,5]",
+        "--attr",
+        "floors=4",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(stdout(&o), "4\nfalse\n(2)[5,5]\nflat\n");
+    let o = run(&["generate", r, "--attr", "floors=99", "--attr", "roof=dome"]);
+    assert_eq!(o.status.code(), Some(0));
+    let err = stderr(&o);
+    assert!(
+        err.contains("warning: 99 is outside the @Range of attribute `floors` (1 to 20), in lot `rect 20x30`"),
+        "{err}"
+    );
+    assert!(
+        err.contains("dome is not one of the @Enum values of attribute `roof` (flat, gable)"),
+        "{err}"
+    );
+    assert!(err.contains("a.cga:2:6"), "{err}");
 }

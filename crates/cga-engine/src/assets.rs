@@ -72,6 +72,11 @@ impl AssetStore {
         self
     }
 
+    /// The largest asset file that is read, in MiB.
+    pub fn max_file_mib(&self) -> u64 {
+        self.max_file_bytes >> 20
+    }
+
     /// The world files are read from.
     pub fn world(&self) -> &Arc<dyn World> {
         &self.world

@@ -15,6 +15,7 @@
 //! ones are taken from the process's working folder, as the file system
 //! takes them.
 
+mod archive;
 mod confined;
 mod disk;
 mod memory;
@@ -24,6 +25,7 @@ use std::io;
 use std::path::{Component, Path, PathBuf};
 use std::time::SystemTime;
 
+pub use archive::{archive_files, mount_archive};
 pub use confined::ConfinedWorld;
 pub use disk::DiskWorld;
 pub use memory::MemoryWorld;

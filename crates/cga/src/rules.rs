@@ -76,6 +76,9 @@ impl Engine {
     /// could be resolved, with the errors in [`Rules::diagnostics`].
     pub fn load(&self, path: impl AsRef<Path>) -> Rules {
         let path = path.as_ref();
+        if is_package(path) {
+            return self.load_package(path);
+        }
         on_big_stack(|| {
             let mut sources = SourceMap::new();
             let loaded = cga_engine::load_with(&*self.world, path, &mut sources, &self.workspaces);
@@ -99,6 +102,53 @@ impl Engine {
             );
             self.rules(path, loaded, sources)
         })
+    }
+
+    /// Loads a rule package (`.rpk`: a 7z or zip archive as CityEngine
+    /// writes them): its files are seen under the package's own path
+    /// (`city.rpk/rules/main.cga`, `city.rpk/assets/...`), over this
+    /// engine's world, and its main rule file is loaded: the rule file of
+    /// the package's one compiled rule (`bin/NAME.cgb`), else its only rule
+    /// file.
+    pub fn load_package(&self, path: impl AsRef<Path>) -> Rules {
+        let path = path.as_ref();
+        let fail = |message: String| {
+            let loaded = cga_engine::Loaded {
+                program: Program::default(),
+                diagnostics: vec![cga_syntax::Diagnostic {
+                    severity: cga_syntax::Severity::Error,
+                    message,
+                    span: None,
+                    label: None,
+                    notes: Vec::new(),
+                }],
+            };
+            self.rules(path, loaded, SourceMap::new())
+        };
+        let bytes = match self.world.read(path) {
+            Ok(b) => b,
+            Err(e) => return fail(format!("cannot read rule package {}: {e}", path.display())),
+        };
+        let root = cga_world::normalize(path);
+        let files = cga_world::MemoryWorld::over(self.world.clone());
+        let names = match cga_world::mount_archive(&files, &root, &bytes) {
+            Ok(n) => n,
+            Err(e) => return fail(format!("cannot read rule package {}: {e}", path.display())),
+        };
+        let main = match package_main_rule(&names) {
+            Ok(m) => m,
+            Err(why) => return fail(format!("rule package {}: {why}", path.display())),
+        };
+        // The package's world holds its files: rules, assets and textures
+        // are all read from there.
+        let world: Arc<dyn World> = Arc::new(files);
+        let engine = Engine {
+            store: Arc::new(
+                AssetStore::new(world.clone()).with_max_file_mib(self.store.max_file_mib()),
+            ),
+            world,
+        };
+        engine.load(root.join(main))
     }
 
     fn rules(&self, path: &Path, loaded: cga_engine::Loaded, sources: SourceMap) -> Rules {
@@ -396,6 +446,47 @@ impl Rules {
     }
 }
 
+/// Whether `path` names a rule package (by its extension).
+fn is_package(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("rpk"))
+}
+
+/// The main rule file of a package with the files `names`: the rule file
+/// of its one compiled rule (`bin/typology/x.cgb` is compiled from
+/// `rules/typology/x.cga`; compiled imports carry a `$` in their name), else
+/// its only rule file.
+fn package_main_rule(names: &[String]) -> Result<String, String> {
+    let cga: Vec<&String> = names
+        .iter()
+        .filter(|n| n.to_ascii_lowercase().ends_with(".cga") && !n.starts_with(".ws/"))
+        .collect();
+    let compiled: Vec<&str> = names
+        .iter()
+        .filter_map(|n| n.strip_prefix("bin/")?.strip_suffix(".cgb"))
+        .filter(|stem| !stem.contains('$'))
+        .collect();
+    if let [stem] = compiled[..] {
+        let wanted = format!("rules/{stem}.cga");
+        if let Some(found) = cga.iter().find(|n| n.eq_ignore_ascii_case(&wanted)) {
+            return Ok(found.to_string());
+        }
+    }
+    match cga[..] {
+        [only] => Ok(only.clone()),
+        [] => Err("it holds no rule file (rules/*.cga)".into()),
+        _ => Err(format!(
+            "it holds {} rule files and no single compiled rule says which is the main one: {}",
+            cga.len(),
+            cga.iter()
+                .map(|s| s.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )),
+    }
+}
+
 fn annotations(list: &[cga_engine::program::AnnotationInfo]) -> Vec<Annotation> {
     list.iter()
         .map(|a| Annotation {
@@ -403,4 +494,35 @@ fn annotations(list: &[cga_engine::program::AnnotationInfo]) -> Vec<Annotation> 
             args: a.args.clone(),
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn names(list: &[&str]) -> Vec<String> {
+        list.iter().map(|s| s.to_string()).collect()
+    }
+
+    #[test]
+    fn a_package_main_rule_is_its_compiled_rule_else_its_only_rule_file() {
+        let envelope = names(&[
+            "bin/typology/envelope2002.cgb",
+            "bin/typology/envelope2002$facade.cgb",
+            "rules/typology/envelope2002.cga",
+            "rules/typology/facade.cga",
+            ".ws/ESRI.lib/rules/Plants/Plant_Loader.cga",
+        ]);
+        assert_eq!(
+            package_main_rule(&envelope).unwrap(),
+            "rules/typology/envelope2002.cga"
+        );
+        assert_eq!(
+            package_main_rule(&names(&["rules/a.cga", "assets/x.obj"])).unwrap(),
+            "rules/a.cga"
+        );
+        let two = package_main_rule(&names(&["rules/a.cga", "rules/b.cga"])).unwrap_err();
+        assert!(two.contains("2 rule files"), "{two}");
+        assert!(package_main_rule(&names(&["assets/x.obj"])).is_err());
+    }
 }

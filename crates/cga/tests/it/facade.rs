@@ -321,3 +321,99 @@ fn many_lots_come_in_order_whatever_the_threads() {
         }
     }
 }
+
+/// A zip archive of `files`, as a rule package.
+fn zip_package(files: &[(&str, &[u8])]) -> Vec<u8> {
+    let mut out = std::io::Cursor::new(Vec::new());
+    {
+        let mut w = zip::ZipWriter::new(&mut out);
+        for (name, bytes) in files {
+            w.start_file(*name, zip::write::SimpleFileOptions::default())
+                .unwrap();
+            std::io::Write::write_all(&mut w, bytes).unwrap();
+        }
+        w.finish().unwrap();
+    }
+    out.into_inner()
+}
+
+#[test]
+fn a_zip_rule_package_loads_with_its_imports_and_assets() {
+    let obj = b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
+    let package = zip_package(&[
+        ("bin/main.cgb", b"compiled"),
+        ("bin/main$lib.cgb", b"compiled"),
+        (
+            "rules/main.cga",
+            b"import lib : \"lib.cga\"\nattr n = 2\nLot --> print(readTextFile(\"notes.txt\")) i(\"box.obj\") lib.Part\n",
+        ),
+        ("rules/lib.cga", b"Part --> report(\"parts\", 1) P.\n"),
+        ("assets/notes.txt", b"from the package"),
+        ("assets/box.obj", obj),
+    ]);
+    let world = MemoryWorld::new().with("/pkgs/city.rpk", package);
+    let rules = Engine::new(world).load("/pkgs/city.rpk");
+    assert!(!rules.has_errors(), "{}", rules.render_diagnostics());
+    assert_eq!(rules.path(), Path::new("/pkgs/city.rpk/rules/main.cga"));
+    assert_eq!(rules.attributes()[0].name, "n");
+    let r = rules
+        .generate(&cga::lots::rect(3.0, 3.0), &Options::default())
+        .unwrap();
+    assert_eq!(r.prints, vec!["from the package"]);
+    assert_eq!(r.reports, vec![("parts".to_string(), Value::Float(1.0))]);
+    assert_eq!(r.model.triangles(), 2);
+    // Not a package, and a missing one, are diagnostics.
+    let world = MemoryWorld::new().with("/pkgs/bad.rpk", "Lot --> X.");
+    let bad = Engine::new(world).load("/pkgs/bad.rpk");
+    assert!(bad.diagnostics()[0]
+        .message
+        .contains("neither a 7z nor a zip"));
+    let missing = Engine::new(MemoryWorld::new()).load("/pkgs/none.rpk");
+    assert!(missing.diagnostics()[0]
+        .message
+        .starts_with("cannot read rule package"));
+}
+
+/// The shared rule packages of CityEngine's runtime (7z archives), when
+/// `../shared` is beside the repository.
+fn shared_package(name: &str) -> Option<std::path::PathBuf> {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/prt-oracle/rpk")
+        .join(name);
+    if p.is_file() {
+        return Some(p);
+    }
+    assert!(
+        std::env::var_os("CGA_REQUIRE_SHARED").is_none(),
+        "../shared/prt-oracle/rpk/{name} is required (CGA_REQUIRE_SHARED) but missing"
+    );
+    eprintln!("skipped: ../shared/prt-oracle/rpk/{name} not found");
+    None
+}
+
+#[test]
+fn seven_zip_packages_of_cityengine_load_and_generate() {
+    let Some(candler) = shared_package("candler.rpk") else {
+        return;
+    };
+    let rules = Engine::on_disk().load(&candler);
+    assert!(!rules.has_errors(), "{}", rules.render_diagnostics());
+    assert!(rules.path().ends_with("candler.rpk/rules/candler.cga"));
+    let r = rules
+        .generate(&cga::lots::rect(20.0, 30.0), &Options::default())
+        .unwrap();
+    assert!(r.error.is_none());
+    assert!(r.warnings.is_empty(), "{:?}", r.warnings);
+    // Its textures come from the package: materials name files inside it.
+    assert!(r.model.materials.iter().any(|m| m.maps[0]
+        .path
+        .contains("candler.rpk/assets/facade/walls/bricks.jpg")));
+    let Some(envelope) = shared_package("envelope2002.rpk") else {
+        return;
+    };
+    let rules = Engine::on_disk().load(&envelope);
+    assert!(rules
+        .path()
+        .ends_with("envelope2002.rpk/rules/typology/envelope2002.cga"));
+    assert!(!rules.has_errors(), "{}", rules.render_diagnostics());
+}

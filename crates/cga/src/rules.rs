@@ -147,6 +147,7 @@ impl Engine {
                 AssetStore::new(world.clone()).with_max_file_mib(self.store.max_file_mib()),
             ),
             world,
+            workspaces: self.workspaces.clone(),
         };
         engine.load(root.join(main))
     }

@@ -939,3 +939,44 @@ fn attribute_values_take_the_attribute_type_and_annotations_warn() {
     );
     assert!(err.contains("a.cga:2:6"), "{err}");
 }
+
+/// Each lot's seed: the run's seed for the first lot, a hash of the seed and
+/// the lot's index for the others (so `--seed 1` is not `--seed 0` shifted
+/// by a lot); a lot's own `seed` property, or `--attr seed=N`, sets it.
+#[test]
+fn every_seed_gives_another_city_and_lots_carry_their_own_seed() {
+    let dir = temp_dir("seeds");
+    let rules = rule_file(&dir, "s.cga", "Lot --> print(seedian) X.\n");
+    let r = rules.to_str().unwrap();
+    let seeds = |args: &[&str]| -> Vec<String> {
+        let mut all = vec!["generate", r];
+        all.extend_from_slice(args);
+        let o = run(&all);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        stdout(&o).lines().map(str::to_string).collect()
+    };
+    let s0 = seeds(&["--lot", "grid:4x1", "--seed", "0"]);
+    let s1 = seeds(&["--lot", "grid:4x1", "--seed", "1"]);
+    assert_eq!(s0[0], "0");
+    assert_eq!(s1[0], "1");
+    assert_ne!(&s0[1..], &s1[..3], "not shifted by a lot");
+    let all: std::collections::HashSet<_> = s0.iter().chain(&s1).collect();
+    assert_eq!(all.len(), 8);
+    // One lot with --seed 666 derives with seedian 666.
+    assert_eq!(seeds(&["--seed", "666"]), vec!["666"]);
+    // --attr seed=N: every lot's own seed.
+    assert_eq!(
+        seeds(&["--lot", "grid:2x1", "--attr", "seed=42"]),
+        vec!["42", "42"]
+    );
+    // A GeoJSON property `seed` is the lot's seed.
+    let geojson = dir.join("lots.geojson");
+    std::fs::write(
+        &geojson,
+        r#"{"type":"FeatureCollection","features":[
+        {"type":"Feature","properties":{"seed":7},"geometry":{"type":"Polygon","coordinates":[[[0,0],[10,0],[10,10],[0,10],[0,0]]]}},
+        {"type":"Feature","properties":{"seed":9},"geometry":{"type":"Polygon","coordinates":[[[20,0],[30,0],[30,10],[20,10],[20,0]]]}}]}"#,
+    )
+    .unwrap();
+    assert_eq!(seeds(&["--lot", geojson.to_str().unwrap()]), vec!["7", "9"]);
+}

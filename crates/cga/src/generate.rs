@@ -226,11 +226,13 @@ impl Rules {
                     };
                     out.attrs.push((id, value))
                 }
-                // As in CityEngine, `seed` is the initial shapes' random
-                // seed unless the rules declare an attribute of that name.
+                // As in CityEngine, `seed` is the initial shapes' own seed
+                // unless the rules declare an attribute of that name.
                 None if name == "seed" => {
-                    out.seed = match value {
-                        cga_value::Value::Float(x) if *x >= 0.0 && x.fract() == 0.0 => *x as u64,
+                    out.lot_seed = match value {
+                        cga_value::Value::Float(x) if *x >= 0.0 && x.fract() == 0.0 => {
+                            Some(*x as u64)
+                        }
                         other => {
                             return Err(Error::Value(format!(
                                 "the seed must be a whole number, found `{}`",

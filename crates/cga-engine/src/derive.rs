@@ -112,25 +112,22 @@ impl RtError {
 /// operations that cannot use one (`print`, `report` and `set` take any
 /// value).
 fn non_finite_arg(op: ops::Op, args: &[Arg]) -> Option<usize> {
-    if matches!(op, ops::Op::Print | ops::Op::Report | ops::Op::Set(_)) {
+    use ops::{AttrOp, Op};
+    if matches!(
+        op,
+        Op::Attr(AttrOp::Print | AttrOp::Report | AttrOp::Set(_))
+    ) {
         return None;
     }
     args.iter()
         .position(|a| matches!(a.value, Value::Float(x) if !x.is_finite()))
 }
 
-/// An operation's name as written in CGA (`Op::PrimitiveCube`:
-/// `primitiveCube`).
-fn op_name(op: ops::Op) -> String {
-    let debug = match op {
-        ops::Op::Insert => "i".to_string(),
-        ops::Op::Set(_) => "set".to_string(),
-        other => format!("{other:?}"),
-    };
-    let mut chars = debug.chars();
-    match chars.next() {
-        Some(c) => c.to_lowercase().chain(chars).collect(),
-        None => debug,
+/// Why the operation `name` of the table is not run (the warning's words).
+fn not_run_reason(name: &str) -> &'static str {
+    match ops::table::find(name).map(|d| d.run) {
+        Some(ops::table::Run::Deprecated(why)) => why,
+        _ => "is not supported yet",
     }
 }
 
@@ -1073,7 +1070,7 @@ impl<'a> Interp<'a> {
                     // CityEngine generates the model: the operation is
                     // skipped, the shape goes on as it was.
                     let rule = self.program.symbol(st.shape.name).to_string();
-                    let op = op_name(call.op);
+                    let op = ops::table::name_of(call.op);
                     let at = e.span.unwrap_or(call.span);
                     self.warn_once(at, || {
                         format!(
@@ -1156,7 +1153,7 @@ impl<'a> Interp<'a> {
                 self.warn_once(*span, || {
                     format!(
                         "operation `{name}` {}; the shape is left unchanged",
-                        ops::not_run_reason(&name)
+                        not_run_reason(&name)
                     )
                 });
                 Ok(())

@@ -968,7 +968,9 @@ impl Resolver<'_> {
             }
             NameKind::Statement => {
                 candidates.extend(t.rules.keys().map(|s| s.as_str()));
-                candidates.extend(ops::ALL_OPERATIONS);
+                for op in ops::table::names() {
+                    candidates.push(op);
+                }
             }
         }
         closest(name, candidates)
@@ -1442,11 +1444,12 @@ impl Resolver<'_> {
         } else {
             vec![current(self, "OperandA"), other]
         };
-        let op = match call.name.name.as_str() {
-            "union" => Op::Union,
-            "subtract" => Op::Subtract,
-            _ => Op::Intersect,
-        };
+        use cga_geometry::boolean::BoolOp;
+        let op = Op::Boolean(match call.name.name.as_str() {
+            "union" => BoolOp::Union,
+            "subtract" => BoolOp::Subtract,
+            _ => BoolOp::Intersect,
+        });
         RStmt::Op(OpCall {
             op,
             args: Vec::new(),
@@ -1600,18 +1603,26 @@ impl Resolver<'_> {
                 span,
             });
         }
-        if let Some(info) = ops::lookup(name) {
-            if arity < info.min_args || arity > info.max_args {
-                self.error(
+        let def = ops::table::find(name);
+        if let Some((def, op)) = def.and_then(|d| match d.run {
+            ops::table::Run::Op(op) => Some((d, op)),
+            _ => None,
+        }) {
+            if !def.accepts(arity) {
+                let mut d = Diagnostic::error(
                     format!(
                         "`{name}` takes {} arguments, found {arity}",
-                        arity_text(info.min_args, info.max_args)
+                        def.arity_text()
                     ),
                     span,
                 );
+                for form in def.signatures() {
+                    d = d.with_note(format!("form: {form}"));
+                }
+                self.diags.push(d);
                 return RStmt::Nil;
             }
-            let mut args = self.op_args(cx, name, call.args.as_deref().unwrap_or(&[]));
+            let mut args = self.op_args(cx, def, call.args.as_deref().unwrap_or(&[]));
             if name == "setbackPerEdge" {
                 // A shortcut for `setback(comp(fe) { all : distance })`
                 // (op_setbackPerEdge.md): the distance is evaluated on
@@ -1625,27 +1636,30 @@ impl Resolver<'_> {
                 _ => Heads::Plain,
             };
             let block = call.block.as_ref().map(|b| self.op_block(cx, b, heads));
-            if block.is_some() && !info.block {
+            if block.is_some() && def.block == ops::table::Block::None {
                 self.error(format!("`{name}` takes no `{{ ... }}` block"), span);
             }
             let remainder_block = call
                 .remainder_block
                 .as_ref()
                 .map(|b| self.op_block(cx, b, Heads::Plain));
-            if remainder_block.is_some() && info.op != Op::SplitAndSetbackPerimeter {
+            if remainder_block.is_some()
+                && op != Op::Footprint(ops::FootprintOp::SplitAndSetbackPerimeter)
+            {
                 self.error(format!("`{name}` takes one `{{ ... }}` block"), span);
             }
             return RStmt::Op(OpCall {
-                op: info.op,
+                op,
                 args,
                 block,
                 remainder_block,
                 span,
             });
         }
-        if ops::ALL_OPERATIONS.contains(&name) {
-            // Resolve what is inside anyway, so that its errors are reported.
-            let _ = self.op_args(cx, name, call.args.as_deref().unwrap_or(&[]));
+        if let Some(def) = def {
+            // An operation that is not run: resolve what is inside anyway,
+            // so that its errors are reported.
+            let _ = self.op_args(cx, def, call.args.as_deref().unwrap_or(&[]));
             if let Some(b) = &call.block {
                 let _ = self.op_block(cx, b, Heads::Plain);
             }
@@ -1715,15 +1729,19 @@ impl Resolver<'_> {
         RStmt::Nil
     }
 
-    fn op_args(&mut self, cx: &Cx, op: &str, args: &[Expr]) -> Vec<RExpr> {
+    fn op_args(&mut self, cx: &Cx, def: &ops::table::OpDef, args: &[Expr]) -> Vec<RExpr> {
         let n = args.len();
+        // Operations not run read names as selector words where they are.
+        let runs = matches!(def.run, ops::table::Run::Op(_));
         args.iter()
             .enumerate()
-            .map(|(i, a)| match (ops::arg_mode(op, n, i), &a.kind) {
-                (ArgMode::Selector, _) => self.selector_arg(cx, a),
-                (ArgMode::Maybe, _) => self.head(cx, a),
-                (ArgMode::Expr, _) => self.expr(cx, a),
-            })
+            .map(
+                |(i, a)| match (if runs { def.mode(n, i) } else { ArgMode::Maybe }, &a.kind) {
+                    (ArgMode::Selector, _) => self.selector_arg(cx, a),
+                    (ArgMode::Maybe, _) => self.head(cx, a),
+                    (ArgMode::Expr, _) => self.expr(cx, a),
+                },
+            )
             .collect()
     }
 
@@ -1767,7 +1785,7 @@ impl Resolver<'_> {
         };
         let value = self.expr(cx, &args[1]);
         RStmt::Op(OpCall {
-            op: Op::Set(t),
+            op: ops::table::set_op(t),
             args: vec![value],
             block: None,
             remainder_block: None,

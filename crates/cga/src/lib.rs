@@ -32,6 +32,7 @@ mod error;
 mod generate;
 pub mod lots;
 mod model;
+pub mod operations;
 mod options;
 mod pipeline;
 mod rules;

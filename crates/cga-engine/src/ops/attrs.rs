@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use cga_value::Value;
 
-use super::{Op, SetTarget};
+use super::{AttrOp, SetTarget};
 use crate::derive::{Arg, Interp, MaterialEdit, RtError, ShapeState};
 use crate::expr::OpCall;
 use crate::material_attr::{parse_hex_color, MatField, MaterialOverrides};
@@ -16,12 +16,13 @@ use crate::values::{to_text, type_name};
 pub fn exec(
     cx: &mut Interp,
     st: &mut ShapeState,
+    op: AttrOp,
     call: &OpCall,
     args: &[Arg],
 ) -> Result<(), RtError> {
     let shape = &mut st.shape;
-    match call.op {
-        Op::Color => match args {
+    match op {
+        AttrOp::Color => match args {
             [hex] => {
                 let s = hex.text()?;
                 if parse_hex_color(s).is_none() {
@@ -81,8 +82,8 @@ pub fn exec(
                 ))
             }
         },
-        Op::Set(target) => set(cx, shape, target, &args[0])?,
-        Op::SetMaterial => {
+        AttrOp::Set(target) => set(cx, shape, target, &args[0])?,
+        AttrOp::SetMaterial => {
             let pairs: Vec<Arc<str>> = match &args[0].value {
                 Value::StrArray(a) => a.data.clone(),
                 other => {
@@ -105,7 +106,7 @@ pub fn exec(
                 set_field(m, field, &Value::Str(v.clone()), &args[0])?;
             }
         }
-        Op::ResetMaterial => {
+        AttrOp::ResetMaterial => {
             let target = match args.first() {
                 Some(a) => super::transform::selector(a, &["shape", "geometry", "all"])?,
                 None => "shape",
@@ -119,8 +120,8 @@ pub fn exec(
                 }
             }
         }
-        Op::Print => cx.out.prints.push(to_text(&args[0].value)),
-        Op::Report => {
+        AttrOp::Print => cx.out.prints.push(to_text(&args[0].value)),
+        AttrOp::Report => {
             let key = match &args[0].value {
                 Value::Str(s) => s.to_string(),
                 other => to_text(other),
@@ -140,7 +141,6 @@ pub fn exec(
                 }
             }
         }
-        _ => unreachable!("not an attribute operation"),
     }
     Ok(())
 }

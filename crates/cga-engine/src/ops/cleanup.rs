@@ -7,19 +7,18 @@
 use cga_geometry::{DAffine3, DVec3, Mesh};
 
 use super::transform::selector;
-use super::Op;
+use super::CleanupOp;
 use crate::derive::{Arg, Interp, RtError, ShapeState};
-use crate::expr::OpCall;
 
 pub fn exec(
     cx: &mut Interp,
     st: &mut ShapeState,
-    call: &OpCall,
+    op: CleanupOp,
     args: &[Arg],
 ) -> Result<(), RtError> {
     let shape = &mut st.shape;
-    match call.op {
-        Op::Convexify => {
+    match op {
+        CleanupOp::Convexify => {
             let max = match args.first() {
                 Some(a) => {
                     let m = a.num()?;
@@ -34,18 +33,18 @@ pub fn exec(
                 shape.set_local_mesh(out);
             }
         }
-        Op::DeleteHoles => {
+        CleanupOp::DeleteHoles => {
             let mesh = shape.geometry.local().clone();
             if mesh.loops.len() > mesh.faces.len() {
                 shape.set_local_mesh(delete_holes(&mesh));
             }
         }
-        Op::ReverseNormals => {
+        CleanupOp::ReverseNormals => {
             let mut mesh = (**shape.geometry.local()).clone();
             reverse_keeping_first_edge(&mut mesh);
             shape.set_local_mesh(mesh);
         }
-        Op::SetNormals => {
+        CleanupOp::SetNormals => {
             let mode = selector(&args[0], &["hard", "conform", "soft", "auto"])?;
             let mut mesh = (**shape.geometry.local()).clone();
             match mode {
@@ -59,13 +58,13 @@ pub fn exec(
             }
             shape.set_local_mesh(mesh);
         }
-        Op::SoftenNormals => {
+        CleanupOp::SoftenNormals => {
             let angle = args[0].num()?;
             let mut mesh = (**shape.geometry.local()).clone();
             cga_geometry::normals::soften_normals(&mut mesh, angle);
             shape.set_local_mesh(mesh);
         }
-        Op::Mirror => {
+        CleanupOp::Mirror => {
             // Mirror inside the scope box: x -> sx - x along flipped axes.
             // The scope stays; a mirror that turns the geometry inside out
             // (an odd number of flips) reverses the faces so that they keep
@@ -85,7 +84,7 @@ pub fn exec(
                     .transform(DAffine3::from_translation(shift) * DAffine3::from_scale(scale));
             }
         }
-        Op::CleanupGeometry => {
+        CleanupOp::CleanupGeometry => {
             let what = selector(&args[0], &["vertices", "edges", "faces", "all"])?;
             let tol = args[1].num()?;
             if !(0.0..=1.0).contains(&tol) {
@@ -98,19 +97,18 @@ pub fn exec(
                 cga_geometry::cleanup::cleanup(&mesh, cleanup_parts(what), tol.clamp(0.0, 1.0));
             shape.set_local_mesh(out);
         }
-        Op::ReduceGeometry => {
+        CleanupOp::ReduceGeometry => {
             let r = args[0].num()?;
             let mesh = shape.geometry.local().clone();
             let out = cga_geometry::cleanup::reduce(&mesh, r.clamp(0.0, 1.0));
             shape.set_local_mesh(out);
         }
-        Op::Rectify => {
+        CleanupOp::Rectify => {
             let angle = args[0].num()?;
             let mesh = shape.geometry.local().clone();
             let out = cga_geometry::cleanup::rectify(&mesh, angle.clamp(0.0, 45.0));
             shape.set_local_mesh(out);
         }
-        _ => unreachable!("not a cleanup operation"),
     }
     Ok(())
 }

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use cga_geometry::{DAffine3, DMat3, DVec3, Mesh};
 
 use super::transform::selector;
-use super::Op;
+use super::{CreateOp, Primitive};
 use crate::derive::{Arg, Interp, RtError, ShapeState};
 use crate::expr::OpCall;
 use crate::shape::{local_bounds, Shape};
@@ -14,24 +14,15 @@ use crate::shape::{local_bounds, Shape};
 pub fn exec(
     cx: &mut Interp,
     st: &mut ShapeState,
+    op: CreateOp,
     call: &OpCall,
     args: &[Arg],
 ) -> Result<(), RtError> {
     let shape = &mut st.shape;
-    match call.op {
-        Op::Extrude => extrude(shape, args),
-        Op::PrimitiveQuad
-        | Op::PrimitiveDisk
-        | Op::PrimitiveCube
-        | Op::PrimitiveSphere
-        | Op::PrimitiveCylinder
-        | Op::PrimitiveCone => primitive(shape, call.op, args),
-        Op::Insert => insert(cx, shape, call, args),
-        Op::ReverseNormals => {
-            cga_geometry::transform::reverse_faces(shape.geometry.local_mut());
-            Ok(())
-        }
-        _ => unreachable!("not a geometry creation operation"),
+    match op {
+        CreateOp::Extrude => extrude(shape, args),
+        CreateOp::Primitive(kind) => primitive(shape, kind, args),
+        CreateOp::Insert => insert(cx, shape, call, args),
     }
 }
 
@@ -52,17 +43,17 @@ fn count(arg: Option<&Arg>, default: usize, min: usize) -> Result<usize, RtError
     }
 }
 
-fn primitive(shape: &mut Shape, op: Op, args: &[Arg]) -> Result<(), RtError> {
+fn primitive(shape: &mut Shape, op: Primitive, args: &[Arg]) -> Result<(), RtError> {
     use cga_geometry::primitive as p;
     let unit = DVec3::ONE;
     // With dimensions: that size, centred in x and z, standing on y = 0;
     // without: a unit shape fitted to the scope.
     let (mesh, sized, flat) = match op {
-        Op::PrimitiveQuad => match args {
+        Primitive::Quad => match args {
             [w, l] => (p::quad(w.num()?, l.num()?), true, true),
             _ => (p::quad(1.0, 1.0), false, true),
         },
-        Op::PrimitiveDisk => {
+        Primitive::Disk => {
             let n = count(args.first(), 16, 3)?;
             match args.get(1) {
                 Some(r) => {
@@ -72,7 +63,7 @@ fn primitive(shape: &mut Shape, op: Op, args: &[Arg]) -> Result<(), RtError> {
                 None => (p::disk(n, 1.0, 1.0), false, true),
             }
         }
-        Op::PrimitiveCube => match args {
+        Primitive::Cube => match args {
             [w, h, d] => (
                 p::cube(DVec3::new(w.num()?, h.num()?, d.num()?)),
                 true,
@@ -80,7 +71,7 @@ fn primitive(shape: &mut Shape, op: Op, args: &[Arg]) -> Result<(), RtError> {
             ),
             _ => (p::cube(unit), false, false),
         },
-        Op::PrimitiveSphere => {
+        Primitive::Sphere => {
             let sides = count(args.first(), 16, 3)?;
             let divisions = count(args.get(1), 16, 2)?;
             match args.get(2) {
@@ -92,7 +83,7 @@ fn primitive(shape: &mut Shape, op: Op, args: &[Arg]) -> Result<(), RtError> {
                 None => (p::sphere(sides, divisions, unit), false, false),
             }
         }
-        Op::PrimitiveCylinder | Op::PrimitiveCone => {
+        Primitive::Cylinder | Primitive::Cone => {
             let sides = count(args.first(), 16, 3)?;
             let size = match (args.get(1), args.get(2)) {
                 (Some(r), Some(h)) => {
@@ -101,14 +92,13 @@ fn primitive(shape: &mut Shape, op: Op, args: &[Arg]) -> Result<(), RtError> {
                 }
                 _ => None,
             };
-            let make = if op == Op::PrimitiveCylinder {
+            let make = if op == Primitive::Cylinder {
                 p::cylinder
             } else {
                 p::cone
             };
             (make(sides, size.unwrap_or(unit)), size.is_some(), false)
         }
-        _ => unreachable!("not a primitive"),
     };
     let mut mesh = mesh;
     // A flat primitive goes into the plane of the scope's non-zero sizes,

@@ -33,7 +33,7 @@ use cga_value::Value;
 
 use super::comp::FaceEdgeSelection;
 use super::transform::selector;
-use super::Op;
+use super::FootprintOp;
 use crate::derive::{Arg, Interp, RtError, ShapeState};
 use crate::expr::{OpCall, RBlock, RBody, RExpr, RExprKind, RPart};
 use crate::selectors::{quadrant_of, Frames, Quadrant};
@@ -44,21 +44,25 @@ use cga_geometry::perimeter;
 pub fn exec(
     cx: &mut Interp,
     st: &mut ShapeState,
+    op: FootprintOp,
     call: &OpCall,
     args: &[Arg],
     frame: &[Value],
 ) -> Result<(), RtError> {
-    match call.op {
-        Op::Offset => offset(cx, st, call, args),
-        Op::Setback | Op::SetbackPerEdge | Op::SetbackToArea => setback(cx, st, call, args, frame),
-        Op::ShapeL | Op::ShapeU | Op::ShapeO => shape_luo(cx, st, call, args, frame),
-        Op::InnerRectangle => inner_rectangle(cx, st, call, args, frame),
-        Op::InnerRect => inner_rect(st),
-        Op::Envelope => envelope(cx, st, call, args),
-        Op::Taper => taper(st, args),
-        Op::Footprint => footprint(st),
-        Op::SplitAndSetbackPerimeter => perimeter(cx, st, call, args, frame),
-        _ => unreachable!("not a footprint operation"),
+    match op {
+        FootprintOp::Offset => offset(cx, st, call, args),
+        FootprintOp::Setback | FootprintOp::SetbackPerEdge | FootprintOp::SetbackToArea => {
+            setback(cx, st, op, call, args, frame)
+        }
+        FootprintOp::ShapeL | FootprintOp::ShapeU | FootprintOp::ShapeO => {
+            shape_luo(cx, st, op, call, args, frame)
+        }
+        FootprintOp::InnerRectangle => inner_rectangle(cx, st, call, args, frame),
+        FootprintOp::InnerRect => inner_rect(st),
+        FootprintOp::Envelope => envelope(cx, st, call, args),
+        FootprintOp::Taper => taper(st, args),
+        FootprintOp::Footprint => footprint(st),
+        FootprintOp::SplitAndSetbackPerimeter => perimeter(cx, st, call, args, frame),
     }
 }
 
@@ -363,13 +367,14 @@ fn offset(
 fn setback(
     cx: &mut Interp,
     st: &mut ShapeState,
+    op: FootprintOp,
     call: &OpCall,
     args: &[Arg],
     frame: &[Value],
 ) -> Result<(), RtError> {
-    let name = match call.op {
-        Op::Setback => "setback",
-        Op::SetbackPerEdge => "setbackPerEdge",
+    let name = match op {
+        FootprintOp::Setback => "setback",
+        FootprintOp::SetbackPerEdge => "setbackPerEdge",
         _ => "setbackToArea",
     };
     let entries = entries(call.block.as_ref(), name, call.span)?;
@@ -397,8 +402,8 @@ fn setback(
             }
         }
     }
-    let o = match call.op {
-        Op::SetbackToArea => {
+    let o = match op {
+        FootprintOp::SetbackToArea => {
             let area = args[0].num()?;
             // (area [, minDistances [, maxDistances]] [, uvSet]): arrays
             // are distances, a trailing float the uv set.
@@ -480,13 +485,14 @@ fn emit_setback(
 fn shape_luo(
     cx: &mut Interp,
     st: &mut ShapeState,
+    op: FootprintOp,
     call: &OpCall,
     args: &[Arg],
     frame: &[Value],
 ) -> Result<(), RtError> {
-    let name = match call.op {
-        Op::ShapeL => "shapeL",
-        Op::ShapeU => "shapeU",
+    let name = match op {
+        FootprintOp::ShapeL => "shapeL",
+        FootprintOp::ShapeU => "shapeU",
         _ => "shapeO",
     };
     let entries = entries(call.block.as_ref(), name, call.span)?;
@@ -505,13 +511,13 @@ fn shape_luo(
     // setback(comp(fe) { front = .. | right = .. | back = .. | left = .. }).
     let w: Vec<f64> = args.iter().map(Arg::num).collect::<Result<_, _>>()?;
     let width = |q: Quadrant| -> f64 {
-        match (call.op, q) {
+        match (op, q) {
             (_, Quadrant::Front) => w[0],
-            (Op::ShapeL, Quadrant::Left) => w[1],
-            (Op::ShapeU | Op::ShapeO, Quadrant::Right) => w[1],
-            (Op::ShapeU, Quadrant::Left) => w[2],
-            (Op::ShapeO, Quadrant::Back) => w[2],
-            (Op::ShapeO, Quadrant::Left) => w[3],
+            (FootprintOp::ShapeL, Quadrant::Left) => w[1],
+            (FootprintOp::ShapeU | FootprintOp::ShapeO, Quadrant::Right) => w[1],
+            (FootprintOp::ShapeU, Quadrant::Left) => w[2],
+            (FootprintOp::ShapeO, Quadrant::Back) => w[2],
+            (FootprintOp::ShapeO, Quadrant::Left) => w[3],
             _ => 0.0,
         }
     };

@@ -19,7 +19,7 @@ use cga_geometry::roof::{roof, RoofKind, RoofSlope};
 use cga_geometry::{measure, DMat3, DVec3, Mesh};
 
 use super::transform::selector;
-use super::Op;
+use super::RoofOp;
 use crate::derive::{Arg, Interp, RtError, ShapeState};
 use crate::expr::OpCall;
 use crate::shape::Shape;
@@ -27,21 +27,22 @@ use crate::shape::Shape;
 pub fn exec(
     cx: &mut Interp,
     st: &mut ShapeState,
+    op: RoofOp,
     call: &OpCall,
     args: &[Arg],
 ) -> Result<(), RtError> {
     let (slope, rest) = slope_args(args)?;
-    let name = op_name(call.op);
+    let name = op_name(op);
     let mesh = st.shape.geometry.local().clone();
     if mesh.faces.is_empty() {
         return Ok(());
     }
-    let kind = match call.op {
-        Op::RoofHip => RoofKind::Hip {
+    let kind = match op {
+        RoofOp::Hip => RoofKind::Hip {
             overhang: opt_num(rest.first(), 0.0)?,
             even: opt_bool(rest.get(1), false)?,
         },
-        Op::RoofGable => {
+        RoofOp::Gable => {
             // The angle form has the index as fifth argument; the
             // valueType form has no index (its fifth argument is `even`).
             let index = match (args[0].value.as_str().is_some(), rest.get(3)) {
@@ -55,20 +56,19 @@ pub fn exec(
                 index,
             }
         }
-        Op::RoofPyramid => RoofKind::Pyramid,
-        Op::RoofShed => RoofKind::Shed {
+        RoofOp::Pyramid => RoofKind::Pyramid,
+        RoofOp::Shed => RoofKind::Shed {
             index: match rest.first() {
                 Some(a) => edge_index(a, &mesh)?,
                 None => 0,
             },
         },
-        Op::RoofRidge => RoofKind::Ridge { ridge: DVec3::X },
-        _ => unreachable!("not a roof operation"),
+        RoofOp::Ridge => RoofKind::Ridge { ridge: DVec3::X },
     };
-    let too_many = match call.op {
-        Op::RoofHip => 2,
-        Op::RoofGable => 4,
-        Op::RoofShed => 1,
+    let too_many = match op {
+        RoofOp::Hip => 2,
+        RoofOp::Gable => 4,
+        RoofOp::Shed => 1,
         _ => 0,
     };
     if rest.len() > too_many {
@@ -96,13 +96,13 @@ pub fn exec(
     Ok(())
 }
 
-fn op_name(op: Op) -> &'static str {
+fn op_name(op: RoofOp) -> &'static str {
     match op {
-        Op::RoofHip => "roofHip",
-        Op::RoofGable => "roofGable",
-        Op::RoofPyramid => "roofPyramid",
-        Op::RoofShed => "roofShed",
-        _ => "roofRidge",
+        RoofOp::Hip => "roofHip",
+        RoofOp::Gable => "roofGable",
+        RoofOp::Pyramid => "roofPyramid",
+        RoofOp::Shed => "roofShed",
+        RoofOp::Ridge => "roofRidge",
     }
 }
 

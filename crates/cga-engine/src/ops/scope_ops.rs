@@ -5,21 +5,20 @@
 use cga_geometry::{DMat3, DVec3};
 
 use super::transform::selector;
-use super::Op;
+use super::ScopeOp;
 use crate::derive::{Arg, Interp, RtError, ShapeState};
-use crate::expr::OpCall;
 use crate::shape::{euler_to_mat, Frame, Shape};
 use cga_geometry::measure as geom;
 
 pub fn exec(
     cx: &mut Interp,
     st: &mut ShapeState,
-    call: &OpCall,
+    op: ScopeOp,
     args: &[Arg],
 ) -> Result<(), RtError> {
     let shape = &mut st.shape;
-    match call.op {
-        Op::AlignScopeToAxes => {
+    match op {
+        ScopeOp::AlignScopeToAxes => {
             let which = match args.first() {
                 Some(a) => selector(
                     a,
@@ -72,7 +71,7 @@ pub fn exec(
             };
             align_pivot_and_scope(shape, axes);
         }
-        Op::AlignScopeToGeometry => {
+        ScopeOp::AlignScopeToGeometry => {
             // xUp is a selector of the reference that CityEngine does not support yet.
             let up = selector(&args[0], &["yUp", "zUp"])?;
             let mesh = shape.object_mesh();
@@ -93,7 +92,7 @@ pub fn exec(
             };
             align_pivot_and_scope(shape, axes);
         }
-        Op::SetPivot => {
+        ScopeOp::SetPivot => {
             // `yUp`/`zUp` were dropped in 2010.1 for `xyz`/`yzx`
             // (cga_changelog.md); older files still use them.
             let map = match selector(&args[0], &["xyz", "yzx", "zxy", "yUp", "zUp"])? {
@@ -104,13 +103,13 @@ pub fn exec(
             let corner = args[1].num()?.round().clamp(0.0, 7.0) as usize;
             set_pivot(shape, map, corner);
         }
-        Op::RotateScope => {
+        ScopeOp::RotateScope => {
             let angles = super::transform::vec3(args, DVec3::ONE)?;
             let rot = shape.scope.rot + angles;
             let axes = shape.pivot.axes * euler_to_mat(rot);
             shape.fit_scope(axes);
         }
-        Op::MirrorScope => {
+        ScopeOp::MirrorScope => {
             // The scope is (t, r, s) as in CGA: a mirrored axis cannot be a
             // rotation, so it is a negative size seen from the far side of
             // the box (as `s` with a negative size makes). The box, the
@@ -126,13 +125,12 @@ pub fn exec(
             }
             shape.reframe_scope(scope);
         }
-        Op::ResetGeometry => {
+        ScopeOp::ResetGeometry => {
             let init = &cx.initial;
             shape.geometry = init.geometry.clone();
             shape.scope = init.scope;
             shape.pivot = init.pivot;
         }
-        _ => unreachable!("not a scope operation"),
     }
     Ok(())
 }

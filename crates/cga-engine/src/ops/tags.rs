@@ -6,13 +6,12 @@ use cga_geometry::tags::{self, TagQuery, TagTarget};
 use cga_geometry::Mesh;
 
 use super::transform::selector;
-use super::Op;
+use super::TagOp;
 use crate::derive::{Arg, RtError, ShapeState};
-use crate::expr::OpCall;
 
-pub fn exec(st: &mut ShapeState, call: &OpCall, args: &[Arg]) -> Result<(), RtError> {
-    match call.op {
-        Op::Tag => {
+pub fn exec(st: &mut ShapeState, op: TagOp, args: &[Arg]) -> Result<(), RtError> {
+    match op {
+        TagOp::Tag => {
             let name = args[0].text()?;
             let target = match args.get(1) {
                 Some(a) => target(a, &["auto", "faces", "edges", "vertices"])?,
@@ -23,7 +22,7 @@ pub fn exec(st: &mut ShapeState, call: &OpCall, args: &[Arg]) -> Result<(), RtEr
             }
             edit(st, |m| tags::add_tag(m, name, target));
         }
-        Op::DeleteTags => {
+        TagOp::DeleteTags => {
             let query = match args.first() {
                 Some(a) => Some(TagQuery::parse(a.text()?)),
                 None => None,
@@ -37,7 +36,6 @@ pub fn exec(st: &mut ShapeState, call: &OpCall, args: &[Arg]) -> Result<(), RtEr
             }
             edit(st, |m| tags::delete_tags(m, query.as_ref(), target));
         }
-        _ => unreachable!("not a tag operation"),
     }
     Ok(())
 }

@@ -46,7 +46,7 @@ use cga_syntax::FileId;
 use cga_value::Value;
 
 use super::transform::selector;
-use super::Op;
+use super::TextureOp;
 use crate::assets::Assets;
 use crate::derive::{Arg, Interp, MaterialEdit, RtError, ShapeState, SizeKind};
 use crate::expr::OpCall;
@@ -56,13 +56,14 @@ use crate::shape::{Frame, Projection, Shape};
 pub fn exec(
     cx: &mut Interp,
     st: &mut ShapeState,
+    op: TextureOp,
     call: &OpCall,
     args: &[Arg],
 ) -> Result<(), RtError> {
     let shape = &mut st.shape;
-    match call.op {
-        Op::SetupProjection => setup_projection(cx, shape, call, args),
-        Op::ProjectUV => {
+    match op {
+        TextureOp::SetupProjection => setup_projection(cx, shape, call, args),
+        TextureOp::ProjectUV => {
             let set = uv_set(&args[0])?;
             match shape.projections.as_ref().and_then(|p| p[set]) {
                 Some(p) => project_uv(shape, set, &p),
@@ -72,19 +73,19 @@ pub fn exec(
             }
             Ok(())
         }
-        Op::TranslateUV => {
+        TextureOp::TranslateUV => {
             let set = uv_set(&args[0])?;
             let d = DVec2::new(args[1].num()?, args[2].num()?);
             edit_uvs(shape, set, |_, uvs| uvs.iter_mut().for_each(|t| *t += d));
             Ok(())
         }
-        Op::ScaleUV => {
+        TextureOp::ScaleUV => {
             let set = uv_set(&args[0])?;
             let f = DVec2::new(args[1].num()?, args[2].num()?);
             edit_uvs(shape, set, |_, uvs| uvs.iter_mut().for_each(|t| *t *= f));
             Ok(())
         }
-        Op::RotateUV => {
+        TextureOp::RotateUV => {
             let set = uv_set(&args[0])?;
             // Counter-clockwise about (0, 0), in degrees.
             let (s, c) = args[1].num()?.to_radians().sin_cos();
@@ -95,7 +96,7 @@ pub fn exec(
             });
             Ok(())
         }
-        Op::NormalizeUV => {
+        TextureOp::NormalizeUV => {
             let set = uv_set(&args[0])?;
             let mode = selector(&args[1], &["uv", "uvUniform", "u", "v"])?;
             let per_face = selector(&args[2], &["separatePerFace", "collectiveAllFaces"])?
@@ -111,15 +112,15 @@ pub fn exec(
             });
             Ok(())
         }
-        Op::TileUV => tile_uv(cx, shape, call, args),
-        Op::DeleteUV => {
+        TextureOp::TileUV => tile_uv(cx, shape, call, args),
+        TextureOp::DeleteUV => {
             let set = uv_set(&args[0])?;
             if shape.geometry.raw().0.uvs[set].is_some() {
                 shape.geometry.local_mut().uvs[set] = None;
             }
             Ok(())
         }
-        Op::CopyUV => {
+        TextureOp::CopyUV => {
             let from = uv_set(&args[0])?;
             let to = uv_set(&args[1])?;
             let mesh = shape.geometry.raw().0;
@@ -129,9 +130,8 @@ pub fn exec(
             }
             Ok(())
         }
-        Op::Texture => texture(cx, shape, call, &args[0]),
-        Op::InsertAlongUV => insert_along(cx, shape, call, args),
-        _ => unreachable!("not a texturing operation"),
+        TextureOp::Texture => texture(cx, shape, call, &args[0]),
+        TextureOp::InsertAlongUV => insert_along(cx, shape, call, args),
     }
 }
 

@@ -3,24 +3,23 @@
 
 use cga_geometry::{DMat3, DVec3};
 
-use super::Op;
+use super::TransformOp;
 use crate::derive::{Arg, Interp, RtError, ShapeState};
-use crate::expr::OpCall;
 use crate::shape::{euler_to_mat, mat_to_euler, Shape};
 
 pub fn exec(
     cx: &mut Interp,
     st: &mut ShapeState,
-    call: &OpCall,
+    op: TransformOp,
     args: &[Arg],
 ) -> Result<(), RtError> {
     let shape = &mut st.shape;
-    match call.op {
-        Op::T => {
+    match op {
+        TransformOp::T => {
             let v = vec3(args, shape.scope.size)?;
             shape.scope.frame.origin += shape.scope.frame.axes * v;
         }
-        Op::Translate => {
+        TransformOp::Translate => {
             let mode = selector(&args[0], &["abs", "rel"])?;
             let system = selector(&args[1], &["scope", "pivot", "object", "world"])?;
             let v = vec3(&args[2..], shape.scope.size)?;
@@ -33,11 +32,11 @@ pub fn exec(
                 _ => f.origin = v,
             }
         }
-        Op::S => {
+        TransformOp::S => {
             let size = vec3(args, shape.scope.size)?;
             shape.resize(size);
         }
-        Op::R => {
+        TransformOp::R => {
             let (center, angles) = match args.len() {
                 4 => (
                     selector(&args[0], &["scopeOrigin", "scopeCenter"])?,
@@ -53,7 +52,7 @@ pub fn exec(
             rotate_about(shape, delta, center == "scopeCenter");
             shape.scope.rot = rot;
         }
-        Op::Rotate => {
+        TransformOp::Rotate => {
             let mode = selector(&args[0], &["abs", "rel"])?;
             let system = selector(&args[1], &["scope", "pivot", "object", "world"])?;
             let angles = vec3(&args[2..], DVec3::ONE)?;
@@ -82,7 +81,7 @@ pub fn exec(
                 shape.scope.set_axes(&pivot_axes, axes);
             }
         }
-        Op::Center => {
+        TransformOp::Center => {
             let which = selector(&args[0], &["x", "y", "z", "xy", "xz", "yz", "xyz"])?;
             let parent = shape.parent_scope.center();
             let own = shape.scope.center();
@@ -99,7 +98,6 @@ pub fn exec(
             }
             shape.scope.frame.origin += axes * d;
         }
-        _ => unreachable!("not a transformation"),
     }
     Ok(())
 }

@@ -1,0 +1,198 @@
+//! Where rules run, the model must be CityEngine's: small rule files of our
+//! own whose answers were measured with CityEngine's runtime (issue 15,
+//! "Fidelity on real packages", and issue 22) or read from the reference
+//! pages.
+
+mod ops_common;
+
+use cga_geometry::{measure, DVec3};
+use ops_common::*;
+
+// ----- extrude by (nearly) nothing -----
+
+/// CityEngine leaves the face as it is for |d| below about 1.8e-3
+/// (absolute): one face, its 4 vertices, normal up, area 600 on
+/// `rect:20,30`.
+#[test]
+fn extrude_by_nearly_nothing_keeps_the_face() {
+    for d in ["0", "0.001", "-0.001", "0.0017"] {
+        let g = gen(&format!(
+            "Lot --> extrude({d}) print(geometry.nFaces) print(geometry.nVertices) X\n"
+        ))
+        .ok();
+        assert_eq!(g.prints(), ["1", "4"], "extrude({d})");
+        assert_eq!(g.meshes().len(), 1);
+        let m = &g.meshes()[0];
+        assert_eq!(m.faces.len(), 1);
+        assert_near(measure::mesh_area(m), 600.0, 1e-9);
+        assert_vec_near(measure::face_normal(m, 0), [0.0, 1.0, 0.0], 1e-12);
+    }
+    // The threshold is absolute: on a 2 x 3 lot as on a 200 x 300 one.
+    for (w, d) in [(2.0, 3.0), (200.0, 300.0)] {
+        let g = gen_with("Lot --> extrude(0.0015) X\n", &Opts::rect(w, d)).ok();
+        assert_eq!(g.meshes()[0].faces.len(), 1);
+        assert_near(g.area(), w * d, 1e-6);
+    }
+    // Above it: a box of six faces.
+    let g = gen("Lot --> extrude(0.002) print(geometry.nFaces) X\n").ok();
+    assert_eq!(g.prints(), ["6"]);
+    assert_near(g.area(), 1200.0 + 0.002 * 100.0, 1e-9);
+}
+
+// ----- roof overhangs -----
+
+/// `roofGable(30, 0, -2)` on `rect:20,30`: the gable ends are pulled in by
+/// 2 (measured horizontally); roof planes from z = -28 to -2, area 600.444.
+#[test]
+fn negative_gable_overhang_pulls_the_gable_ends_in() {
+    let g = gen("Lot --> roofGable(30, 0, -2) comp(f){ top : X. | all : NIL }\n").ok();
+    assert_near(g.area(), 600.444, 1e-3);
+    let (lo, hi) = g.bounds();
+    assert_near(lo.z, -28.0, 1e-9);
+    assert_near(hi.z, -2.0, 1e-9);
+    assert_near(lo.x, 0.0, 1e-9);
+    assert_near(hi.x, 20.0, 1e-9);
+    // The exact figure: two planes 26 long, 10 / cos 30 wide.
+    let exact = 2.0 * 26.0 * 10.0 / 30f64.to_radians().cos();
+    assert_near(g.area(), exact, 1e-9);
+}
+
+/// A negative `overhangX` pulls the eaves in along the roof planes (they
+/// stay in their planes, so they rise); a negative hip overhang likewise.
+#[test]
+fn negative_eave_and_hip_overhangs_pull_the_roof_in() {
+    let g = gen("Lot --> roofGable(30, -1, 0) comp(f){ top : X. | all : NIL }\n").ok();
+    let (lo, hi) = g.bounds();
+    let c = 30f64.to_radians().cos();
+    assert_near(lo.x, c, 1e-9);
+    assert_near(hi.x, 20.0 - c, 1e-9);
+    assert_near(lo.y, 30f64.to_radians().sin(), 1e-9);
+    assert_near(g.area(), 2.0 * 30.0 * (10.0 / c - 1.0), 1e-9);
+
+    let g = gen("Lot --> roofHip(45, -1) comp(f){ top : X. | all : NIL }\n").ok();
+    let (lo, hi) = g.bounds();
+    let c = 45f64.to_radians().cos();
+    assert_near(lo.x, c, 1e-9);
+    assert_near(hi.x, 20.0 - c, 1e-9);
+    assert_near(hi.z, -c, 1e-9);
+    assert_near(lo.z, -30.0 + c, 1e-9);
+    // The planes cover the inner 18.586 x 28.586 rectangle, at 45 degrees.
+    let inner = (20.0 - 2.0 * c) * (30.0 - 2.0 * c);
+    assert_near(g.area(), inner / c, 1e-6);
+
+    // Pulled in past the roof itself: no roof planes, a warning.
+    let g = gen("Lot --> roofHip(45, -20) comp(f){ top : X. | all : NIL }\n").ok();
+    assert_eq!(g.meshes().len(), 0);
+    assert!(
+        g.warnings().iter().any(|w| w.contains("roofHip")),
+        "{:?}",
+        g.warnings()
+    );
+}
+
+// ----- innerRectangle(edge) keeps the face's edge order -----
+
+/// The direction of the first edge of the first face of a leaf.
+fn first_edge(g: &Gen) -> DVec3 {
+    let m = &g.meshes()[0];
+    let pts: Vec<DVec3> = m.loop_points(m.outer_loop(0)).collect();
+    (pts[1] - pts[0]).normalize()
+}
+
+#[test]
+fn inner_rectangle_edge_keeps_the_first_edge_direction() {
+    let rule = "Lot --> innerRectangle(edge){ shape : X. | remainder : NIL }\n";
+    // A rectangle in each of its 4 vertex rotations: the rectangle's first
+    // edge runs like the lot's.
+    let corners = [(0.0, 0.0), (20.0, 0.0), (20.0, -30.0), (0.0, -30.0)];
+    for k in 0..4 {
+        let p: Vec<(f64, f64)> = (0..4).map(|i| corners[(i + k) % 4]).collect();
+        let lot = pts(&p);
+        let g = gen_with(rule, &Opts::polygon(&lot)).ok();
+        let want = (lot[1] - lot[0]).normalize();
+        assert_vec_near(first_edge(&g), want.to_array(), 1e-9);
+        assert_near(g.area(), 600.0, 1e-6);
+    }
+    // A square, and a trapezoid whose long first edge is the street.
+    let square = pts(&[(0.0, 0.0), (0.0, -10.0), (-10.0, -10.0), (-10.0, 0.0)]);
+    let g = gen_with(rule, &Opts::polygon(&square)).ok();
+    assert_vec_near(first_edge(&g), [0.0, 0.0, -1.0], 1e-9);
+    let trapezoid = pts(&[(0.0, 0.0), (30.0, 0.0), (20.0, -10.0), (10.0, -10.0)]);
+    let g = gen_with(rule, &Opts::polygon(&trapezoid)).ok();
+    assert_vec_near(first_edge(&g), [1.0, 0.0, 0.0], 1e-9);
+    // The L: its first edge is the 12 long front.
+    let g = gen_with(rule, &Opts::polygon(&l_lot())).ok();
+    assert_vec_near(first_edge(&g), [1.0, 0.0, 0.0], 1e-9);
+    // So a following alignScopeToGeometry(yUp, 0, world.lowest) and t move
+    // along the lot's first edge.
+    let lot = pts(&[(20.0, -30.0), (0.0, -30.0), (0.0, 0.0), (20.0, 0.0)]);
+    let g = gen_with(
+        "Lot --> innerRectangle(edge){ shape : alignScopeToGeometry(yUp, 0, world.lowest) t(1, 0, 0) X. | remainder : NIL }\n",
+        &Opts::polygon(&lot),
+    )
+    .ok();
+    let (lo, hi) = g.bounds();
+    assert_vec_near(lo, [-1.0, 0.0, -30.0], 1e-9);
+    assert_vec_near(hi, [19.0, 0.0, 0.0], 1e-9);
+}
+
+// ----- primitives into a zero-size scope -----
+
+/// A primitive into a point scope keeps the asset's position, as `i()`
+/// does: the unit quad is centred on the point. CityEngine puts the cube
+/// centred on the lot's centre, x from 8.586 to 11.414 on `rect:20,30`.
+#[test]
+fn primitive_into_a_point_scope_is_centred_on_it() {
+    let g = gen(
+        "Lot --> alignScopeToAxes() s(0,0,0) center(xz) rotateScope(0,45,0) primitiveQuad() M\n\
+         M --> s(2,1,2) center(xz) primitiveCube()\n",
+    )
+    .ok();
+    let (lo, hi) = g.bounds();
+    let h = 2f64.sqrt();
+    assert_near(lo.x, 10.0 - h, 1e-9);
+    assert_near(hi.x, 10.0 + h, 1e-9);
+    assert_near(lo.z, -15.0 - h, 1e-9);
+    assert_near(hi.z, -15.0 + h, 1e-9);
+    assert_near(lo.x, 8.586, 5e-4);
+    assert_near(hi.x, 11.414, 5e-4);
+    // The quad itself: a unit square centred on the lot's centre.
+    let g = gen("Lot --> alignScopeToAxes() s(0,0,0) center(xz) primitiveQuad() X\n").ok();
+    let (lo, hi) = g.bounds();
+    assert_vec_near(lo, [9.5, 0.0, -15.5], 1e-9);
+    assert_vec_near(hi, [10.5, 0.0, -14.5], 1e-9);
+    // A scope with sizes keeps the fit: the cube fills it.
+    let g = gen("Lot --> s(4, 2, 6) primitiveCube() X\n").ok();
+    let (lo, hi) = g.bounds();
+    assert_vec_near(lo, [0.0, 0.0, -30.0], 1e-9);
+    assert_vec_near(hi, [4.0, 2.0, -24.0], 1e-9);
+}
+
+// ----- ring primitives: vertices half a step off the axes -----
+
+/// `primitiveCylinder(8)`: vertices at 22.5 + k 45 degrees, the flat sides
+/// touching the scope: the ring fills it.
+#[test]
+fn cylinder_disk_and_cone_rings_fill_the_scope() {
+    let g = gen("Lot --> s(10, 4, 10) primitiveCylinder(8) X\n").ok();
+    let (lo, hi) = g.bounds();
+    assert_vec_near(lo, [0.0, 0.0, -30.0], 1e-9);
+    assert_vec_near(hi, [10.0, 4.0, -20.0], 1e-9);
+    // An octagon of apothem 5: area 200 tan(22.5), volume that times 4.
+    let octagon = 8.0 * 25.0 * (std::f64::consts::PI / 8.0).tan();
+    assert_near(g.volume(), 4.0 * octagon, 1e-9);
+    // Every vertex of the ring is 22.5 degrees off an axis.
+    let m = &g.meshes()[0];
+    for p in &m.positions {
+        let (x, z) = (p.x - 5.0, p.z + 25.0);
+        let a = z.atan2(x).to_degrees().rem_euclid(45.0);
+        assert_near(a, 22.5, 1e-9);
+    }
+    let g = gen("Lot --> s(10, 0, 10) primitiveDisk(8) X\n").ok();
+    assert_near(g.area(), octagon, 1e-9);
+    let g = gen("Lot --> s(10, 3, 10) primitiveCone(8) X\n").ok();
+    assert_near(g.volume(), octagon * 3.0 / 3.0, 1e-9);
+    let (lo, hi) = g.bounds();
+    assert_vec_near(lo, [0.0, 0.0, -30.0], 1e-9);
+    assert_vec_near(hi, [10.0, 3.0, -20.0], 1e-9);
+}

@@ -196,3 +196,124 @@ fn cylinder_disk_and_cone_rings_fill_the_scope() {
     assert_vec_near(lo, [0.0, 0.0, -30.0], 1e-9);
     assert_vec_near(hi, [10.0, 3.0, -20.0], 1e-9);
 }
+
+// ----- shapeL / shapeU / shapeO component tags -----
+
+/// The edge lengths of a shape by setback tag, each list sorted, and its
+/// `geometry.tags`.
+fn luo_tags(op: &str, part: &str) -> (Vec<Vec<f64>>, String) {
+    let other = if part == "shape" {
+        "remainder"
+    } else {
+        "shape"
+    };
+    let g = gen(&format!(
+        "Lot --> {op} {{ {part} : print(geometry.tags) T | {other} : NIL }}\n\
+         T --> comp(e) {{ isTagged(\"setback.front\") : E(\"front\") | isTagged(\"setback.back\") : E(\"back\") \
+         | isTagged(\"setback.side\") : E(\"side\") | isTagged(\"setback.remainder\") : E(\"remainder\") | all : E(\"none\") }}\n\
+         E(n) --> print(n + \" \" + scope.sx) NIL\n"
+    ))
+    .ok();
+    let p = g.prints();
+    let mut out = vec![Vec::new(); 5];
+    for line in &p[1..] {
+        let (name, len) = line.split_once(' ').unwrap();
+        let k = ["front", "back", "side", "remainder", "none"]
+            .iter()
+            .position(|n| *n == name)
+            .unwrap();
+        out[k].push(len.parse::<f64>().unwrap());
+    }
+    for v in &mut out {
+        v.sort_by(f64::total_cmp);
+    }
+    (out, p[0].clone())
+}
+
+/// op_shapeLUO: the operations tag "exactly like the setback operation";
+/// its figure: original edges in the shape `setback.front` (blue), new
+/// setback edges `setback.back` (green), side edges `setback.side`
+/// (yellow), original edges in the remainder `setback.remainder` (purple).
+#[test]
+fn shape_luo_tag_their_edges_like_setback() {
+    let e = Vec::<f64>::new();
+    // shapeL(4, 4) on 20 x 30: wings along the front (20) and the left (30).
+    let (t, tags) = luo_tags("shapeL(4, 4)", "shape");
+    assert_eq!(
+        t,
+        [
+            vec![20.0, 30.0],
+            vec![16.0, 26.0],
+            vec![4.0, 4.0],
+            e.clone(),
+            e.clone()
+        ]
+    );
+    for name in ["setback.front", "setback.back", "setback.side"] {
+        assert!(tags.contains(name), "{tags}");
+    }
+    assert!(!tags.contains("setback.remainder"), "{tags}");
+    let (t, tags) = luo_tags("shapeL(4, 4)", "remainder");
+    assert_eq!(
+        t,
+        [
+            e.clone(),
+            vec![16.0, 26.0],
+            e.clone(),
+            vec![16.0, 26.0],
+            e.clone()
+        ]
+    );
+    assert!(
+        tags.contains("setback.remainder") && !tags.contains("setback.side"),
+        "{tags}"
+    );
+
+    // shapeU(4, 4, 4): front, right and left wings.
+    let (t, _) = luo_tags("shapeU(4, 4, 4)", "shape");
+    assert_eq!(
+        t,
+        [
+            vec![20.0, 30.0, 30.0],
+            vec![12.0, 26.0, 26.0],
+            vec![4.0, 4.0],
+            e.clone(),
+            e.clone()
+        ]
+    );
+    let (t, _) = luo_tags("shapeU(4, 4, 4)", "remainder");
+    assert_eq!(
+        t,
+        [
+            e.clone(),
+            vec![12.0, 26.0, 26.0],
+            e.clone(),
+            vec![12.0],
+            e.clone()
+        ]
+    );
+
+    // shapeO(4, 4, 4, 4): a ring, its hole the new edges; no sides.
+    let (t, _) = luo_tags("shapeO(4, 4, 4, 4)", "shape");
+    assert_eq!(
+        t,
+        [
+            vec![20.0, 20.0, 30.0, 30.0],
+            vec![12.0, 12.0, 22.0, 22.0],
+            e.clone(),
+            e.clone(),
+            e.clone()
+        ]
+    );
+    let (t, _) = luo_tags("shapeO(4, 4, 4, 4)", "remainder");
+    assert_eq!(
+        t,
+        [
+            e.clone(),
+            vec![12.0, 12.0, 22.0, 22.0],
+            e.clone(),
+            e.clone(),
+            e
+        ]
+    );
+}

@@ -69,7 +69,7 @@ pub use mesh::{Face, Loop, Mesh, UV_SETS};
 pub use obj::{load_obj, parse_obj, ObjAsset, ObjError};
 pub use roof::{roof, Roof, RoofEdgeKind, RoofFaceRole, RoofKind, RoofSlope, SourceEdge};
 pub use setback::{
-    merge_strips, offset, setback, setback_to_area, Offset, OffsetFace, SetbackEdgeTag,
+    merge_strips, offset, setback, setback_luo, setback_to_area, Offset, OffsetFace, SetbackEdgeTag,
 };
 pub use skeleton::{skeleton, straight_skeleton, Skeleton, SkeletonError, StopAt, WeightChange};
 pub use tags::{TagQuery, TagSet, TagTarget};

@@ -317,3 +317,64 @@ fn shape_luo_tag_their_edges_like_setback() {
         ]
     );
 }
+
+// ----- random attribute defaults -----
+
+/// Each `attr` and `const` with a random default draws its own numbers
+/// (CityEngine's runtime gives `attr nFloor = ceil(rand(1,15))` and
+/// `attr floorHeight = rand(4,5)` the independent draws 0.55 and 0.694 on
+/// one lot): different attributes get different values, the same on every
+/// run, whichever is read first, and other values on another lot.
+#[test]
+fn random_attribute_defaults_draw_their_own_numbers() {
+    let src = |order: &str| {
+        format!(
+            "attr height = rand(10, 30)\nattr roofAngle = rand(20, 45)\nconst hue = rand(0, 360)\n\
+             attr same = rand(10, 30)\n\
+             Lot --> {order} X\n"
+        )
+    };
+    let fwd = "print(height) print(roofAngle) print(hue) print(same)";
+    let bwd = "print(same) print(hue) print(roofAngle) print(height)";
+    let opts = Opts {
+        lots: vec![
+            cga_engine::lot::rect(20.0, 30.0),
+            cga_engine::lot::rect(20.0, 30.0),
+        ],
+        ..Opts::default()
+    };
+    let values = |g: &Gen, lot: usize| -> Vec<f64> {
+        g.lots[lot]
+            .prints
+            .iter()
+            .map(|p| p.parse::<f64>().unwrap())
+            .collect()
+    };
+    let g = gen_with(&src(fwd), &opts).ok();
+    let a = values(&g, 0);
+    let (h, r, c, s) = (a[0], a[1], a[2], a[3]);
+    assert!((10.0..30.0).contains(&h) && (20.0..45.0).contains(&r) && (0.0..360.0).contains(&c));
+    // Not one point of one stream: the draws differ ((h - 10) / 20 would
+    // equal (r - 20) / 25 and c / 360 if they shared it).
+    let u = [(h - 10.0) / 20.0, (r - 20.0) / 25.0, c / 360.0, (s - 10.0) / 20.0];
+    for i in 0..4 {
+        for j in i + 1..4 {
+            assert!((u[i] - u[j]).abs() > 1e-9, "draws {i} and {j}: {u:?}");
+        }
+    }
+    // Deterministic, and independent of the order of evaluation.
+    let again = gen_with(&src(fwd), &opts).ok();
+    assert_eq!(values(&again, 0), a);
+    let mut b = values(&gen_with(&src(bwd), &opts).ok(), 0);
+    b.reverse();
+    assert_eq!(b, a);
+    // Another lot (its own seed) draws other values; so does another seed.
+    let other = values(&g, 1);
+    assert!(other.iter().zip(&a).all(|(x, y)| x != y), "{other:?} {a:?}");
+    let seeded = values(&gen_with(&src(fwd), &opts.clone().seed(5)).ok(), 0);
+    assert!(seeded.iter().zip(&a).all(|(x, y)| x != y));
+    // A rule's own rand() is not one of the attributes' draws either.
+    let g = gen("attr height = rand(0, 1)\nLot --> print(height) print(rand(0, 1)) X\n").ok();
+    let p = g.prints();
+    assert_ne!(p[0], p[1]);
+}

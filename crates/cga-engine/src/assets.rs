@@ -129,7 +129,7 @@ impl Assets {
     }
 
     /// The geometry of the asset `path`: a built-in (`builtin:cube`, ...)
-    /// or an OBJ file, loaded once.
+    /// or an OBJ, COLLADA or glTF file, loaded once.
     pub fn mesh(&self, from: FileId, path: &str) -> Result<Arc<Mesh>, String> {
         if let Some(name) = path.strip_prefix("builtin:") {
             return builtin_geometry(name)
@@ -169,7 +169,7 @@ impl Assets {
         if let Some(r) = cache.get(&file) {
             return r.clone();
         }
-        let r = load_obj(&file).map(Arc::new);
+        let r = load_any(&file).map(Arc::new);
         cache.insert(file, r.clone());
         r
     }
@@ -196,12 +196,13 @@ fn builtin_geometry(name: &str) -> Option<Arc<Mesh>> {
         .map(|(_, m)| m.clone())
 }
 
-/// Loads an OBJ asset; its warnings (missing MTL, unknown materials) are
-/// dropped here: the asset still loads with default materials.
-fn load_obj(path: &std::path::Path) -> Result<Mesh, String> {
-    cga_geometry::load_obj(path)
-        .map(|asset| asset.mesh)
-        .map_err(|e| format!("cannot load asset {}: {e}", path.display()))
+/// Loads an asset in any format the engine reads (OBJ, COLLADA, glTF; see
+/// `cga_geometry::load_asset`); its warnings (missing MTL, unknown
+/// materials, skipped polygons) are dropped here: the asset still loads.
+/// A file that cannot be read, in a format that is not read, or without
+/// polygons is an error message: the caller warns, naming it.
+fn load_any(path: &std::path::Path) -> Result<Mesh, String> {
+    cga_geometry::load_asset(path).map(|asset| asset.mesh)
 }
 
 impl Assets {

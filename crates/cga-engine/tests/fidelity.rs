@@ -356,7 +356,12 @@ fn random_attribute_defaults_draw_their_own_numbers() {
     assert!((10.0..30.0).contains(&h) && (20.0..45.0).contains(&r) && (0.0..360.0).contains(&c));
     // Not one point of one stream: the draws differ ((h - 10) / 20 would
     // equal (r - 20) / 25 and c / 360 if they shared it).
-    let u = [(h - 10.0) / 20.0, (r - 20.0) / 25.0, c / 360.0, (s - 10.0) / 20.0];
+    let u = [
+        (h - 10.0) / 20.0,
+        (r - 20.0) / 25.0,
+        c / 360.0,
+        (s - 10.0) / 20.0,
+    ];
     for i in 0..4 {
         for j in i + 1..4 {
             assert!((u[i] - u[j]).abs() > 1e-9, "draws {i} and {j}: {u:?}");
@@ -377,4 +382,251 @@ fn random_attribute_defaults_draw_their_own_numbers() {
     let g = gen("attr height = rand(0, 1)\nLot --> print(height) print(rand(0, 1)) X\n").ok();
     let p = g.prints();
     assert_ne!(p[0], p[1]);
+}
+
+// ----- assets in every format the i() page lists -----
+
+/// A folder holding the rule file `src` and the given asset files (made
+/// here, by this test code); derives the rule on `rect:20,30`.
+fn gen_with_assets(src: &str, files: &[(&str, &[u8])]) -> Gen {
+    static N: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = N.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("cga-fidelity-{}-{n}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, bytes) in files {
+        let p = dir.join(name);
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        std::fs::write(p, bytes).unwrap();
+    }
+    let path = dir.join("rules.cga");
+    std::fs::write(&path, src).unwrap();
+    gen_file(&path, &Opts::default())
+}
+
+/// A 2 x 1 x 3 m box written in centimetres with z up, placed by its node
+/// 1 m along x: its top two triangles red, its other five faces quads of a
+/// brick texture (through an effect's sampler and surface).
+const BOX_DAE: &str = r##"<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="centimeter" meter="0.01"/><up_axis>Z_UP</up_axis></asset>
+  <library_images><image id="brick-img"><init_from>tex/brick%20wall.png</init_from></image></library_images>
+  <library_effects>
+    <effect id="red-fx"><profile_COMMON><technique sid="t"><lambert>
+      <diffuse><color>1 0 0 1</color></diffuse></lambert></technique></profile_COMMON></effect>
+    <effect id="brick-fx"><profile_COMMON>
+      <newparam sid="surf"><surface type="2D"><init_from>brick-img</init_from></surface></newparam>
+      <newparam sid="samp"><sampler2D><source>surf</source></sampler2D></newparam>
+      <technique sid="t"><phong><diffuse><texture texture="samp" texcoord="UV"/></diffuse></phong></technique>
+    </profile_COMMON></effect>
+  </library_effects>
+  <library_materials>
+    <material id="red" name="Red"><instance_effect url="#red-fx"/></material>
+    <material id="brick" name="Brick"><instance_effect url="#brick-fx"/></material>
+  </library_materials>
+  <library_geometries>
+    <geometry id="box" name="box"><mesh>
+      <source id="pos">
+        <float_array id="pos-a" count="24">0 0 0 200 0 0 200 300 0 0 300 0 0 0 100 200 0 100 200 300 100 0 300 100</float_array>
+        <technique_common><accessor source="#pos-a" count="8" stride="3"/></technique_common>
+      </source>
+      <source id="uv">
+        <float_array id="uv-a" count="8">0 0 1 0 1 1 0 1</float_array>
+        <technique_common><accessor source="#uv-a" count="4" stride="2"/></technique_common>
+      </source>
+      <vertices id="verts"><input semantic="POSITION" source="#pos"/></vertices>
+      <triangles material="top" count="2">
+        <input semantic="VERTEX" source="#verts" offset="0"/>
+        <input semantic="TEXCOORD" source="#uv" offset="1" set="0"/>
+        <p>4 0 5 1 6 2  4 0 6 2 7 3</p>
+      </triangles>
+      <polylist material="walls" count="5">
+        <input semantic="VERTEX" source="#verts" offset="0"/>
+        <vcount>4 4 4 4 4</vcount>
+        <p>0 3 2 1  0 1 5 4  1 2 6 5  2 3 7 6  3 0 4 7</p>
+      </polylist>
+    </mesh></geometry>
+  </library_geometries>
+  <library_visual_scenes><visual_scene id="scene">
+    <node id="n" name="Box"><translate>100 0 0</translate>
+      <instance_geometry url="#box"><bind_material><technique_common>
+        <instance_material symbol="top" target="#red"/>
+        <instance_material symbol="walls" target="#brick"/>
+      </technique_common></bind_material></instance_geometry>
+    </node>
+  </visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#scene"/></scene>
+</COLLADA>
+"##;
+
+#[test]
+fn collada_assets_are_inserted_with_their_scene_graph_units_and_up_axis() {
+    let g = gen_with_assets(
+        "Lot --> i(\"box.dae\", yUp, keepSizeAndPosition) print(geometry.nFaces) X\n",
+        &[("box.dae", BOX_DAE.as_bytes())],
+    )
+    .ok();
+    assert!(g.warnings().is_empty(), "{:?}", g.warnings());
+    assert_eq!(g.prints(), ["7"]);
+    // Centimetres to metres, z up to y up (the file's y becomes -z), the
+    // node's translation of 100 cm along x; placed at the lot's scope
+    // origin (0, 0, -30).
+    let (lo, hi) = g.bounds();
+    assert_vec_near(lo, [1.0, 0.0, -33.0], 1e-9);
+    assert_vec_near(hi, [3.0, 1.0, -30.0], 1e-9);
+    assert_near(g.area(), 22.0, 1e-9);
+    assert_near(g.volume(), 6.0, 1e-9);
+    let mats = g.face_materials();
+    let red = mats.iter().filter(|m| rgb255(m) == [255, 0, 0]).count();
+    assert_eq!(red, 2);
+    let bricks = mats
+        .iter()
+        .filter(|m| m.colormap().ends_with("tex/brick wall.png"))
+        .count();
+    assert_eq!(bricks, 5);
+    // Fitted into a scope like any asset.
+    let g = gen_with_assets(
+        "Lot --> s(4, 2, 6) i(\"box.dae\") X\n",
+        &[("box.dae", BOX_DAE.as_bytes())],
+    )
+    .ok();
+    let (lo, hi) = g.bounds();
+    assert_vec_near(lo, [0.0, 0.0, -30.0], 1e-9);
+    assert_vec_near(hi, [4.0, 2.0, -24.0], 1e-9);
+    assert_near(g.volume(), 48.0, 1e-9);
+}
+
+/// A glTF quad: two triangles in a base64 buffer, placed by a node's
+/// translation (1, 2, 3) and scale 2, with a grey material whose linear
+/// factor is 0.5^2.2 (CGA colour 0.5).
+fn quad_gltf(uri: &str, buffer_len: usize) -> String {
+    format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
+ "nodes":[{{"name":"Quad","mesh":0,"translation":[1,2,3],"scale":[2,2,2]}}],
+ "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0,"TEXCOORD_0":1}},"indices":2,"material":0}}]}}],
+ "materials":[{{"name":"Grey","pbrMetallicRoughness":{{"baseColorFactor":[0.21763764,0.21763764,0.21763764,1]}}}}],
+ "buffers":[{{"byteLength":{buffer_len}{uri}}}],
+ "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":48}},{{"buffer":0,"byteOffset":48,"byteLength":32}},{{"buffer":0,"byteOffset":80,"byteLength":12}}],
+ "accessors":[{{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,-1],"max":[1,0,0]}},
+  {{"bufferView":1,"componentType":5126,"count":4,"type":"VEC2"}},
+  {{"bufferView":2,"componentType":5123,"count":6,"type":"SCALAR"}}]}}"#
+    )
+}
+
+/// The binary buffer of [`quad_gltf`]: positions, texture coordinates,
+/// 16-bit indices.
+fn quad_buffer() -> Vec<u8> {
+    let mut b = Vec::new();
+    for v in [
+        0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, -1.0, 0.0, 0.0, -1.0,
+    ] {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    for v in [0.0f32, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0] {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    for i in [0u16, 1, 2, 0, 2, 3] {
+        b.extend_from_slice(&i.to_le_bytes());
+    }
+    b
+}
+
+/// A GLB container of `json` and `bin` (both padded to 4 bytes).
+fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
+    let mut j = json.as_bytes().to_vec();
+    while !j.len().is_multiple_of(4) {
+        j.push(b' ');
+    }
+    let mut b = bin.to_vec();
+    while !b.len().is_multiple_of(4) {
+        b.push(0);
+    }
+    let total = 12 + 8 + j.len() + 8 + b.len();
+    let mut out = Vec::new();
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(j.len() as u32).to_le_bytes());
+    out.extend_from_slice(&0x4E4F_534Au32.to_le_bytes());
+    out.extend_from_slice(&j);
+    out.extend_from_slice(&(b.len() as u32).to_le_bytes());
+    out.extend_from_slice(&0x004E_4942u32.to_le_bytes());
+    out.extend_from_slice(&b);
+    out
+}
+
+#[test]
+fn gltf_and_glb_assets_are_inserted_with_their_node_transforms() {
+    use base64::Engine as _;
+    let bin = quad_buffer();
+    let data = base64::engine::general_purpose::STANDARD.encode(&bin);
+    let embedded = quad_gltf(
+        &format!(r#","uri":"data:application/octet-stream;base64,{data}""#),
+        bin.len(),
+    );
+    let external = quad_gltf(r#","uri":"quad%20data.bin""#, bin.len());
+    let binary = glb(&quad_gltf("", bin.len()), &bin);
+    type Files<'a> = Vec<(&'a str, &'a [u8])>;
+    let cases: [(&str, Files); 3] = [
+        ("quad.gltf", vec![("quad.gltf", embedded.as_bytes())]),
+        (
+            "quad.gltf",
+            vec![("quad.gltf", external.as_bytes()), ("quad data.bin", &bin)],
+        ),
+        ("quad.glb", vec![("quad.glb", &binary)]),
+    ];
+    for (name, files) in cases {
+        let g = gen_with_assets(
+            &format!("Lot --> i(\"{name}\", yUp, keepSizeAndPosition) print(geometry.nFaces) X\n"),
+            &files,
+        )
+        .ok();
+        assert!(g.warnings().is_empty(), "{name}: {:?}", g.warnings());
+        assert_eq!(g.prints(), ["2"], "{name}");
+        // At the lot's scope origin (0, 0, -30).
+        let (lo, hi) = g.bounds();
+        assert_vec_near(lo, [1.0, 2.0, -29.0], 1e-6);
+        assert_vec_near(hi, [3.0, 2.0, -27.0], 1e-6);
+        assert_near(g.area(), 4.0, 1e-9);
+        let m = &g.meshes()[0];
+        assert_vec_near(measure::face_normal(m, 0), [0.0, 1.0, 0.0], 1e-9);
+        let mat = g.face_materials()[0].clone();
+        assert_eq!(&*mat.name, "Grey");
+        for c in mat.color {
+            assert_near(c, 0.5, 1e-6);
+        }
+        // glTF's texture origin is the top left, CGA's the bottom left.
+        let uv = m.uvs[0].as_ref().expect("texture coordinates");
+        assert_near(uv[0].y, 0.0, 1e-9);
+        assert_near(uv[1].x, 1.0, 1e-9);
+        assert_near(uv[1].y, 0.0, 1e-9);
+    }
+}
+
+/// An asset that cannot be read is always a warning naming it; the shape
+/// keeps its geometry and the model goes on.
+#[test]
+fn unreadable_assets_are_warnings_naming_them() {
+    let cases: [(&str, &[u8], &str); 5] = [
+        ("model.fbx", b"Kaydara FBX Binary  \0", "FBX"),
+        ("model.usdz", b"PK", "USD"),
+        ("broken.dae", b"<COLLADA><library_geometries>", "broken.dae"),
+        (
+            "empty.dae",
+            b"<COLLADA version=\"1.4.1\"><asset><up_axis>Y_UP</up_axis></asset></COLLADA>",
+            "no polygons",
+        ),
+        ("model.xyz", b"1 2 3", "unknown asset format"),
+    ];
+    for (name, bytes, what) in cases {
+        let g = gen_with_assets(
+            &format!("Lot --> i(\"{name}\") print(geometry.area) X\n"),
+            &[(name, bytes)],
+        )
+        .ok();
+        let w = g.warnings();
+        assert_eq!(w.len(), 1, "{name}: {w:?}");
+        assert!(w[0].contains(name) && w[0].contains(what), "{name}: {w:?}");
+        assert_eq!(g.prints(), ["600"], "{name}");
+    }
 }

@@ -630,3 +630,44 @@ fn unreadable_assets_are_warnings_naming_them() {
         assert_eq!(g.prints(), ["600"], "{name}");
     }
 }
+
+// ----- trim planes -----
+
+/// Trim planes are classified when they are applied, against the xz-plane
+/// of the pivot then in force. CityEngine keeps the cube beside the top
+/// face whole (area 28): `alignScopeToAxes(y)` levels the pivot, so all
+/// four edges of the flat top face are horizontal (off by default).
+#[test]
+fn trim_planes_are_classified_against_the_pivot_when_applied() {
+    let rule = |t_ops: &str, settings: &str| {
+        format!(
+            "Lot --> s(4,0,2) center(xz) extrude(3) comp(f){{ top : T | all : NIL }}\n\
+             T --> {settings} extrude(1) {t_ops} t(4,0,0) primitiveCube()\n"
+        )
+    };
+    let g = gen(&rule("alignScopeToAxes(y)", "")).ok();
+    assert_near(g.area(), 28.0, 1e-9);
+    let (lo, hi) = g.bounds();
+    assert_vec_near(lo, [12.0, 3.0, -16.0], 1e-9);
+    assert_vec_near(hi, [16.0, 4.0, -14.0], 1e-9);
+    // With horizontal planes on, the plane bisecting the top face and its
+    // side at x = 12 keeps the wedge x - 12 <= y - 3 (an open cut): two
+    // triangles of 0.5, the top 1 x 2 and the side 1 x 2.
+    let g = gen(&rule("alignScopeToAxes(y)", "set(trim.horizontal, true)")).ok();
+    assert_near(g.area(), 5.0, 1e-9);
+    // Without the alignment the pivot is the top face's (its y-axis level,
+    // across the first edge): the edges at x = 8 and x = 12 run along it
+    // and are vertical, so the same wedge is all that is left.
+    let g = gen(&rule("", "")).ok();
+    assert_near(g.area(), 5.0, 1e-9);
+    // Switched off, nothing is cut.
+    let g = gen(&rule("", "set(trim.vertical, false)")).ok();
+    assert_near(g.area(), 28.0, 1e-9);
+    // trim() after the alignment applies nothing either.
+    let g = gen(
+        "Lot --> s(4,0,2) center(xz) extrude(3) comp(f){ top : T | all : NIL }\n\
+         T --> extrude(1) alignScopeToAxes(y) t(4,0,0) trim() X\n",
+    )
+    .ok();
+    assert_near(g.area(), 28.0, 1e-9);
+}

@@ -4,10 +4,9 @@
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let text = String::from_utf8_lossy(data).into_owned();
-    let mut sources = cga_syntax::SourceMap::new();
-    let loaded = cga_engine::load_text(std::path::Path::new("fuzz.cga"), text, &mut sources);
-    for d in &loaded.diagnostics {
-        let _ = d.render(&sources);
-    }
+    let text = cga::decode_text(data);
+    // In memory, over nothing: imports find no files, whatever they name.
+    let rules = cga::Engine::new(cga::MemoryWorld::new()).load_text("/fuzz/fuzz.cga", text);
+    let _ = rules.render_diagnostics();
+    let _ = rules.attributes();
 });

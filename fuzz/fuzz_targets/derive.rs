@@ -5,16 +5,15 @@
 
 use libfuzzer_sys::fuzz_target;
 
-use cga_engine::{generate_lot, lot, GenerateOptions, Limits};
+use cga::{Limits, Options};
 
 fuzz_target!(|data: &[u8]| {
-    let text = String::from_utf8_lossy(data).into_owned();
-    let mut sources = cga_syntax::SourceMap::new();
-    let loaded = cga_engine::load_text(std::path::Path::new("fuzz.cga"), text, &mut sources);
-    let Some(program) = loaded.program else { return };
-    let Ok(rule) = program.start_rule(None) else { return };
-    let assets = cga_engine::assets::Assets::new(&sources);
-    let options = GenerateOptions {
+    let text = cga::decode_text(data);
+    let rules = cga::Engine::new(cga::MemoryWorld::new()).load_text("/fuzz/fuzz.cga", text);
+    if rules.has_errors() || rules.start_rule(None).is_err() {
+        return;
+    }
+    let options = Options {
         limits: Limits {
             max_depth: 64,
             max_shapes: 1000,
@@ -25,14 +24,15 @@ fuzz_target!(|data: &[u8]| {
             max_seconds: 0.05,
             max_faces: 500,
         },
-        ..GenerateOptions::default()
+        jobs: Some(1),
+        ..Options::default()
     };
     // One lot per input (a building-sized one or a sliver, picked by the
     // input's length) keeps the executions per second high.
-    let l = if data.len() % 2 == 0 {
-        lot::rect(20.0, 30.0)
+    let lot = if data.len() % 2 == 0 {
+        cga::lots::rect(20.0, 30.0)
     } else {
-        lot::rect(0.5, 7.0)
+        cga::lots::rect(0.5, 7.0)
     };
-    let _ = generate_lot(&program, &assets, rule, &l, 0, &options);
+    let _ = rules.generate(&lot, &options);
 });

@@ -4,7 +4,7 @@
 
 use std::collections::BTreeMap;
 
-use cga_value::Value;
+use cga::Value;
 
 #[derive(Default)]
 pub struct Reports {

@@ -823,3 +823,63 @@ fn assets_over_the_size_limit_are_a_warning() {
     let out = run(&["generate", rules.to_str().unwrap()]);
     assert_eq!(stdout(&out), "300\n");
 }
+
+/// A rule package as CityEngine shares them (here a zip archive): `cga
+/// generate` and `cga check` take it directly; its assets resolve inside it.
+#[test]
+fn rule_packages_are_read_directly() {
+    let dir = temp_dir("rpk");
+    let mut out = std::io::Cursor::new(Vec::new());
+    {
+        let mut w = zip::ZipWriter::new(&mut out);
+        let files: [(&str, &str); 3] = [
+            (
+                "rules/tower.cga",
+                "attr floors = 3\n@StartRule\nTower --> extrude(floors * 3) print(scope.sy) i(\"block.obj\") X.\n",
+            ),
+            (
+                "assets/block.obj",
+                "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n",
+            ),
+            ("bin/tower.cgb", "compiled"),
+        ];
+        for (name, text) in files {
+            w.start_file(name, zip::write::SimpleFileOptions::default())
+                .unwrap();
+            std::io::Write::write_all(&mut w, text.as_bytes()).unwrap();
+        }
+        w.finish().unwrap();
+    }
+    let package = dir.join("tower.rpk");
+    std::fs::write(&package, out.into_inner()).unwrap();
+    let pkg = package.to_str().unwrap();
+    let check = run(&["check", pkg]);
+    assert_eq!(check.status.code(), Some(0), "{}", stderr(&check));
+    assert!(stderr(&check).contains("ok (1 rules, 1 attributes, 0 functions)"));
+    let glb = dir.join("tower.glb");
+    let o = run(&[
+        "generate",
+        pkg,
+        "--attr",
+        "floors=4",
+        "-o",
+        glb.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(stdout(&o), "12\n");
+    assert!(
+        stderr(&o).contains("1 lots, 2 shapes, 1 leaf shapes, 1 faces, 2 triangles"),
+        "{}",
+        stderr(&o)
+    );
+    // A file that is not an archive is a rule error naming it.
+    let bad = dir.join("bad.rpk");
+    std::fs::write(&bad, "Lot --> X.").unwrap();
+    let o = run(&["check", bad.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("neither a 7z nor a zip archive"),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -28,10 +28,10 @@ fn bench(c: &mut Criterion) {
     let path = dir.join("facade.cga");
     std::fs::write(&path, RULES).unwrap();
     let mut sources = SourceMap::new();
-    let program = cga_engine::load(&path, &mut sources)
-        .program
+    let program = cga_engine::load(&cga_world::DiskWorld, &path, &mut sources)
+        .usable()
         .expect("the facade grammar loads");
-    let assets = Assets::new(&sources);
+    let assets = Assets::on_disk(&sources);
     let rule = program.start_rule(None).unwrap();
     let lot = lot::rect(20.0, 30.0);
     let options = GenerateOptions::default();

@@ -7,45 +7,204 @@
 //! all shapes and all lots.
 
 use std::collections::HashMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
 use cga_geometry::topology::FxHashMap;
 use cga_geometry::Mesh;
 use cga_syntax::{FileId, SourceMap};
+use cga_world::World;
 
 use crate::resolve::find_relative;
 
 /// Default largest asset file read, in MiB (`--max-asset-mib`).
 pub const DEFAULT_MAX_ASSET_MIB: u64 = 512;
 
-pub struct Assets {
-    /// The rule file of each source file id.
-    files: Vec<PathBuf>,
+/// What is read from files, kept across programs: a reloaded rule file
+/// (an editor's save, a preview's regeneration) finds the meshes, texts,
+/// image facts it read before, as long as the files did not change (their
+/// size and modification time are compared on each new program's first
+/// request). Shared by every thread deriving lots.
+pub struct AssetStore {
+    world: Arc<dyn World>,
     /// Larger asset files are not read: a warning, the model goes on.
     max_file_bytes: u64,
-    meshes: Mutex<HashMap<PathBuf, Result<Arc<Mesh>, String>>>,
-    texts: Mutex<HashMap<PathBuf, Option<Arc<str>>>>,
+    meshes: ByFile<Result<Arc<Mesh>, String>>,
+    texts: ByFile<Option<Arc<str>>>,
+    /// Whether a texture file has an alpha channel, by file: reading the
+    /// image's header once for all lots.
+    alpha: Mutex<FxHashMap<Arc<str>, Stamped<bool>>>,
+    /// Image sizes (width, height) by file.
+    image_sizes: ByFile<Option<(u32, u32)>>,
+}
+
+/// Values read from files, by file.
+type ByFile<T> = Mutex<HashMap<PathBuf, Stamped<T>>>;
+
+/// A value read from a file, with the file's size and modification time
+/// when it was read.
+#[derive(Clone)]
+struct Stamped<T> {
+    stamp: Option<(u64, Option<std::time::SystemTime>)>,
+    value: T,
+}
+
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+impl AssetStore {
+    /// A store reading from `world`.
+    pub fn new(world: Arc<dyn World>) -> AssetStore {
+        AssetStore {
+            world,
+            max_file_bytes: DEFAULT_MAX_ASSET_MIB << 20,
+            meshes: Default::default(),
+            texts: Default::default(),
+            alpha: Default::default(),
+            image_sizes: Default::default(),
+        }
+    }
+
+    /// Sets the largest asset file that is read, in MiB.
+    pub fn with_max_file_mib(mut self, mib: u64) -> AssetStore {
+        self.max_file_bytes = mib.saturating_mul(1 << 20);
+        self
+    }
+
+    /// The largest asset file that is read, in MiB.
+    pub fn max_file_mib(&self) -> u64 {
+        self.max_file_bytes >> 20
+    }
+
+    /// The world files are read from.
+    pub fn world(&self) -> &Arc<dyn World> {
+        &self.world
+    }
+
+    fn stamp(&self, file: &Path) -> Option<(u64, Option<std::time::SystemTime>)> {
+        self.world.metadata(file).map(|m| (m.len, m.modified))
+    }
+
+    /// The cached value for `file` if the file did not change since it was
+    /// read, else a new one from `make` (not made under the lock: reading
+    /// may take a while).
+    fn cached<K, T: Clone>(
+        &self,
+        cache: &Mutex<HashMap<K, Stamped<T>>>,
+        key: &K,
+        file: &Path,
+        make: impl FnOnce() -> T,
+    ) -> T
+    where
+        K: std::hash::Hash + Eq + Clone,
+    {
+        let stamp = self.stamp(file);
+        if let Some(s) = lock(cache).get(key) {
+            if s.stamp == stamp {
+                return s.value.clone();
+            }
+        }
+        let value = make();
+        lock(cache).insert(
+            key.clone(),
+            Stamped {
+                stamp,
+                value: value.clone(),
+            },
+        );
+        value
+    }
+
+    /// Refuses files larger than the limit, before reading them.
+    fn check_size(&self, file: &Path) -> Result<(), String> {
+        let len = self.world.metadata(file).map_or(0, |m| m.len);
+        if len > self.max_file_bytes {
+            return Err(format!(
+                "{} is {} MiB, larger than the asset size limit ({} MiB; raise it with --max-asset-mib)",
+                file.display(),
+                len >> 20,
+                self.max_file_bytes >> 20
+            ));
+        }
+        Ok(())
+    }
+
+    /// The geometry of the asset file `file` (OBJ, COLLADA, glTF).
+    fn mesh(&self, file: &Path) -> Result<Arc<Mesh>, String> {
+        self.check_size(file)?;
+        self.cached(&self.meshes, &file.to_path_buf(), file, || {
+            load_any(&*self.world, file).map(Arc::new)
+        })
+    }
+
+    /// The text of `file`, decoded as rule files are, with line endings
+    /// normalised.
+    fn text(&self, file: &Path) -> Option<Arc<str>> {
+        self.check_size(file).ok()?;
+        self.cached(&self.texts, &file.to_path_buf(), file, || {
+            self.world
+                .read_text(file)
+                .ok()
+                .map(|s| Arc::from(s.replace("\r\n", "\n").as_str()))
+        })
+    }
+
+    /// Whether the texture `file` has an alpha channel, asking `read` (given
+    /// the file's first bytes) the first time for each file.
+    pub fn texture_alpha(&self, file: &Arc<str>, read: impl FnOnce(&[u8]) -> bool) -> bool {
+        let path = Path::new(&**file);
+        let stamp = self.stamp(path);
+        if let Some(s) = lock(&self.alpha).get(file) {
+            if s.stamp == stamp {
+                return s.value;
+            }
+        }
+        // PNG chunks before the image data are small; 64 KiB covers them.
+        let value = self
+            .world
+            .read_prefix(path, 1 << 16)
+            .map(|head| read(&head))
+            .unwrap_or(false);
+        lock(&self.alpha).insert(file.clone(), Stamped { stamp, value });
+        value
+    }
+
+    /// Width and height of the image `file`, from its header.
+    fn image_size(&self, file: &Path) -> Option<(u32, u32)> {
+        self.cached(&self.image_sizes, &file.to_path_buf(), file, || {
+            // Headers come first, but JPEG may put large metadata before
+            // its frame header: try a prefix, then the whole file.
+            let size = |bytes: &[u8]| {
+                imagesize::blob_size(bytes)
+                    .ok()
+                    .map(|s| (s.width as u32, s.height as u32))
+            };
+            let head = self.world.read_prefix(file, 1 << 18).ok()?;
+            size(&head).or_else(|| size(&self.world.read(file).ok()?))
+        })
+    }
+}
+
+/// The assets of one program: files named in its rule files are searched
+/// from the file that names them (see the module docs), and what is found
+/// is read through the shared [`AssetStore`].
+pub struct Assets {
+    store: Arc<AssetStore>,
+    /// The rule file of each source file id.
+    files: Vec<PathBuf>,
     /// Answers by request (rule file, path as written), shared by all lots:
-    /// a search looks at the file system several times, and Candler alone
-    /// inserts 1,600 assets and names 6,000 textures per building.
+    /// a search looks at the file system several times, and a building may
+    /// insert thousands of assets and name thousands of textures.
     found: Requests<Option<PathBuf>>,
     mesh_requests: Requests<Result<Arc<Mesh>, String>>,
     texture_files: Requests<Option<Arc<str>>>,
-    /// Whether a texture file has an alpha channel, by file: reading the
-    /// image's header once for all lots (a city reads it once, not per lot).
-    alpha: Mutex<FxHashMap<Arc<str>, bool>>,
 }
 
 /// A cache by rule file and path as written.
 type Requests<T> = Mutex<FxHashMap<u32, FxHashMap<Box<str>, T>>>;
 
 fn cached<T: Clone>(cache: &Requests<T>, from: FileId, path: &str, make: impl FnOnce() -> T) -> T {
-    fn lock<T>(
-        c: &Requests<T>,
-    ) -> std::sync::MutexGuard<'_, FxHashMap<u32, FxHashMap<Box<str>, T>>> {
-        c.lock().unwrap_or_else(|e| e.into_inner())
-    }
     if let Some(v) = lock(cache).get(&from.0).and_then(|m| m.get(path)) {
         return v.clone();
     }
@@ -59,54 +218,51 @@ fn cached<T: Clone>(cache: &Requests<T>, from: FileId, path: &str, make: impl Fn
 }
 
 impl Assets {
-    pub fn new(sources: &SourceMap) -> Assets {
+    /// The assets of the rule files in `sources`, read through `store`.
+    pub fn new(store: Arc<AssetStore>, sources: &SourceMap) -> Assets {
+        let files = sources
+            .files()
+            .map(|(_, f)| store.world.canonical(&f.path))
+            .collect();
         Assets {
-            max_file_bytes: DEFAULT_MAX_ASSET_MIB << 20,
-            // Absolute paths: searching the ancestors of `rules/a.cga` given
-            // relative to the working directory must reach the project root.
-            files: sources
-                .files()
-                .map(|(_, f)| {
-                    f.path.canonicalize().unwrap_or_else(|_| {
-                        std::env::current_dir()
-                            .map(|d| d.join(&f.path))
-                            .unwrap_or_else(|_| f.path.clone())
-                    })
-                })
-                .collect(),
-            meshes: Mutex::new(HashMap::new()),
-            texts: Mutex::new(HashMap::new()),
+            store,
+            files,
             found: Default::default(),
             mesh_requests: Default::default(),
             texture_files: Default::default(),
-            alpha: Default::default(),
         }
+    }
+
+    /// Assets of the rule files in `sources`, read from disk with a store
+    /// of their own (tests, one-off tools).
+    pub fn on_disk(sources: &SourceMap) -> Assets {
+        Assets::new(
+            Arc::new(AssetStore::new(Arc::new(cga_world::DiskWorld))),
+            sources,
+        )
     }
 
     /// An asset set with no rule files (tests).
     pub fn empty() -> Assets {
-        Assets {
-            max_file_bytes: DEFAULT_MAX_ASSET_MIB << 20,
-            files: Vec::new(),
-            meshes: Mutex::new(HashMap::new()),
-            texts: Mutex::new(HashMap::new()),
-            found: Default::default(),
-            mesh_requests: Default::default(),
-            texture_files: Default::default(),
-            alpha: Default::default(),
-        }
+        Assets::on_disk(&SourceMap::new())
+    }
+
+    /// The store files are read through.
+    pub fn store(&self) -> &Arc<AssetStore> {
+        &self.store
     }
 
     /// The file `path` names, searched from the rule file `from` (once per
     /// rule file and path).
     pub fn resolve(&self, from: FileId, path: &str) -> Option<PathBuf> {
         cached(&self.found, from, path, || {
-            let p = std::path::Path::new(path);
-            if p.is_absolute() && p.is_file() {
+            let world = &*self.store.world;
+            let p = Path::new(path);
+            if p.is_absolute() && world.is_file(p) {
                 return Some(p.to_path_buf());
             }
             let rule_file = self.files.get(from.0 as usize)?;
-            find_relative(rule_file, path)
+            find_relative(world, rule_file, path)
         })
     }
 
@@ -115,16 +271,14 @@ impl Assets {
     /// absolute path (once per rule file and path).
     pub fn texture_file(&self, from: FileId, path: &str) -> Option<Arc<str>> {
         cached(&self.texture_files, from, path, || {
+            let world = &*self.store.world;
             // Textures of inserted assets come as paths next to the asset
             // file, which may be relative to the working folder.
             let file = self.resolve(from, path).or_else(|| {
-                let p = std::path::Path::new(path);
-                p.is_file().then(|| p.to_path_buf())
+                let p = Path::new(path);
+                world.is_file(p).then(|| p.to_path_buf())
             });
-            file.map(|f| {
-                let f = f.canonicalize().unwrap_or(f);
-                Arc::from(f.to_string_lossy().as_ref())
-            })
+            file.map(|f| Arc::from(world.canonical(&f).to_string_lossy().as_ref()))
         })
     }
 
@@ -136,104 +290,31 @@ impl Assets {
                 .ok_or_else(|| format!("there is no built-in asset \"{path}\""));
         }
         cached(&self.mesh_requests, from, path, || {
-            self.load_mesh(from, path)
+            let file = self
+                .resolve(from, path)
+                .ok_or_else(|| format!("asset \"{path}\" not found"))?;
+            self.store.mesh(&file)
         })
     }
 
-    /// Sets the largest asset file that is read, in MiB.
-    pub fn with_max_file_mib(mut self, mib: u64) -> Assets {
-        self.max_file_bytes = mib.saturating_mul(1 << 20);
-        self
-    }
-
-    /// Refuses files larger than the limit, before reading them.
-    fn check_size(&self, file: &std::path::Path) -> Result<(), String> {
-        let len = std::fs::metadata(file).map(|m| m.len()).unwrap_or(0);
-        if len > self.max_file_bytes {
-            return Err(format!(
-                "{} is {} MiB, larger than the asset size limit ({} MiB; raise it with --max-asset-mib)",
-                file.display(),
-                len >> 20,
-                self.max_file_bytes >> 20
-            ));
-        }
-        Ok(())
-    }
-
-    fn load_mesh(&self, from: FileId, path: &str) -> Result<Arc<Mesh>, String> {
-        let file = self
-            .resolve(from, path)
-            .ok_or_else(|| format!("asset \"{path}\" not found"))?;
-        self.check_size(&file)?;
-        let mut cache = self.meshes.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some(r) = cache.get(&file) {
-            return r.clone();
-        }
-        let r = load_any(&file).map(Arc::new);
-        cache.insert(file, r.clone());
-        r
-    }
-}
-
-/// The built-in geometry assets as unit shapes, made once.
-fn builtin_geometry(name: &str) -> Option<Arc<Mesh>> {
-    use cga_geometry::primitive as p;
-    use cga_geometry::DVec3;
-    static BUILTINS: std::sync::LazyLock<Vec<(&str, Arc<Mesh>)>> = std::sync::LazyLock::new(|| {
-        vec![
-            ("cube", Arc::new(p::builtin_cube())),
-            ("quad", Arc::new(p::quad(1.0, 1.0))),
-            ("disk", Arc::new(p::disk(16, 1.0, 1.0))),
-            ("sphere", Arc::new(p::sphere(16, 16, DVec3::ONE))),
-            ("cylinder", Arc::new(p::cylinder(16, DVec3::ONE))),
-            ("cone", Arc::new(p::cone(16, DVec3::ONE))),
-        ]
-    });
-    let name = name.strip_suffix(".obj").unwrap_or(name);
-    BUILTINS
-        .iter()
-        .find(|(n, _)| *n == name)
-        .map(|(_, m)| m.clone())
-}
-
-/// Loads an asset in any format the engine reads (OBJ, COLLADA, glTF; see
-/// `cga_geometry::load_asset`); its warnings (missing MTL, unknown
-/// materials, skipped polygons) are dropped here: the asset still loads.
-/// A file that cannot be read, in a format that is not read, or without
-/// polygons is an error message: the caller warns, naming it.
-fn load_any(path: &std::path::Path) -> Result<Mesh, String> {
-    cga_geometry::load_asset(path).map(|asset| asset.mesh)
-}
-
-impl Assets {
     /// Whether the texture `file` (as [`Assets::texture_file`] found it) has
-    /// an alpha channel, asking `read` the first time for each file.
-    pub fn texture_alpha(&self, file: &Arc<str>, read: impl FnOnce(&str) -> bool) -> bool {
-        let lock = || self.alpha.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some(&a) = lock().get(file) {
-            return a;
-        }
-        // Not under the lock: reading may take a while.
-        let a = read(file);
-        lock().insert(file.clone(), a);
-        a
+    /// an alpha channel, asking `read` with the file's first bytes the
+    /// first time for each file.
+    pub fn texture_alpha(&self, file: &Arc<str>, read: impl FnOnce(&[u8]) -> bool) -> bool {
+        self.store.texture_alpha(file, read)
+    }
+
+    /// Width and height of the image `path` names, searched from `from`.
+    pub fn image_size(&self, from: FileId, path: &str) -> Option<(u32, u32)> {
+        let file = self.resolve(from, path)?;
+        self.store.image_size(&file)
     }
 
     /// The text of a file found like an asset (`readTextFile`, tables),
     /// with line endings normalised; cached.
     pub fn text(&self, from: FileId, path: &str) -> Option<Arc<str>> {
         let file = self.resolve(from, path)?;
-        self.check_size(&file).ok()?;
-        let mut cache = self.texts.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some(t) = cache.get(&file) {
-            return t.clone();
-        }
-        let t = std::fs::read(&file).ok().map(|bytes| {
-            let s = String::from_utf8_lossy(&bytes).replace("\r\n", "\n");
-            Arc::from(s.as_str())
-        });
-        cache.insert(file, t.clone());
-        t
+        self.store.text(&file)
     }
 
     /// Files of the rule file's project matching a search query (`*` and `?`
@@ -243,9 +324,10 @@ impl Assets {
         let Some(rule_file) = self.files.get(from.0 as usize) else {
             return Vec::new();
         };
-        let root = project_root(rule_file);
+        let world = &*self.store.world;
+        let root = project_root(world, rule_file);
         let mut files = Vec::new();
-        list_files(&root, &mut files, 0);
+        list_files(world, &root, &mut files, 0);
         let terms: Vec<fancy_regex::Regex> = query
             .split_whitespace()
             .filter_map(|t| {
@@ -277,27 +359,62 @@ impl Assets {
     }
 }
 
+/// The built-in geometry assets as unit shapes, made once.
+fn builtin_geometry(name: &str) -> Option<Arc<Mesh>> {
+    use cga_geometry::primitive as p;
+    use cga_geometry::DVec3;
+    static BUILTINS: std::sync::LazyLock<Vec<(&str, Arc<Mesh>)>> = std::sync::LazyLock::new(|| {
+        vec![
+            ("cube", Arc::new(p::builtin_cube())),
+            ("quad", Arc::new(p::quad(1.0, 1.0))),
+            ("disk", Arc::new(p::disk(16, 1.0, 1.0))),
+            ("sphere", Arc::new(p::sphere(16, 16, DVec3::ONE))),
+            ("cylinder", Arc::new(p::cylinder(16, DVec3::ONE))),
+            ("cone", Arc::new(p::cone(16, DVec3::ONE))),
+        ]
+    });
+    let name = name.strip_suffix(".obj").unwrap_or(name);
+    BUILTINS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, m)| m.clone())
+}
+
+/// Loads an asset from `world` in any format the engine reads (OBJ with
+/// its material libraries, COLLADA, glTF with its buffers; see
+/// `cga_geometry::load_asset`); its warnings (missing MTL, unknown
+/// materials, skipped polygons) are dropped here: the asset still loads.
+/// A file that cannot be read, in a format that is not read, or without
+/// polygons is an error message: the caller warns, naming it.
+fn load_any(world: &dyn World, path: &Path) -> Result<Mesh, String> {
+    cga_geometry::load_asset(path, &|p: &Path| {
+        world
+            .read(p)
+            .map_err(|e| format!("cannot read '{}': {e}", p.display()))
+    })
+    .map(|asset| asset.mesh)
+}
+
 /// The project folder of a rule file: the nearest ancestor holding an
 /// `assets/` or `rules/` folder, else the rule file's folder.
-fn project_root(rule_file: &std::path::Path) -> PathBuf {
-    let dir = rule_file.parent().unwrap_or(std::path::Path::new("."));
+fn project_root(world: &dyn World, rule_file: &Path) -> PathBuf {
+    let dir = rule_file.parent().unwrap_or(Path::new("."));
     dir.ancestors()
-        .find(|d| d.join("assets").is_dir() || d.join("rules").is_dir())
+        .find(|d| world.is_dir(&d.join("assets")) || world.is_dir(&d.join("rules")))
         .unwrap_or(dir)
         .to_path_buf()
 }
 
-fn list_files(dir: &std::path::Path, out: &mut Vec<PathBuf>, depth: usize) {
+fn list_files(world: &dyn World, dir: &Path, out: &mut Vec<PathBuf>, depth: usize) {
     if depth > 16 {
         return;
     }
-    let Ok(entries) = std::fs::read_dir(dir) else {
+    let Ok(entries) = world.read_dir(dir) else {
         return;
     };
-    for e in entries.flatten() {
-        let p = e.path();
-        if p.is_dir() {
-            list_files(&p, out, depth + 1);
+    for p in entries {
+        if world.is_dir(&p) {
+            list_files(world, &p, out, depth + 1);
         } else {
             out.push(p);
         }

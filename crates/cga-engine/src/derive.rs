@@ -55,6 +55,19 @@ impl Default for Limits {
 pub struct RtError {
     pub message: String,
     pub span: Option<Span>,
+    pub kind: RtErrorKind,
+}
+
+/// Why a derivation stopped.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RtErrorKind {
+    /// Something in the rules (a wrong argument, a failed operation).
+    #[default]
+    Rules,
+    /// A limit (depth, shapes, faces, time) was reached.
+    Limit,
+    /// The caller cancelled the generation.
+    Cancelled,
 }
 
 impl RtError {
@@ -62,7 +75,14 @@ impl RtError {
         RtError {
             message: message.into(),
             span: Some(span),
+            kind: RtErrorKind::Rules,
         }
+    }
+
+    /// The same error, of kind `kind`.
+    pub fn of_kind(mut self, kind: RtErrorKind) -> RtError {
+        self.kind = kind;
+        self
     }
 
     pub fn to_diagnostic(&self) -> Diagnostic {
@@ -184,6 +204,12 @@ pub struct Leaf {
     /// The materials of the mesh's slots: its own with the shape's material
     /// attributes applied and texture paths resolved to files.
     pub materials: SharedVec<Material>,
+    /// The rule whose application made this leaf (`None`: the initial
+    /// shape itself, when no rule ran).
+    pub rule: Option<RuleId>,
+    /// The shape's name: its rule's, or the leaf's (`Window.`), as an index
+    /// into `Program::symbols`.
+    pub name: u32,
 }
 
 impl Leaf {
@@ -257,9 +283,18 @@ fn pooled_queue() -> std::collections::VecDeque<PendingRule> {
         .unwrap_or_default()
 }
 
-/// Gives a queue's room back to the thread's pool (the larger room is kept).
+/// Rule calls' room kept per thread between initial shapes: a building
+/// needs thousands; the room of an exceptional lot (a runaway grammar's
+/// millions) is given back, so a long-running host does not keep it.
+const KEPT_QUEUE: usize = 1 << 16;
+
+/// Gives a queue's room back to the thread's pool (the larger room is kept,
+/// up to [`KEPT_QUEUE`]).
 fn return_queue(mut queue: std::collections::VecDeque<PendingRule>) {
     queue.clear();
+    if queue.capacity() > KEPT_QUEUE {
+        return;
+    }
     // `try_with`: nothing to keep while the thread shuts down.
     let _ = QUEUES.try_with(|q| {
         if let Ok(mut q) = q.try_borrow_mut() {
@@ -292,6 +327,11 @@ pub struct Interp<'a> {
     /// The rule file of the rule being applied: texture paths of the shapes
     /// it emits are resolved from there.
     pub(crate) current_file: cga_syntax::FileId,
+    /// The rule being applied (the provenance of the leaves it emits).
+    current_rule: Option<RuleId>,
+    /// Set by another thread to stop the derivation (checked where the
+    /// time limit is).
+    pub cancel: Option<Arc<std::sync::atomic::AtomicBool>>,
     /// Emit leaves unbaked into `out.leaves` instead of `out.meshes`.
     pub keep_leaves: bool,
     /// With `keep_leaves`: hand each leaf to this as it is emitted instead
@@ -537,6 +577,8 @@ impl<'a> Interp<'a> {
             warned: HashSet::new(),
             textures: Default::default(),
             current_file: cga_syntax::FileId(0),
+            current_rule: None,
+            cancel: None,
             keep_leaves: false,
             leaf_sink: None,
             emitted: EmitCache::default(),
@@ -650,7 +692,7 @@ impl<'a> Interp<'a> {
                     self.limits.max_depth, def.name
                 ),
                 call_span,
-            ));
+            ).of_kind(crate::derive::RtErrorKind::Limit));
         }
         // Few shapes can still take long (each rule multiplying the
         // geometry): the clock is also read every 64 rule applications.
@@ -679,11 +721,13 @@ impl<'a> Interp<'a> {
         if r.is_ok() {
             let mut st = ShapeState::new(shape);
             let caller_file = std::mem::replace(&mut self.current_file, def.span.file);
+            let caller_rule = self.current_rule.replace(rule);
             r = self.exec_body(&def.body, &frame, &mut st);
             if r.is_ok() {
                 self.finish(st);
             }
             self.current_file = caller_file;
+            self.current_rule = caller_rule;
         }
         self.generation = outer_generation;
         if let Some((k, n)) = outer_key {
@@ -738,30 +782,45 @@ impl<'a> Interp<'a> {
                     self.limits.max_shapes
                 ),
                 span,
-            ));
+            ).of_kind(crate::derive::RtErrorKind::Limit));
         }
         Ok(())
     }
 
     /// Fails with the time limit's error once the initial shape has taken
-    /// longer than allowed.
+    /// longer than allowed, and with the cancellation error once the
+    /// generation was cancelled.
     fn check_time(&self, span: Span) -> Result<(), RtError> {
-        if self.started.elapsed().as_secs_f64() > self.limits.max_seconds {
+        if self.started.elapsed().as_secs_f64() > self.limits.max_seconds || self.is_cancelled() {
             return Err(self.time_limit_error(span));
         }
         Ok(())
     }
 
-    /// When the time limit of the initial shape runs out (`None`: never),
-    /// for operations long enough to look at the clock themselves.
-    pub fn deadline(&self) -> Option<std::time::Instant> {
-        std::time::Duration::try_from_secs_f64(self.limits.max_seconds)
-            .ok()
-            .and_then(|d| self.started.checked_add(d))
+    fn is_cancelled(&self) -> bool {
+        self.cancel
+            .as_ref()
+            .is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed))
     }
 
-    /// The error of a derivation stopped by the time limit.
+    /// When operations long enough to look at the clock themselves should
+    /// give up: the time limit of the initial shape, or cancellation.
+    pub fn stop(&self) -> cga_geometry::boolean::Stop<'_> {
+        cga_geometry::boolean::Stop {
+            deadline: std::time::Duration::try_from_secs_f64(self.limits.max_seconds)
+                .ok()
+                .and_then(|d| self.started.checked_add(d)),
+            cancel: self.cancel.as_deref(),
+        }
+    }
+
+    /// The error of a derivation stopped by the time limit (or, if that is
+    /// why it stopped, by cancellation).
     pub fn time_limit_error(&self, span: Span) -> RtError {
+        if self.is_cancelled() {
+            return RtError::new("the generation was cancelled", span)
+                .of_kind(RtErrorKind::Cancelled);
+        }
         RtError::new(
             format!(
                 "time limit ({} s) reached for one initial shape (raise the limit with --max-seconds)",
@@ -769,6 +828,7 @@ impl<'a> Interp<'a> {
             ),
             span,
         )
+        .of_kind(RtErrorKind::Limit)
     }
 
     pub fn count_shape(&mut self, span: Span) -> Result<(), RtError> {
@@ -808,6 +868,8 @@ impl<'a> Interp<'a> {
                 mesh: mesh.clone(),
                 transform: shape.object_transform(),
                 materials,
+                rule: self.current_rule,
+                name: shape.name,
             };
             match &mut self.leaf_sink {
                 Some(sink) => sink(leaf),
@@ -967,7 +1029,7 @@ impl<'a> Interp<'a> {
                             self.limits.max_faces
                         ),
                         call.span,
-                    ));
+                    ).of_kind(crate::derive::RtErrorKind::Limit));
                 }
                 Ok(())
             }

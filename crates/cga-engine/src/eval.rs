@@ -306,7 +306,7 @@ impl Interp<'_> {
                     self.limits.max_depth
                 ),
                 at.span,
-            ));
+            ).of_kind(crate::derive::RtErrorKind::Limit));
         }
         self.depth += 1;
         Ok(())

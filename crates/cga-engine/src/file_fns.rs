@@ -199,12 +199,8 @@ impl Interp<'_> {
             FileFn::ImageInfo => {
                 let path = text(&args[0], at)?;
                 let which = text(&args[1], at)?;
-                let size = self
-                    .assets
-                    .resolve(file, path)
-                    .and_then(|p| imagesize::size(p).ok());
-                match size {
-                    Some(s) => Value::Float(if which == "sy" { s.height } else { s.width } as f64),
+                match self.assets.image_size(file, path) {
+                    Some((w, h)) => Value::Float(if which == "sy" { h } else { w } as f64),
                     None => {
                         self.warn_once(at.span, || {
                             format!(
@@ -353,14 +349,11 @@ impl Interp<'_> {
             .iter()
             .map(|path| {
                 if f == FileFn::ImagesSortRatio {
-                    let s = self
-                        .assets
-                        .resolve(file, path)
-                        .and_then(|p| imagesize::size(p).ok())?;
+                    let (w, h) = self.assets.image_size(file, path)?;
                     let mut v = [0.0; 3];
-                    v[axes[0]] = s.width as f64;
+                    v[axes[0]] = w as f64;
                     if let Some(&b) = axes.get(1) {
-                        v[b] = s.height as f64;
+                        v[b] = h as f64;
                     }
                     Some(v)
                 } else {

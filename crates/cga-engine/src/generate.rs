@@ -28,6 +28,10 @@ pub struct GenerateOptions {
     /// out from the program on each call. A program with context queries
     /// derives each lot twice (see `crate::context`).
     pub context_use: Option<ContextUse>,
+    /// Set by another thread to stop the generation: the derivation ends
+    /// with an error of kind [`RtErrorKind::Cancelled`](crate::derive::RtErrorKind)
+    /// within moments (it is looked at where the time limit is).
+    pub cancel: Option<Arc<std::sync::atomic::AtomicBool>>,
     /// The first-pass records of every lot of the generation, for `inter`
     /// context queries ([`collect_lot`], [`SceneContext::new`]). Without
     /// it, a lot's first pass is run by [`generate_lot`] itself and inter
@@ -205,6 +209,7 @@ fn derive<'a>(
         geo_origin: lot.geo_origin,
     };
     let mut interp = Interp::new(program, assets, options.limits, info, shape, &[]);
+    interp.cancel = options.cancel.clone();
     interp.keep_leaves = options.leaves || sink.is_some();
     interp.leaf_sink = sink;
     interp.context = context;
@@ -231,6 +236,43 @@ fn derive<'a>(
     }
     let context = interp.context.take();
     (std::mem::take(&mut interp.out), error, context)
+}
+
+/// The values the attributes `ids` take on `lot` before any rule runs
+/// (their defaults, evaluated on the initial shape, or the lot's own
+/// values), in the order of `ids`.
+pub fn attribute_values(
+    program: &Program,
+    assets: &Assets,
+    lot: &Lot,
+    seed: u64,
+    ids: &[AttrId],
+) -> Vec<Result<Value, RtError>> {
+    let shape = initial_shape(lot, seed, 0);
+    let info = InitialInfo {
+        name: lot.name.clone(),
+        start_rule: String::new(),
+        geo_origin: lot.geo_origin,
+    };
+    let limits = crate::derive::Limits {
+        max_seconds: 10.0,
+        ..Default::default()
+    };
+    let mut interp = Interp::new(program, assets, limits, info, shape, &[]);
+    for (name, raw) in &lot.attrs {
+        if let Some(id) = program.main_attr(name) {
+            let def = &program.attrs[id as usize];
+            if let Ok(default) = interp.attr_default(id, &RExpr::constant(raw.clone(), def.span)) {
+                interp.set_attr_default(id, coerce(raw, &default));
+            }
+        }
+    }
+    ids.iter()
+        .map(|&id| {
+            let at = RExpr::constant(Value::Float(0.0), program.attrs[id as usize].span);
+            interp.attr_default(id, &at)
+        })
+        .collect()
 }
 
 /// A value given from outside (command line, GIS properties) in the type of
@@ -294,10 +336,10 @@ Roof --> reverseNormals t(0, 1, 0) primitiveCube() color(0.5, 0.5, 0.9) R.
         )
         .unwrap();
         let mut sources = cga_syntax::SourceMap::new();
-        let program = crate::load(&path, &mut sources)
-            .program
+        let program = crate::load(&cga_world::DiskWorld, &path, &mut sources)
+            .usable()
             .expect("rules load");
-        let assets = Assets::new(&sources);
+        let assets = Assets::on_disk(&sources);
         let rule = program.start_rule(Some("Lot")).unwrap();
         let lot = crate::lot::rect(12.0, 7.0);
         let baked = generate_lot(

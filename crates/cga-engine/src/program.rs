@@ -100,6 +100,8 @@ pub struct Program {
     /// Whether a rule calls `getTreeKey`: only then are the shapes' tree
     /// keys kept during derivation.
     pub uses_tree_key: bool,
+    /// The styles of the main rule file, `Default` first, in file order.
+    pub styles: Vec<String>,
 }
 
 impl Program {

@@ -16,6 +16,7 @@ use std::sync::Arc;
 use cga_syntax::ast::{self, BlockPart, Body, Expr, ExprKind, Item, Stmt};
 use cga_syntax::{Diagnostic, SourceMap, Span};
 use cga_value::Value;
+use cga_world::World;
 
 use crate::expr::{OpCall, RBlock, RBody, RExpr, RExprKind, RPart, RStmt, RuleCall};
 use crate::ops::{self, ArgMode, Op, SetTarget};
@@ -26,19 +27,35 @@ use crate::program::{
 use crate::shape_fns;
 use crate::values;
 
-/// The result of loading a rule file: the program (if it resolved without
-/// errors) and every diagnostic found.
+/// The result of loading a rule file: the program and every diagnostic
+/// found. A file with errors still gives a program of everything that
+/// could be resolved (rules, attributes, functions with their spans; what
+/// did not resolve is a placeholder), for tools that read it; only a
+/// program without errors may be derived ([`Loaded::usable`]).
 pub struct Loaded {
-    pub program: Option<Program>,
+    pub program: Program,
     pub diagnostics: Vec<Diagnostic>,
 }
 
-/// Loads `path` and everything it imports into `sources`, parses and resolves.
-pub fn load(path: &Path, sources: &mut SourceMap) -> Loaded {
-    match std::fs::read_to_string(path) {
-        Ok(text) => load_text(path, text, sources),
+impl Loaded {
+    /// Whether a diagnostic is an error.
+    pub fn has_errors(&self) -> bool {
+        self.diagnostics.iter().any(Diagnostic::is_error)
+    }
+
+    /// The program, if it has no errors.
+    pub fn usable(self) -> Option<Program> {
+        (!self.has_errors()).then_some(self.program)
+    }
+}
+
+/// Loads `path` and everything it imports from `world` into `sources`,
+/// parses and resolves.
+pub fn load(world: &dyn World, path: &Path, sources: &mut SourceMap) -> Loaded {
+    match world.read_text(path) {
+        Ok(text) => load_text(world, path, text, sources),
         Err(e) => Loaded {
-            program: None,
+            program: Program::default(),
             diagnostics: vec![plain_error(format!(
                 "cannot read rule file {}: {e}",
                 path.display()
@@ -49,8 +66,9 @@ pub fn load(path: &Path, sources: &mut SourceMap) -> Loaded {
 
 /// Like [`load`] for rule text already in memory; `path` names it in
 /// diagnostics and is where its imports are searched from.
-pub fn load_text(path: &Path, text: String, sources: &mut SourceMap) -> Loaded {
+pub fn load_text(world: &dyn World, path: &Path, text: String, sources: &mut SourceMap) -> Loaded {
     let mut r = Resolver {
+        world,
         sources,
         program: Program::default(),
         diags: Vec::new(),
@@ -62,6 +80,18 @@ pub fn load_text(path: &Path, text: String, sources: &mut SourceMap) -> Loaded {
         symbols: HashMap::new(),
     };
     let main = r.parse_file(path, text);
+    r.program.styles = std::iter::once("Default".to_string())
+        .chain(
+            r.parsed_files[main]
+                .module
+                .items
+                .iter()
+                .filter_map(|i| match i {
+                    Item::Style { name, .. } if name.name != "Default" => Some(name.name.clone()),
+                    _ => None,
+                }),
+        )
+        .collect();
     r.instantiate(main, String::new(), None);
     r.resolve_pending();
     if let Some(t) = r.tables.first() {
@@ -79,7 +109,6 @@ pub fn load_text(path: &Path, text: String, sources: &mut SourceMap) -> Loaded {
     // Report in file order, whatever stage found them.
     r.diags
         .sort_by_key(|d| d.span.map(|s| (s.file.0, s.start)).unwrap_or((0, 0)));
-    let has_errors = r.diags.iter().any(|d| d.is_error());
     let mut program = r.program;
     program.symbols = {
         let mut v = vec![Arc::<str>::from(""); r.symbols.len()];
@@ -89,7 +118,7 @@ pub fn load_text(path: &Path, text: String, sources: &mut SourceMap) -> Loaded {
         v
     };
     Loaded {
-        program: if has_errors { None } else { Some(program) },
+        program,
         diagnostics: r.diags,
     }
 }
@@ -148,6 +177,7 @@ enum Pending {
 }
 
 struct Resolver<'s> {
+    world: &'s dyn World,
     sources: &'s mut SourceMap,
     program: Program,
     diags: Vec<Diagnostic>,
@@ -262,7 +292,7 @@ impl Resolver<'_> {
     }
 
     fn parse_file(&mut self, path: &Path, text: String) -> usize {
-        let key = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
+        let key = self.world.canonical(path);
         if let Some(&idx) = self.parsed.get(&key) {
             return idx;
         }
@@ -385,7 +415,7 @@ impl Resolver<'_> {
                 );
                 continue;
             }
-            let text = match std::fs::read_to_string(&target) {
+            let text = match self.world.read_text(&target) {
                 Ok(t) => t,
                 Err(e) => {
                     self.error(
@@ -589,7 +619,7 @@ impl Resolver<'_> {
     /// `rules/`), and for absolute workspace paths (`/ESRI.lib/...`) inside an
     /// ancestor or its `.ws` workspace folder.
     fn find_import(&self, importer: &Path, target: &str) -> Option<PathBuf> {
-        find_relative(importer, target)
+        find_relative(self.world, importer, target)
     }
 
     fn resolve_pending(&mut self) {
@@ -1558,17 +1588,17 @@ fn literal(e: &Expr) -> Option<Value> {
 /// Finds `target` for a file at `from`: relative to its folder, then
 /// relative to each ancestor folder and its `assets/` folder; absolute
 /// workspace paths (`/lib/x.cga`) inside an ancestor or its `.ws` folder.
-pub fn find_relative(from: &Path, target: &str) -> Option<PathBuf> {
+pub fn find_relative(world: &dyn World, from: &Path, target: &str) -> Option<PathBuf> {
     let start = from.parent()?;
     let rel = target.trim_start_matches('/');
     if target.starts_with('/') {
         let p = Path::new(target);
-        if p.is_file() {
+        if world.is_file(p) {
             return Some(p.to_path_buf());
         }
         for dir in start.ancestors() {
             for c in [dir.join(rel), dir.join(".ws").join(rel)] {
-                if c.is_file() {
+                if world.is_file(&c) {
                     return Some(c);
                 }
             }
@@ -1576,12 +1606,12 @@ pub fn find_relative(from: &Path, target: &str) -> Option<PathBuf> {
         return None;
     }
     let direct = start.join(rel);
-    if direct.is_file() {
+    if world.is_file(&direct) {
         return Some(direct);
     }
     for dir in start.ancestors() {
         for c in [dir.join("assets").join(rel), dir.join(rel)] {
-            if c.is_file() {
+            if world.is_file(&c) {
                 return Some(c);
             }
         }

@@ -30,10 +30,10 @@ fn run_candler(dir: &std::path::Path, lot: &Lot) -> Run {
     // Loaded in place, so that its assets resolve.
     let path = dir.join("rules/candler/rules/candler.cga");
     let mut sources = cga_syntax::SourceMap::new();
-    let loaded = cga_engine::load(&path, &mut sources);
-    let program = loaded.program.expect("candler loads");
+    let loaded = cga_engine::load(&cga_world::DiskWorld, &path, &mut sources);
+    let program = loaded.usable().expect("candler loads");
     let rule = program.start_rule(None).expect("start rule");
-    let assets = cga_engine::assets::Assets::new(&sources);
+    let assets = cga_engine::assets::Assets::on_disk(&sources);
     let (out, error) = cga_engine::generate_lot(
         &program,
         &assets,

@@ -27,11 +27,13 @@ fn run(src: &str, lots: &[Lot]) -> Vec<LotOutput> {
 fn run_with(src: &str, lots: &[Lot], scene: bool) -> Vec<LotOutput> {
     let mut sources = SourceMap::new();
     let loaded = cga_engine::load_text(
+        &cga_world::DiskWorld,
         std::path::Path::new("context.cga"),
         src.to_string(),
         &mut sources,
     );
-    let Some(program) = loaded.program else {
+    let errors = loaded.has_errors();
+    let Some(program) = (!errors).then_some(loaded.program) else {
         let text: String = loaded
             .diagnostics
             .iter()
@@ -49,7 +51,7 @@ fn run_with(src: &str, lots: &[Lot], scene: bool) -> Vec<LotOutput> {
         .start_rule(None)
         .or_else(|_| program.start_rule(Some(first)))
         .unwrap_or_else(|e| panic!("{e}"));
-    let assets = Assets::new(&sources);
+    let assets = Assets::on_disk(&sources);
     let mut options = GenerateOptions::default();
     if scene {
         options.scene = Some(Arc::new(collect_scene(

@@ -129,7 +129,9 @@ fn const_example() {
     let path = dir.join("c.cga");
     std::fs::write(&path, src).unwrap();
     let mut sources = cga_syntax::SourceMap::new();
-    let program = cga_engine::load(&path, &mut sources).program.unwrap();
+    let program = cga_engine::load(&cga_world::DiskWorld, &path, &mut sources)
+        .usable()
+        .unwrap();
     assert!(program.main_attr("height").is_none());
 }
 

@@ -463,7 +463,7 @@ fn inline_syntax_errors() {
         let path = dir.join("bad.cga");
         std::fs::write(&path, src).unwrap();
         let mut sources = cga_syntax::SourceMap::new();
-        let loaded = cga_engine::load(&path, &mut sources);
+        let loaded = cga_engine::load(&cga_world::DiskWorld, &path, &mut sources);
         let text: String = loaded
             .diagnostics
             .iter()

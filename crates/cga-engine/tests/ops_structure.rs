@@ -341,8 +341,8 @@ fn case_chain_needs_else() {
         let path = dir.join("r.cga");
         std::fs::write(&path, src).unwrap();
         let mut sources = cga_syntax::SourceMap::new();
-        let loaded = cga_engine::load(&path, &mut sources);
-        assert!(loaded.program.is_none(), "{src}");
+        let loaded = cga_engine::load(&cga_world::DiskWorld, &path, &mut sources);
+        assert!(loaded.has_errors(), "{src}");
     }
 }
 

@@ -28,7 +28,7 @@ fn rule_file(name: &str) -> PathBuf {
 
 fn load(name: &str) -> (Program, Assets) {
     let mut sources = SourceMap::new();
-    let loaded = cga_engine::load(&rule_file(name), &mut sources);
+    let loaded = cga_engine::load(&cga_world::DiskWorld, &rule_file(name), &mut sources);
     let errors: Vec<_> = loaded
         .diagnostics
         .iter()
@@ -36,8 +36,8 @@ fn load(name: &str) -> (Program, Assets) {
         .map(|d| d.message.clone())
         .collect();
     assert!(errors.is_empty(), "{name}: {errors:?}");
-    let assets = Assets::new(&sources);
-    (loaded.program.expect("program"), assets)
+    let assets = Assets::on_disk(&sources);
+    (loaded.usable().expect("program"), assets)
 }
 
 /// Derives `lot` with rule `start` of rule file `name`.

@@ -20,9 +20,9 @@ fn program() -> (Program, Assets) {
     let path =
         PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/rules/split_area/property.cga");
     let mut sources = SourceMap::new();
-    let loaded = cga_engine::load(&path, &mut sources);
-    let assets = Assets::new(&sources);
-    (loaded.program.expect("property.cga loads"), assets)
+    let loaded = cga_engine::load(&cga_world::DiskWorld, &path, &mut sources);
+    let assets = Assets::on_disk(&sources);
+    (loaded.usable().expect("property.cga loads"), assets)
 }
 
 /// A star-shaped ring in the xz plane (counter-clockwise seen from +y unless

@@ -192,8 +192,10 @@ fn bad_uv_set_is_an_error_not_a_panic() {
     let path = dir.join("rules/main.cga");
     std::fs::write(&path, "Lot --> projectUV(10) X.").unwrap();
     let mut sources = cga_syntax::SourceMap::new();
-    let program = cga_engine::load(&path, &mut sources).program.unwrap();
-    let assets = cga_engine::assets::Assets::new(&sources);
+    let program = cga_engine::load(&cga_world::DiskWorld, &path, &mut sources)
+        .usable()
+        .unwrap();
+    let assets = cga_engine::assets::Assets::on_disk(&sources);
     let rule = program.start_rule(None).unwrap();
     let (_, error) = cga_engine::generate_lot(
         &program,

@@ -73,7 +73,7 @@ pub const DEFAULT_FLUSH_MIB: usize = 64;
 const GLB_JSON_ROOM: u64 = 1 << 20;
 
 /// Writes values as the little-endian bytes glTF's binary buffer holds.
-fn write_le<T: bytemuck::Pod>(w: &mut impl Write, values: &[T]) -> std::io::Result<()> {
+fn write_le<T: bytemuck::Pod>(w: &mut (impl Write + ?Sized), values: &[T]) -> std::io::Result<()> {
     if cfg!(target_endian = "little") {
         return w.write_all(bytemuck::cast_slice(values));
     }
@@ -132,7 +132,7 @@ impl Bucket {
     }
 
     /// The arrays in the order of the binary layout.
-    fn write_arrays(&self, w: &mut impl Write) -> std::io::Result<()> {
+    fn write_arrays(&self, w: &mut (impl Write + ?Sized)) -> std::io::Result<()> {
         write_le(w, &self.positions)?;
         write_le(w, &self.normals)?;
         for coords in &self.coords {
@@ -302,9 +302,24 @@ pub(crate) struct MapUse {
     channel: usize,
 }
 
+/// Where a GLB or a glTF's JSON is written: a file, or any stream that can
+/// also be read back and sought (a GLB's binary data may have to be moved
+/// up: see `finish_early_glb`), such as a `Cursor<Vec<u8>>`.
+pub trait Output: Read + Write + Seek + Send + 'static {
+    /// The output as `Any`, to take the concrete stream back after writing.
+    fn into_any(self: Box<Self>) -> Box<dyn std::any::Any>;
+}
+
+impl<T: Read + Write + Seek + Send + 'static> Output for T {
+    fn into_any(self: Box<Self>) -> Box<dyn std::any::Any> {
+        self
+    }
+}
+
 pub(crate) struct GltfWriter {
+    /// The output's path (also the name of an in-memory output in messages).
     path: PathBuf,
-    out: BufWriter<File>,
+    out: BufWriter<Box<dyn Output>>,
     binary: bool,
     /// GLB: put images into the binary chunk (else refer to them by URI).
     embed_images: bool,
@@ -348,12 +363,32 @@ impl GltfWriter {
             .truncate(true)
             .open(path)
             .map_err(|e| ExportError::io(path, e))?;
+        Ok(GltfWriter::new(
+            Box::new(file),
+            path,
+            binary,
+            embed_images,
+            asset_extras,
+            flush_mib,
+        ))
+    }
+
+    /// A writer into `out`, named `path` (glTF writes its `.bin` beside
+    /// that path).
+    pub(crate) fn new(
+        out: Box<dyn Output>,
+        path: &Path,
+        binary: bool,
+        embed_images: bool,
+        asset_extras: Option<serde_json::Value>,
+        flush_mib: usize,
+    ) -> GltfWriter {
         let stem = path
             .file_stem()
             .map_or("model".into(), |s| s.to_string_lossy());
-        Ok(GltfWriter {
+        GltfWriter {
             path: path.to_path_buf(),
-            out: BufWriter::with_capacity(1 << 16, file),
+            out: BufWriter::with_capacity(1 << 16, out),
             binary,
             embed_images: binary && embed_images,
             asset_extras,
@@ -367,7 +402,7 @@ impl GltfWriter {
             written: Vec::new(),
             written_bytes: 0,
             bin_out: None,
-        })
+        }
     }
 
     /// File names this writer creates next to the output.
@@ -441,7 +476,7 @@ impl GltfWriter {
     fn flush(&mut self) -> Result<(), ExportError> {
         let path = self.path.clone();
         let io = |e| ExportError::io(&path, e);
-        let out: &mut BufWriter<File> = if self.binary {
+        let out: &mut dyn Write = if self.binary {
             if self.written_bytes == 0 {
                 self.out.seek(SeekFrom::Start(GLB_JSON_ROOM)).map_err(io)?;
             }
@@ -469,12 +504,13 @@ impl GltfWriter {
         Ok(())
     }
 
+    /// Writes what is pending and gives the output back.
     pub(crate) fn finish(
         mut self,
         table: &MaterialTable,
         textures: &Textures,
         stats: &mut ExportStats,
-    ) -> Result<(), ExportError> {
+    ) -> Result<Box<dyn Output>, ExportError> {
         let mut root = json::Root {
             asset: json::Asset {
                 generator: Some("CGA engine (cga-export)".into()),
@@ -644,7 +680,10 @@ impl GltfWriter {
         if !self.embed_images {
             textures.copy_all(images.iter().copied())?;
         }
-        Ok(())
+        let path = self.path;
+        self.out
+            .into_inner()
+            .map_err(|e| ExportError::io(&path, e.into_error()))
     }
 
     fn write_glb(
@@ -695,7 +734,7 @@ impl GltfWriter {
             GLB_JSON_ROOM
         } else {
             let file = self.out.get_mut();
-            move_up(file, GLB_JSON_ROOM, bin_len, head - GLB_JSON_ROOM).map_err(io)?;
+            move_up(&mut **file, GLB_JSON_ROOM, bin_len, head - GLB_JSON_ROOM).map_err(io)?;
             head
         };
         json.resize((start - 28) as usize, b' ');
@@ -735,7 +774,7 @@ fn write_glb_head(
 
 /// Moves the `len` bytes of `file` at `start` up by `by` bytes, from the
 /// end backwards so that nothing is overwritten before it is moved.
-fn move_up(file: &mut File, start: u64, len: u64, by: u64) -> std::io::Result<()> {
+fn move_up(file: &mut dyn Output, start: u64, len: u64, by: u64) -> std::io::Result<()> {
     let mut buf = vec![0u8; 1 << 20];
     let mut end = start + len;
     while end > start {
@@ -1067,21 +1106,7 @@ fn write_bin(
     }
     for &t in images {
         let tex = textures.get(t);
-        if let Some(data) = &tex.data {
-            w.write_all(data).map_err(io)?;
-            let pad = (tex.len.next_multiple_of(4) - tex.len) as usize;
-            w.write_all(&[0u8; 3][..pad]).map_err(io)?;
-            continue;
-        }
-        let file = File::open(&tex.source).map_err(|e| ExportError::io(&tex.source, e))?;
-        let copied = std::io::copy(&mut file.take(tex.len), w).map_err(io)?;
-        if copied != tex.len {
-            let msg = format!(
-                "texture changed while exporting ({copied} of {} bytes)",
-                tex.len
-            );
-            return Err(ExportError::io(&tex.source, std::io::Error::other(msg)));
-        }
+        w.write_all(&textures.bytes(t)?).map_err(io)?;
         let pad = (tex.len.next_multiple_of(4) - tex.len) as usize;
         w.write_all(&[0u8; 3][..pad]).map_err(io)?;
     }

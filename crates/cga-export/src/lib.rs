@@ -34,6 +34,7 @@ mod gltf;
 mod hash;
 mod materials;
 mod obj;
+mod plain;
 mod prepare;
 mod textures;
 
@@ -45,10 +46,13 @@ use cga_geometry::{DAffine3, DVec3, Material, Mesh};
 
 use std::sync::Arc;
 
+use cga_world::World;
+
 pub use crate::encode::{Encoded, Encoder};
 use crate::encode::{EncoderShared, MeshEncoder};
-pub use crate::gltf::DEFAULT_FLUSH_MIB;
+pub use crate::gltf::{Output, DEFAULT_FLUSH_MIB};
 use crate::materials::MaterialTable;
+pub use crate::plain::{PlainCollector, PlainMesh, PlainModel};
 use crate::prepare::{FacePrep, SlotIds};
 use crate::textures::{TextureProbe, Textures};
 
@@ -78,7 +82,7 @@ impl Format {
 }
 
 /// How a model is written.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 pub struct ExportOptions {
     /// Folders in which texture paths that are not existing absolute paths
     /// are looked up, in order (typically the rule file's project folder).
@@ -98,6 +102,8 @@ pub struct ExportOptions {
     /// glTF and GLB: vertex data held in memory before it is written out,
     /// in MiB (see `gltf`'s module docs): bounds memory for large models.
     pub flush_mib: usize,
+    /// Where texture files are read from.
+    pub world: Arc<dyn World>,
 }
 
 impl Default for ExportOptions {
@@ -107,6 +113,7 @@ impl Default for ExportOptions {
             embed_textures: true,
             georeference: None,
             flush_mib: gltf::DEFAULT_FLUSH_MIB,
+            world: Arc::new(cga_world::DiskWorld),
         }
     }
 }
@@ -176,6 +183,8 @@ pub enum ExportError {
     /// The model exceeds a limit of the format (glTF: 2^32 vertices per
     /// material, 4 GiB per GLB file; OBJ: 2^32 vertices).
     TooLarge(String),
+    /// Something asked of a writer that its kind does not do.
+    Unsupported(String),
 }
 
 impl ExportError {
@@ -193,6 +202,7 @@ impl fmt::Display for ExportError {
             ExportError::Io { path, source } => write!(f, "{}: {source}", path.display()),
             ExportError::InvalidMesh(msg) => write!(f, "invalid mesh: {msg}"),
             ExportError::TooLarge(msg) => write!(f, "model too large: {msg}"),
+            ExportError::Unsupported(msg) => write!(f, "{msg}"),
         }
     }
 }
@@ -260,9 +270,6 @@ impl ModelWriter {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         };
-        let encoders = Arc::new(EncoderShared::new(TextureProbe::new(
-            &options.texture_roots,
-        )));
         let (sink, reserved) = match format {
             Format::Glb | Format::Gltf => {
                 let w = gltf::GltfWriter::create(
@@ -290,15 +297,67 @@ impl ModelWriter {
         let reserved: Vec<&str> = reserved.iter().map(String::as_str).collect();
         // GLB embeds images instead of copying them.
         let copy_textures = options.embed_textures && format != Format::Glb;
-        let textures = Textures::new(&options.texture_roots, copy_textures, &out_dir, &reserved);
-        Ok(ModelWriter {
+        Ok(ModelWriter::with_sink(
+            sink,
+            &options,
+            copy_textures,
+            &out_dir,
+            &reserved,
+        ))
+    }
+
+    /// A GLB written into `out` (a `Cursor<Vec<u8>>`, a file opened for
+    /// reading and writing, ...) instead of a file of its own; textures are
+    /// embedded whatever `options.embed_textures` says (there is nowhere
+    /// else to put them). `name` names the output in error messages.
+    pub fn glb_into(
+        out: impl Output + 'static,
+        name: &str,
+        options: ExportOptions,
+    ) -> Result<ModelWriter, ExportError> {
+        let w = gltf::GltfWriter::new(
+            Box::new(out),
+            Path::new(name),
+            true,
+            true,
+            options.georeference.map(Georeference::to_json),
+            options.flush_mib,
+        );
+        Ok(ModelWriter::with_sink(
+            Sink::Gltf(w, Box::default()),
+            &options,
+            false,
+            Path::new("."),
+            &[],
+        ))
+    }
+
+    fn with_sink(
+        sink: Sink,
+        options: &ExportOptions,
+        copy_textures: bool,
+        out_dir: &Path,
+        reserved: &[&str],
+    ) -> ModelWriter {
+        let encoders = Arc::new(EncoderShared::new(TextureProbe::new(
+            options.world.clone(),
+            &options.texture_roots,
+        )));
+        let textures = Textures::new(
+            options.world.clone(),
+            &options.texture_roots,
+            copy_textures,
+            out_dir,
+            reserved,
+        );
+        ModelWriter {
             table: MaterialTable::default(),
             textures,
             encoders,
             sink,
             stats: ExportStats::default(),
             skipped_non_finite: 0,
-        })
+        }
     }
 
     /// Adds one shape's geometry, in world coordinates. Faces with fewer
@@ -409,18 +468,46 @@ impl ModelWriter {
     }
 
     /// Writes everything that is still pending and closes the files.
-    pub fn finish(mut self) -> Result<ExportStats, ExportError> {
+    pub fn finish(self) -> Result<ExportStats, ExportError> {
+        Ok(self.finish_into()?.0)
+    }
+
+    /// [`finish`](ModelWriter::finish), giving back the stream a GLB was
+    /// written into ([`glb_into`](ModelWriter::glb_into)); `None` for OBJ.
+    pub fn finish_into(mut self) -> Result<(ExportStats, Option<Box<dyn Output>>), ExportError> {
         if self.skipped_non_finite > 0 {
             self.stats.warnings.push(format!(
                 "{} face(s) with non-finite coordinates left out",
                 self.skipped_non_finite
             ));
         }
-        match self.sink {
-            Sink::Gltf(w, _) => w.finish(&self.table, &self.textures, &mut self.stats)?,
-            Sink::Obj(w, ..) => w.finish(&self.table, &self.textures, &mut self.stats)?,
-        }
-        Ok(self.stats)
+        let out = match self.sink {
+            Sink::Gltf(w, _) => Some(w.finish(&self.table, &self.textures, &mut self.stats)?),
+            Sink::Obj(w, ..) => {
+                w.finish(&self.table, &self.textures, &mut self.stats)?;
+                None
+            }
+        };
+        Ok((self.stats, out))
+    }
+
+    /// A GLB written into memory; [`finish_bytes`](ModelWriter::finish_bytes)
+    /// gives its bytes.
+    pub fn glb_in_memory(options: ExportOptions) -> Result<ModelWriter, ExportError> {
+        ModelWriter::glb_into(std::io::Cursor::new(Vec::new()), "model.glb", options)
+    }
+
+    /// Finishes a writer made by [`glb_in_memory`](ModelWriter::glb_in_memory)
+    /// and gives the GLB's bytes.
+    pub fn finish_bytes(self) -> Result<(Vec<u8>, ExportStats), ExportError> {
+        let (stats, out) = self.finish_into()?;
+        let bytes = out
+            .and_then(|o| o.into_any().downcast::<std::io::Cursor<Vec<u8>>>().ok())
+            .map(|c| c.into_inner())
+            .ok_or_else(|| {
+                ExportError::Unsupported("the model was not written into memory".into())
+            })?;
+        Ok((bytes, stats))
     }
 }
 

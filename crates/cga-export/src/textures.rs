@@ -12,10 +12,10 @@
 //! written next to the output (there is no file to refer to).
 
 use std::collections::{HashMap, HashSet};
-use std::fs::File;
-use std::io::Read;
 use std::path::{Component, Path, PathBuf};
 use std::sync::{Arc, Mutex};
+
+use cga_world::World;
 
 use crate::ExportError;
 
@@ -36,6 +36,7 @@ pub(crate) struct Texture {
 }
 
 pub(crate) struct Textures {
+    world: Arc<dyn World>,
     roots: Vec<PathBuf>,
     /// Copy textures next to the output (else refer to them where they are).
     copy: bool,
@@ -49,8 +50,15 @@ pub(crate) struct Textures {
 impl Textures {
     /// `reserved`: file names of the model's own output files, which a copied
     /// texture must not overwrite.
-    pub(crate) fn new(roots: &[PathBuf], copy: bool, out_dir: &Path, reserved: &[&str]) -> Self {
+    pub(crate) fn new(
+        world: Arc<dyn World>,
+        roots: &[PathBuf],
+        copy: bool,
+        out_dir: &Path,
+        reserved: &[&str],
+    ) -> Self {
         Textures {
+            world,
             roots: roots.to_vec(),
             copy,
             out_dir: out_dir.to_path_buf(),
@@ -84,7 +92,7 @@ impl Textures {
             self.by_rule_path.insert(rule_path.clone(), found);
             return found;
         }
-        let found = locate(&self.roots, rule_path).and_then(|p| self.add(&p).ok());
+        let found = locate(&*self.world, &self.roots, rule_path).and_then(|p| self.add(&p).ok());
         if found.is_none() {
             let searched = if self.roots.is_empty() {
                 "the current directory".to_string()
@@ -104,11 +112,11 @@ impl Textures {
     }
 
     fn add(&mut self, path: &Path) -> std::io::Result<u32> {
-        let source = path.canonicalize()?;
+        let source = self.world.canonical(path);
         if let Some(&i) = self.by_source.get(&source) {
             return Ok(i);
         }
-        let (len, mime) = file_kind(&source)?;
+        let (len, mime) = file_kind(&*self.world, &source)?;
         let out_name = self.unique_name(&source);
         let i = self.list.len() as u32;
         self.list.push(Texture {
@@ -170,6 +178,28 @@ impl Textures {
         &self.list[i as usize]
     }
 
+    /// The bytes of texture `i`: a built-in's image, or the file's, which
+    /// must still have the size it had when it was found.
+    pub(crate) fn bytes(&self, i: u32) -> Result<Arc<[u8]>, ExportError> {
+        let t = self.get(i);
+        if let Some(data) = &t.data {
+            return Ok(data.clone());
+        }
+        let bytes = self
+            .world
+            .read(&t.source)
+            .map_err(|e| ExportError::io(&t.source, e))?;
+        if bytes.len() as u64 != t.len {
+            let msg = format!(
+                "texture changed while exporting ({} bytes, then {})",
+                t.len,
+                bytes.len()
+            );
+            return Err(ExportError::io(&t.source, std::io::Error::other(msg)));
+        }
+        Ok(Arc::from(bytes))
+    }
+
     /// How the output refers to texture `i`, as a `/`-separated path: its
     /// copied file name, or the path from the output's folder to the source.
     pub(crate) fn reference(&self, i: u32) -> String {
@@ -201,7 +231,11 @@ impl Textures {
             }
             let same = dest.canonicalize().is_ok_and(|d| d == t.source);
             if !same {
-                std::fs::copy(&t.source, &dest).map_err(|e| ExportError::io(&dest, e))?;
+                let bytes = self
+                    .world
+                    .read(&t.source)
+                    .map_err(|e| ExportError::io(&t.source, e))?;
+                std::fs::write(&dest, bytes).map_err(|e| ExportError::io(&dest, e))?;
             }
         }
         Ok(())
@@ -210,9 +244,9 @@ impl Textures {
 
 /// Where a rule path names a file: an existing absolute path, else the
 /// first texture root holding it (a leading `/` dropped).
-fn locate(roots: &[PathBuf], rule_path: &str) -> Option<PathBuf> {
+fn locate(world: &dyn World, roots: &[PathBuf], rule_path: &str) -> Option<PathBuf> {
     let path = Path::new(rule_path);
-    if path.is_absolute() && path.is_file() {
+    if path.is_absolute() && world.is_file(path) {
         return Some(path.to_path_buf());
     }
     let relative = rule_path.trim_start_matches(['/', '\\']);
@@ -221,21 +255,22 @@ fn locate(roots: &[PathBuf], rule_path: &str) -> Option<PathBuf> {
     }
     if roots.is_empty() {
         let p = Path::new(relative);
-        return p.is_file().then(|| p.to_path_buf());
+        return world.is_file(p).then(|| p.to_path_buf());
     }
     roots
         .iter()
         .map(|root| root.join(relative))
-        .find(|p| p.is_file())
+        .find(|p| world.is_file(p))
 }
 
 /// A file's size and image format (`None`: neither PNG nor JPEG).
-fn file_kind(path: &Path) -> std::io::Result<(u64, Option<&'static str>)> {
-    let mut file = File::open(path)?;
-    let len = file.metadata()?.len();
-    let mut magic = [0u8; 8];
-    let n = read_up_to(&mut file, &mut magic)?;
-    Ok((len, sniff_mime(&magic[..n])))
+fn file_kind(world: &dyn World, path: &Path) -> std::io::Result<(u64, Option<&'static str>)> {
+    let len = world
+        .metadata(path)
+        .ok_or_else(|| std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"))?
+        .len;
+    let magic = world.read_prefix(path, 8)?;
+    Ok((len, sniff_mime(&magic)))
 }
 
 /// Tells, from any thread, whether a texture path will be usable in glTF
@@ -243,13 +278,15 @@ fn file_kind(path: &Path) -> std::io::Result<(u64, Option<&'static str>)> {
 /// need it to lay out vertices before the writer resolves the texture.
 /// Each path is looked at once.
 pub(crate) struct TextureProbe {
+    world: Arc<dyn World>,
     roots: Vec<PathBuf>,
     known: Mutex<HashMap<Arc<str>, bool>>,
 }
 
 impl TextureProbe {
-    pub(crate) fn new(roots: &[PathBuf]) -> TextureProbe {
+    pub(crate) fn new(world: Arc<dyn World>, roots: &[PathBuf]) -> TextureProbe {
         TextureProbe {
+            world,
             roots: roots.to_vec(),
             known: Mutex::new(HashMap::new()),
         }
@@ -266,24 +303,13 @@ impl TextureProbe {
         let usable = if rule_path.starts_with(crate::builtin::PREFIX) {
             crate::builtin::builtin_texture(rule_path).is_some()
         } else {
-            locate(&self.roots, rule_path)
-                .and_then(|p| file_kind(&p).ok())
+            locate(&*self.world, &self.roots, rule_path)
+                .and_then(|p| file_kind(&*self.world, &p).ok())
                 .is_some_and(|(_, mime)| mime.is_some())
         };
         lock().insert(rule_path.clone(), usable);
         usable
     }
-}
-
-fn read_up_to(file: &mut File, buf: &mut [u8]) -> std::io::Result<usize> {
-    let mut n = 0;
-    while n < buf.len() {
-        match file.read(&mut buf[n..])? {
-            0 => break,
-            k => n += k,
-        }
-    }
-    Ok(n)
 }
 
 /// The image formats glTF 2.0 core allows, recognised by their signatures.

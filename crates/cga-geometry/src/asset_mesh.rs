@@ -11,39 +11,52 @@ use crate::material::Material;
 use crate::mesh::Mesh;
 use crate::obj::ObjAsset;
 
-/// Reads the asset file `path` by its extension: OBJ, COLLADA (`.dae`),
-/// glTF (`.gltf`, `.glb`). The other formats the `i()` page lists (FBX,
-/// USD, DWG, IFC) have no well-kept pure-Rust reader: they are an error
-/// naming the file and the format, as is an unknown extension. The error
-/// is a message for a warning; the model goes on without the asset.
-pub fn load_asset(path: &Path) -> Result<ObjAsset, String> {
+/// Reads a file's bytes (the asset and the files it names: OBJ material
+/// libraries, glTF buffers); the error is a message.
+pub type ReadFile<'a> = dyn Fn(&Path) -> Result<Vec<u8>, String> + 'a;
+
+/// Reads the asset file `path` by its extension, through `read`: OBJ,
+/// COLLADA (`.dae`), glTF (`.gltf`, `.glb`). The other formats the `i()`
+/// page lists (FBX, USD, DWG, IFC) have no well-kept pure-Rust reader: they
+/// are an error naming the file and the format, as is an unknown extension
+/// or an asset without polygons. The error is a message for a warning; the
+/// model goes on without the asset.
+pub fn load_asset(path: &Path, read: &ReadFile) -> Result<ObjAsset, String> {
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     let shown = path.display();
-    let read = match ext.as_str() {
-        "obj" => crate::obj::load_obj(path),
-        "dae" => crate::collada::load_collada(path),
-        "gltf" | "glb" => crate::gltf_asset::load_gltf(path),
-        "fbx" | "usd" | "usda" | "usdc" | "usdz" | "dwg" | "ifc" => {
-            let format = match ext.as_str() {
-                "fbx" => "FBX",
-                "dwg" => "DWG",
-                "ifc" => "IFC",
-                _ => "USD",
-            };
-            return Err(format!(
-                "cannot load asset {shown}: {format} assets are not read by this engine (no well-kept pure-Rust reader); convert it to glTF, COLLADA or OBJ"
-            ));
-        }
-        _ => {
-            return Err(format!(
+    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let format = match ext.as_str() {
+        "obj" | "dae" | "gltf" | "glb" => None,
+        "fbx" => Some("FBX"),
+        "dwg" => Some("DWG"),
+        "ifc" => Some("IFC"),
+        "usd" | "usda" | "usdc" | "usdz" => Some("USD"),
+        _ => return Err(format!(
             "cannot load asset {shown}: unknown asset format (expected .obj, .dae, .gltf or .glb)"
-        ))
-        }
+        )),
     };
-    let asset = read.map_err(|e| format!("cannot load asset {shown}: {e}"))?;
+    if let Some(format) = format {
+        return Err(format!(
+            "cannot load asset {shown}: {format} assets are not read by this engine (no well-kept pure-Rust reader); convert it to glTF, COLLADA or OBJ"
+        ));
+    }
+    let bytes = read(path).map_err(|e| format!("cannot load asset {shown}: {e}"))?;
+    let asset = match ext.as_str() {
+        "obj" => {
+            let text = String::from_utf8_lossy(&bytes);
+            crate::obj::parse_obj(&text, &dir, |name| {
+                read(&dir.join(name))
+                    .map(|b| String::from_utf8_lossy(&b).into_owned())
+                    .map_err(|e| format!("cannot read material library: {e}"))
+            })
+        }
+        "dae" => crate::collada::parse_collada(&String::from_utf8_lossy(&bytes), &dir),
+        _ => crate::gltf_asset::parse_gltf(&bytes, &dir, read),
+    }
+    .map_err(|e| format!("cannot load asset {shown}: {e}"))?;
     if asset.mesh.faces.is_empty() {
         return Err(format!("asset {shown} has no polygons"));
     }
@@ -222,6 +235,32 @@ pub(crate) fn up_axis_to_y(axis: char) -> DMat3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Files are read through the given reader (a world of the caller's:
+    /// memory here), the asset and what it names.
+    #[test]
+    fn assets_are_read_through_the_reader() {
+        let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 0 -1\nusemtl red\nf 1 2 3\n";
+        let mtl = "newmtl red\nKd 1 0 0\n";
+        let files: Vec<(&str, &str)> = vec![("mem/a.obj", obj), ("mem/m.mtl", mtl)];
+        let read = |p: &Path| -> Result<Vec<u8>, String> {
+            files
+                .iter()
+                .find(|(n, _)| Path::new(n) == p)
+                .map(|(_, t)| t.as_bytes().to_vec())
+                .ok_or_else(|| format!("no {}", p.display()))
+        };
+        let a = load_asset(Path::new("mem/a.obj"), &read).unwrap();
+        assert_eq!(a.mesh.faces.len(), 1);
+        assert_eq!(
+            a.mesh.materials[a.mesh.faces[0].material as usize].color,
+            [1.0, 0.0, 0.0]
+        );
+        let e = load_asset(Path::new("mem/b.dae"), &read).unwrap_err();
+        assert!(e.contains("mem/b.dae") && e.contains("no mem/b.dae"), "{e}");
+        let e = load_asset(Path::new("mem/a.FBX"), &read).unwrap_err();
+        assert!(e.contains("FBX assets are not read"), "{e}");
+    }
 
     #[test]
     fn up_axes() {

@@ -45,6 +45,7 @@
 //! the largest coordinate magnitude (at least 1) of a plane lie on it.
 
 use std::cell::Cell;
+use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use glam::{DVec2, DVec3};
@@ -94,27 +95,44 @@ pub struct BoolResult {
 /// Closed operands give a closed result. Never panics; degenerate faces
 /// (fewer than three corners, no area) take no part in the operation.
 pub fn boolean(a: &Mesh, b: &Mesh, op: BoolOp) -> BoolResult {
-    match boolean_within(a, b, op, None) {
+    match boolean_within(a, b, op, Stop::NEVER) {
         Ok(r) => r,
         Err(TimedOut) => unreachable!("no deadline, no time out"),
     }
 }
 
-/// The operation gave up at its deadline.
+/// The operation gave up at its deadline, or was cancelled.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TimedOut;
 
-/// [`boolean`] that gives up once `deadline` has passed. Operands of many
+/// When a long operation should give up: a point in time, or a flag
+/// another thread sets (a cancelled generation).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Stop<'a> {
+    pub deadline: Option<Instant>,
+    pub cancel: Option<&'a AtomicBool>,
+}
+
+impl Stop<'_> {
+    /// Never gives up.
+    pub const NEVER: Stop<'static> = Stop {
+        deadline: None,
+        cancel: None,
+    };
+}
+
+/// [`boolean`] that gives up once `stop` says so. Operands of many
 /// thousands of faces can make the BSP trees fragment their polygons into
 /// millions (each clip splits polygons by the other tree's planes), which
-/// takes minutes: the engine's time limit must hold inside one operation.
+/// takes minutes: the engine's time limit and cancellation must hold
+/// inside one operation.
 pub fn boolean_within(
     a: &Mesh,
     b: &Mesh,
     op: BoolOp,
-    deadline: Option<Instant>,
+    stop: Stop<'_>,
 ) -> Result<BoolResult, TimedOut> {
-    let clock = Clock::new(deadline);
+    let clock = Clock::new(stop);
     let scale = a
         .positions
         .iter()
@@ -160,33 +178,41 @@ pub fn boolean_within(
     boolean_3d(a, b, op, &tol, &clock)
 }
 
-/// Tells the loops of an operation when its deadline has passed (looking
-/// at the time at the first question and every 256th; once passed, always).
-struct Clock {
-    deadline: Option<Instant>,
+/// Tells the loops of an operation when to give up (looking at the time
+/// and the cancel flag at the first question and every 256th; once passed,
+/// always).
+struct Clock<'a> {
+    stop: Stop<'a>,
     asked: Cell<u32>,
     passed: Cell<bool>,
 }
 
-impl Clock {
-    fn new(deadline: Option<Instant>) -> Clock {
+impl<'a> Clock<'a> {
+    fn new(stop: Stop<'a>) -> Clock<'a> {
         Clock {
-            deadline,
+            stop,
             asked: Cell::new(0),
             passed: Cell::new(false),
         }
     }
 
     fn passed(&self) -> bool {
-        let Some(deadline) = self.deadline else {
+        if self.stop.deadline.is_none() && self.stop.cancel.is_none() {
             return false;
-        };
+        }
         if !self.passed.get() {
             let n = self.asked.get().wrapping_add(1);
             self.asked.set(n);
             // The first question and every 256th look at the time.
-            if n % 256 == 1 && Instant::now() >= deadline {
-                self.passed.set(true);
+            if n % 256 == 1 {
+                let late = self.stop.deadline.is_some_and(|d| Instant::now() >= d);
+                let cancelled = self
+                    .stop
+                    .cancel
+                    .is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed));
+                if late || cancelled {
+                    self.passed.set(true);
+                }
             }
         }
         self.passed.get()
@@ -358,7 +384,7 @@ struct Node {
 struct Bsp<'c> {
     nodes: Vec<Node>,
     eps: f64,
-    clock: &'c Clock,
+    clock: &'c Clock<'c>,
 }
 
 impl<'c> Bsp<'c> {
@@ -584,7 +610,7 @@ fn boolean_3d(
     b: &Mesh,
     op: BoolOp,
     tol: &Tol,
-    clock: &Clock,
+    clock: &Clock<'_>,
 ) -> Result<BoolResult, TimedOut> {
     let mut srcs = Vec::new();
     let pa = polygons(a, 0, tol.plane, &mut srcs);
@@ -743,7 +769,7 @@ fn finish(
     out: [Mesh; 2],
     tol: &Tol,
     mut sources: Vec<FaceSource>,
-    clock: &Clock,
+    clock: &Clock<'_>,
 ) -> Result<BoolResult, TimedOut> {
     let [mut ma, mb] = out;
     sources.resize(ma.faces.len(), FaceSource::A);
@@ -1014,7 +1040,7 @@ fn boolean_2d(
     op: BoolOp,
     (n, w): (DVec3, f64),
     tol: &Tol,
-    clock: &Clock,
+    clock: &Clock<'_>,
 ) -> Result<BoolResult, TimedOut> {
     let (u, v) = plane_basis(n);
     let fr = Frame2 { u, v, n, w };
@@ -1133,7 +1159,7 @@ fn boolean_2d(
 /// without area, and inserts into every edge the vertices lying on it
 /// (T-junctions), interpolating per-corner attributes. Returns, per input
 /// face, whether it was kept.
-fn stitch(mesh: &mut Mesh, tol: f64, clock: &Clock) -> Result<Vec<bool>, TimedOut> {
+fn stitch(mesh: &mut Mesh, tol: f64, clock: &Clock<'_>) -> Result<Vec<bool>, TimedOut> {
     let weld = weld_points(&mesh.positions, tol);
     let positions: Vec<DVec3> = weld
         .representative
@@ -1296,11 +1322,32 @@ mod tests {
         let b = boxm(DVec3::ONE, DVec3::ONE * 2.0);
         let past = Instant::now();
         for op in [BoolOp::Union, BoolOp::Subtract, BoolOp::Intersect] {
-            assert_eq!(boolean_within(&a, &b, op, Some(past)).err(), Some(TimedOut));
+            let at = |deadline| Stop {
+                deadline: Some(deadline),
+                cancel: None,
+            };
+            assert_eq!(boolean_within(&a, &b, op, at(past)).err(), Some(TimedOut));
             let later = Instant::now() + std::time::Duration::from_secs(3600);
-            let r = boolean_within(&a, &b, op, Some(later)).unwrap();
+            let r = boolean_within(&a, &b, op, at(later)).unwrap();
             assert_eq!(r.mesh.faces.len(), boolean(&a, &b, op).mesh.faces.len());
         }
+    }
+
+    #[test]
+    fn a_set_cancel_flag_gives_up() {
+        let a = boxm(DVec3::ZERO, DVec3::ONE * 2.0);
+        let b = boxm(DVec3::ONE, DVec3::ONE * 2.0);
+        let flag = AtomicBool::new(true);
+        let stop = Stop {
+            deadline: None,
+            cancel: Some(&flag),
+        };
+        assert_eq!(
+            boolean_within(&a, &b, BoolOp::Union, stop).err(),
+            Some(TimedOut)
+        );
+        flag.store(false, std::sync::atomic::Ordering::Relaxed);
+        assert!(boolean_within(&a, &b, BoolOp::Union, stop).is_ok());
     }
 
     fn unit_at(lo: f64) -> Mesh {

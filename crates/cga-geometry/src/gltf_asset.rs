@@ -21,27 +21,29 @@ use base64::Engine as _;
 use glam::{DAffine3, DMat4, DVec2, DVec3};
 use gltf::mesh::Mode;
 
-use crate::asset_mesh::{percent_decode, MeshBuilder, Placement};
+use crate::asset_mesh::{percent_decode, MeshBuilder, Placement, ReadFile};
 use crate::material::Material;
 use crate::obj::{ObjAsset, ObjError};
 
 /// Node nesting followed at most (a malformed file may loop).
 const MAX_DEPTH: usize = 64;
 
-/// Loads a `.gltf` or `.glb` file; external buffers and images are read
-/// relative to its folder.
+/// Loads a `.gltf` or `.glb` file from disk; external buffers and images
+/// are read relative to its folder.
 pub fn load_gltf(path: &Path) -> Result<ObjAsset, ObjError> {
     let bytes = std::fs::read(path).map_err(|e| ObjError::Io {
         path: path.display().to_string(),
         message: e.to_string(),
     })?;
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    parse_gltf(&bytes, &dir)
+    parse_gltf(&bytes, &dir, &|p: &Path| {
+        std::fs::read(p).map_err(|e| format!("cannot read '{}': {e}", p.display()))
+    })
 }
 
 /// Parses glTF JSON or GLB bytes; `dir` is the folder external buffers and
-/// images are relative to.
-pub fn parse_gltf(bytes: &[u8], dir: &Path) -> Result<ObjAsset, ObjError> {
+/// images are relative to, `read` reads external buffers.
+pub fn parse_gltf(bytes: &[u8], dir: &Path, read: &ReadFile) -> Result<ObjAsset, ObjError> {
     let bad = |message: String| ObjError::Parse { line: 0, message };
     let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| bad(format!("not a glTF file: {e}")))?;
     let mut warnings = Vec::new();
@@ -49,7 +51,7 @@ pub fn parse_gltf(bytes: &[u8], dir: &Path) -> Result<ObjAsset, ObjError> {
     for buffer in gltf.document.buffers() {
         let data = match buffer.source() {
             gltf::buffer::Source::Bin => gltf.blob.clone().unwrap_or_default(),
-            gltf::buffer::Source::Uri(uri) => read_uri(uri, dir).map_err(bad)?,
+            gltf::buffer::Source::Uri(uri) => read_uri(uri, dir, read).map_err(bad)?,
         };
         if data.len() < buffer.length() {
             return Err(bad(format!(
@@ -87,7 +89,7 @@ pub fn parse_gltf(bytes: &[u8], dir: &Path) -> Result<ObjAsset, ObjError> {
 }
 
 /// The bytes of a buffer URI: base64 data or a file next to the asset.
-fn read_uri(uri: &str, dir: &Path) -> Result<Vec<u8>, String> {
+fn read_uri(uri: &str, dir: &Path, read: &ReadFile) -> Result<Vec<u8>, String> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let (_, data) = rest
             .split_once(";base64,")
@@ -96,8 +98,7 @@ fn read_uri(uri: &str, dir: &Path) -> Result<Vec<u8>, String> {
             .decode(data)
             .map_err(|e| format!("bad base64 buffer: {e}"));
     }
-    let p = dir.join(percent_decode(uri));
-    std::fs::read(&p).map_err(|e| format!("cannot read buffer '{}': {e}", p.display()))
+    read(&dir.join(percent_decode(uri)))
 }
 
 struct Reader<'a> {

@@ -172,7 +172,7 @@ fn combine(
         bake_material(&mut b.mesh, &b.shape.material);
         a.shape.material = Arc::new(MaterialOverrides::default());
     }
-    let mut r = boolean_within(&a.mesh, &b.mesh, op, cx.deadline())
+    let mut r = boolean_within(&a.mesh, &b.mesh, op, cx.stop())
         .map_err(|_| cx.time_limit_error(call.span))?;
     // Auto-tags: `bool.A` on the faces from A (or both operands), `bool.B`
     // on those from B (or both). The edges where faces of different

@@ -146,7 +146,7 @@ pub fn exec(
             let mut out = pieces.next().map(std::mem::take).unwrap_or_default();
             for m in pieces {
                 use cga_geometry::boolean::{boolean_within, BoolOp};
-                out = boolean_within(&out, m, BoolOp::Union, cx.deadline())
+                out = boolean_within(&out, m, BoolOp::Union, cx.stop())
                     .map_err(|_| cx.time_limit_error(call.span))?
                     .mesh;
             }

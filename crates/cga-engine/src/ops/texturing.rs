@@ -37,7 +37,6 @@
 
 pub mod insert_along_uv;
 
-use std::io::Read;
 use std::sync::Arc;
 
 use cga_geometry::measure::{uv_bounds, uv_unit_scale};
@@ -317,8 +316,15 @@ pub fn project_uv(shape: &mut Shape, set: usize, p: &Projection) {
         uvs.clear();
         uvs.extend(m.corners.iter().map(|&c| at[c as usize]));
         m.uvs[set] = Some(uvs);
+        // The room of one huge mesh is not kept for the thread's lifetime.
+        if at.capacity() > KEPT_PROJECTED {
+            *at = Vec::new();
+        }
     });
 }
+
+/// Positions' room kept between projections (a building's largest meshes).
+const KEPT_PROJECTED: usize = 1 << 16;
 
 thread_local! {
     /// The texture coordinates of each position, reused by `project_uv`.
@@ -531,7 +537,7 @@ impl TextureFiles {
         if let Some(&a) = self.alpha.get(&file) {
             return a;
         }
-        let a = assets.texture_alpha(&file, |f| image_has_alpha(std::path::Path::new(f)));
+        let a = assets.texture_alpha(&file, |head| image_has_alpha(&file, head));
         self.alpha.insert(file, a);
         a
     }
@@ -563,21 +569,13 @@ impl TextureFiles {
     }
 }
 
-/// Reads just enough of an image file to tell whether it has an alpha
-/// channel.
-fn image_has_alpha(path: &std::path::Path) -> bool {
-    let Ok(file) = std::fs::File::open(path) else {
-        return false;
-    };
-    // PNG chunks before the image data are small; 64 KiB covers them.
-    let mut head = Vec::new();
-    if file.take(1 << 16).read_to_end(&mut head).is_err() {
-        return false;
-    }
+/// Whether an image file, of which `head` holds the first bytes, has an
+/// alpha channel.
+fn image_has_alpha(path: &str, head: &[u8]) -> bool {
     if head.starts_with(b"\x89PNG\r\n\x1a\n") {
-        return png_has_alpha(&head);
+        return png_has_alpha(head);
     }
-    let ext = path
+    let ext = std::path::Path::new(path)
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase());
     if ext.as_deref() == Some("tga") && head.len() >= 18 {

@@ -33,18 +33,18 @@ pub fn run_on(name: &str, text: &str, lot: &Lot, start: &str) -> Run {
     let path = dir.join(format!("{name}.cga"));
     std::fs::write(&path, text.replace("{DIR}", &assets_dir())).expect("write rules");
     let mut sources = SourceMap::new();
-    let loaded = cga_engine::load(&path, &mut sources);
+    let loaded = cga_engine::load(&cga_world::DiskWorld, &path, &mut sources);
     let errors: Vec<String> = loaded
         .diagnostics
         .iter()
         .filter(|d| d.is_error())
         .map(|d| d.message.clone())
         .collect();
-    let Some(program) = loaded.program else {
+    let Some(program) = errors.is_empty().then_some(loaded.program) else {
         panic!("rules do not load: {errors:?}");
     };
     let rule = program.start_rule(Some(start)).expect("start rule");
-    let assets = Assets::new(&sources);
+    let assets = Assets::on_disk(&sources);
     let (out, error) = generate_lot(&program, &assets, rule, lot, 0, &GenerateOptions::default());
     Run {
         prints: out.prints,
@@ -66,8 +66,8 @@ pub fn load_errors(name: &str, text: &str) -> Vec<String> {
     let path = dir.join(format!("{name}.cga"));
     std::fs::write(&path, text).expect("write rules");
     let mut sources = SourceMap::new();
-    let loaded = cga_engine::load(&path, &mut sources);
-    assert!(loaded.program.is_none(), "rules should not load");
+    let loaded = cga_engine::load(&cga_world::DiskWorld, &path, &mut sources);
+    assert!(loaded.has_errors(), "rules should not load");
     loaded
         .diagnostics
         .iter()

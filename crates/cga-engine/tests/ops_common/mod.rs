@@ -135,8 +135,9 @@ pub fn gen_seeds(src: &str, opts: &Opts, seeds: &[u64]) -> Vec<Gen> {
 #[track_caller]
 fn gen_file_seeds(path: &Path, opts: &Opts, seeds: &[u64]) -> Vec<Gen> {
     let mut sources = SourceMap::new();
-    let loaded = cga_engine::load(path, &mut sources);
-    let Some(program) = loaded.program else {
+    let loaded = cga_engine::load(&cga_world::DiskWorld, path, &mut sources);
+    let errors = loaded.has_errors();
+    let Some(program) = (!errors).then_some(loaded.program) else {
         let text: String = loaded
             .diagnostics
             .iter()
@@ -154,7 +155,7 @@ fn gen_file_seeds(path: &Path, opts: &Opts, seeds: &[u64]) -> Vec<Gen> {
             .unwrap_or_else(|| panic!("no attribute {name}"));
         attrs.push((id, v.clone()));
     }
-    let assets = Assets::new(&sources);
+    let assets = Assets::on_disk(&sources);
     seeds
         .iter()
         .map(|&seed| {

@@ -27,18 +27,16 @@ pub fn run_in(dir: &Path, text: &str, lot: &Lot) -> LotOutput {
     let path = dir.join("rules/main.cga");
     std::fs::write(&path, text).unwrap();
     let mut sources = SourceMap::new();
-    let loaded = cga_engine::load(&path, &mut sources);
-    let program = loaded.program.unwrap_or_else(|| {
-        panic!(
-            "rule errors: {}",
-            loaded
-                .diagnostics
-                .iter()
-                .map(|d| d.render(&sources))
-                .collect::<String>()
-        )
-    });
-    let assets = Assets::new(&sources);
+    let loaded = cga_engine::load(&cga_world::DiskWorld, &path, &mut sources);
+    let rendered: String = loaded
+        .diagnostics
+        .iter()
+        .map(|d| d.render(&sources))
+        .collect();
+    let program = loaded
+        .usable()
+        .unwrap_or_else(|| panic!("rule errors: {rendered}"));
+    let assets = Assets::on_disk(&sources);
     let rule = program.start_rule(Some("Lot")).unwrap();
     let (out, error) = generate_lot(&program, &assets, rule, lot, 0, &GenerateOptions::default());
     if let Some(e) = error {

@@ -1,0 +1,181 @@
+//! Models as plain arrays, for programs that use the geometry themselves
+//! (a Python user's numpy arrays, a viewer's buffers) instead of a file.
+//!
+//! Faces are placed, triangulated and left out exactly as the file writers
+//! do (`prepare`): a [`PlainModel`] holds the triangles a GLB of the same
+//! leaves holds, in coordinates of `f64`, with each triangle's leaf.
+
+use cga_geometry::mesh::SharedVec;
+use cga_geometry::{DAffine3, Material, Mesh};
+
+use crate::hash::FastMap;
+use crate::materials::MaterialTable;
+use crate::prepare::{FacePrep, SlotIds};
+use crate::{check_mesh, ExportError};
+
+/// The triangles of one material.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PlainMesh {
+    /// Index into [`PlainModel::materials`].
+    pub material: usize,
+    /// Vertex positions (object coordinates, metres; y up).
+    pub positions: Vec<[f64; 3]>,
+    /// Unit normal per vertex: the mesh's own, else its face's.
+    pub normals: Vec<[f64; 3]>,
+    /// Texture coordinates of UV set 0 per vertex, as CGA has them
+    /// (v up); (0, 0) where the face has none.
+    pub uvs: Vec<[f64; 2]>,
+    /// Three vertex indices per triangle, counter-clockwise seen from the
+    /// side the normal points to.
+    pub indices: Vec<[u32; 3]>,
+    /// Per triangle, the leaf it comes from (the number given to
+    /// [`PlainCollector::add_placed`]).
+    pub triangle_leaf: Vec<u32>,
+}
+
+/// Meshes by material.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PlainModel {
+    /// Distinct materials, in order of first use.
+    pub materials: Vec<Material>,
+    /// One mesh per material, in the order of `materials`.
+    pub meshes: Vec<PlainMesh>,
+    /// Faces written (before triangulation).
+    pub faces: u64,
+    /// Faces left out for non-finite coordinates.
+    pub skipped_non_finite: u64,
+}
+
+impl PlainModel {
+    /// Triangles over all meshes.
+    pub fn triangles(&self) -> usize {
+        self.meshes.iter().map(|m| m.indices.len()).sum()
+    }
+}
+
+/// Gathers leaves into a [`PlainModel`].
+#[derive(Default)]
+pub struct PlainCollector {
+    prep: FacePrep,
+    slots: SlotIds,
+    table: MaterialTable,
+    model: PlainModel,
+    /// The vertex of each corner of the face being added.
+    corner_vertex: FastMap<u32, u32>,
+}
+
+impl PlainCollector {
+    pub fn new() -> PlainCollector {
+        PlainCollector::default()
+    }
+
+    /// Adds one leaf's geometry given in its own coordinates, placed by
+    /// `transform`, with `materials` for its slots (as
+    /// [`ModelWriter::add_placed`](crate::ModelWriter::add_placed) takes
+    /// them); its triangles are marked with `leaf`.
+    pub fn add_placed(
+        &mut self,
+        mesh: &Mesh,
+        transform: Option<&DAffine3>,
+        materials: &SharedVec<Material>,
+        leaf: u32,
+    ) -> Result<(), ExportError> {
+        check_mesh(mesh, materials.len())?;
+        let PlainCollector {
+            prep,
+            slots,
+            table,
+            model,
+            corner_vertex,
+        } = self;
+        slots.begin(materials);
+        let skipped = prep.faces(mesh, transform, |f| {
+            let id = slots.id(f.material, || {
+                let (id, new) = table.intern(&materials[f.material as usize]);
+                if new {
+                    model.materials.push(table.get(id).clone());
+                    model.meshes.push(PlainMesh {
+                        material: id as usize,
+                        ..PlainMesh::default()
+                    });
+                }
+                id
+            });
+            let out = &mut model.meshes[id as usize];
+            let uvs = f.mesh.uvs[0].as_deref();
+            corner_vertex.clear();
+            for tri in f.triangles {
+                let mut ids = [0u32; 3];
+                for (k, &c) in tri.iter().enumerate() {
+                    ids[k] = *corner_vertex.entry(c).or_insert_with(|| {
+                        let p = f.positions[f.mesh.corners[c as usize] as usize];
+                        let n = f.normals.map_or(f.normal, |n| n[c as usize]);
+                        let uv = uvs.and_then(|u| u.get(c as usize)).copied();
+                        out.positions.push(p.to_array());
+                        out.normals.push(n.to_array());
+                        out.uvs.push(uv.map_or([0.0; 2], |t| t.to_array()));
+                        (out.positions.len() - 1) as u32
+                    });
+                }
+                out.indices.push(ids);
+                out.triangle_leaf.push(leaf);
+            }
+            model.faces += 1;
+            Ok(())
+        });
+        slots.end(materials);
+        model.skipped_non_finite += skipped?;
+        Ok(())
+    }
+
+    /// The model gathered so far; the collector starts a new one.
+    pub fn take(&mut self) -> PlainModel {
+        self.table = MaterialTable::default();
+        self.slots.clear();
+        std::mem::take(&mut self.model)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cga_geometry::DVec3;
+
+    #[test]
+    fn a_cube_gives_twelve_triangles_of_one_material() {
+        let cube = cga_geometry::primitive::cube(DVec3::new(2.0, 3.0, 4.0));
+        let mut c = PlainCollector::new();
+        let shift = DAffine3::from_translation(DVec3::new(10.0, 0.0, 0.0));
+        c.add_placed(&cube, Some(&shift), &cube.materials, 7)
+            .unwrap();
+        let m = c.take();
+        assert_eq!(m.materials.len(), 1);
+        assert_eq!(m.faces, 6);
+        let mesh = &m.meshes[0];
+        assert_eq!(mesh.indices.len(), 12);
+        assert_eq!(mesh.triangle_leaf, vec![7; 12]);
+        // Each face has its own four corners (flat normals).
+        assert_eq!(mesh.positions.len(), 24);
+        let xs: Vec<f64> = mesh.positions.iter().map(|p| p[0]).collect();
+        assert_eq!(xs.iter().cloned().fold(f64::INFINITY, f64::min), 10.0);
+        assert_eq!(xs.iter().cloned().fold(f64::NEG_INFINITY, f64::max), 12.0);
+        // Triangle areas add up to the cube's surface.
+        let area: f64 = mesh
+            .indices
+            .iter()
+            .map(|t| {
+                let p = |i: u32| DVec3::from_array(mesh.positions[i as usize]);
+                (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0])).length() / 2.0
+            })
+            .sum();
+        assert!((area - 2.0 * (6.0 + 8.0 + 12.0)).abs() < 1e-9);
+        // Normals point out of the cube.
+        for (t, _) in mesh.indices.iter().zip(0..) {
+            let p = |i: u32| DVec3::from_array(mesh.positions[i as usize]);
+            let geometric = (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0]));
+            let n = DVec3::from_array(mesh.normals[t[0] as usize]);
+            assert!(geometric.dot(n) > 0.0);
+        }
+        assert!(c.take().meshes.is_empty());
+    }
+}

@@ -1,0 +1,457 @@
+//! Generating lots: one on the calling thread's behalf, or many in
+//! parallel and in order, into plain meshes or a model file.
+
+use std::sync::Arc;
+
+use cga_engine::context::{LotContext, SceneContext};
+use cga_engine::derive::{Leaf, RtErrorKind};
+use cga_engine::generate::{collect_lot, generate_lot_streaming};
+use cga_engine::{GenerateOptions, LotOutput, RtError};
+use cga_export::{ModelWriter, PlainCollector};
+
+use crate::diagnostics::Diagnostic;
+use crate::lots::Lot;
+use crate::model::{LeafOrigin, LotResult, Summary};
+use crate::options::Options;
+use crate::pipeline::{run_pipeline, Taken};
+use crate::rules::{RuleRef, Rules};
+use crate::stack::{on_big_stack, STACK_SIZE};
+use crate::Error;
+
+/// Where the geometry of generated lots goes.
+pub enum Target<'w> {
+    /// Nowhere: only prints, reports and diagnostics are wanted.
+    Nothing,
+    /// Into each lot's [`LotResult::model`], as plain arrays.
+    Meshes,
+    /// Into a model file (streamed: memory does not grow with the lots).
+    Writer(&'w mut ModelWriter),
+}
+
+impl Rules {
+    /// Generates one lot, with its geometry as plain meshes. A lot stopped
+    /// by an error (in the rules, or a limit) is still a result, with the
+    /// error in [`LotResult::error`].
+    pub fn generate(&self, lot: &Lot, options: &Options) -> Result<LotResult, Error> {
+        let mut out = None;
+        self.generate_lots(std::slice::from_ref(lot), options, Target::Meshes, |r| {
+            out = Some(r)
+        })?;
+        Ok(out.unwrap_or_default())
+    }
+
+    /// Generates `lots` in parallel, their geometry as plain meshes, and
+    /// gives the results in lot order.
+    pub fn generate_all(&self, lots: &[Lot], options: &Options) -> Result<Vec<LotResult>, Error> {
+        let mut out = Vec::with_capacity(lots.len());
+        self.generate_lots(lots, options, Target::Meshes, |r| out.push(r))?;
+        Ok(out)
+    }
+
+    /// Generates `lots` on [`Options::jobs`] threads, the geometry into
+    /// `target`, and hands each lot's result to `each` on the calling
+    /// thread in lot order, as lots finish: the output does not depend on
+    /// the number of threads, and memory holds only a few lots per thread
+    /// at a time. Programs with context queries between lots derive every
+    /// lot twice (the first pass records what the queries look at).
+    pub fn generate_lots(
+        &self,
+        lots: &[Lot],
+        options: &Options,
+        target: Target<'_>,
+        mut each: impl FnMut(LotResult),
+    ) -> Result<Summary, Error> {
+        self.check_usable()?;
+        let started = std::time::Instant::now();
+        let rule = self.start_rule(options.start_rule.as_deref())?;
+        let mut engine_options = self.engine_options(options)?;
+        let jobs = options.threads().min(lots.len().max(1));
+        let program = &self.inner.program;
+        let assets = &self.inner.assets;
+        let usage = self.inner.context_use;
+        engine_options.context_use = Some(usage);
+        if usage.inter && lots.len() > 1 {
+            engine_options.scene = Some(Arc::new(self.collect_scene(
+                rule,
+                lots,
+                &engine_options,
+                jobs,
+            )?));
+        }
+        let cancelled = || options.cancel.as_ref().is_some_and(|c| c.is_cancelled());
+        if cancelled() {
+            return Err(Error::Cancelled);
+        }
+
+        let (mut writer, keep_meshes) = match target {
+            Target::Nothing => (None, false),
+            Target::Meshes => (None, true),
+            Target::Writer(w) => (Some(w), false),
+        };
+        // Leaves go to the calling thread in batches as they are emitted,
+        // so that writing the model overlaps deriving it, even for a single
+        // lot. For glTF and GLB with several workers, the workers encode
+        // them into vertex data first, leaving the calling thread little to
+        // do; with one worker, the calling thread encodes the leaves it is
+        // sent, so that two threads share the work. Either way a lot's
+        // leaves are encoded in the same batches (`Batcher`), so the model
+        // is written out at the same points and the file is the same.
+        // Plain meshes are made on the workers, per lot.
+        let encoder = writer.as_ref().and_then(|w| w.encoder());
+        let workers_encode = jobs > 1;
+        let has_writer = writer.is_some();
+        let new_batcher = || match &encoder {
+            Some(e) if workers_encode => Batcher::Encode(Box::new(e.another()), 0),
+            _ if has_writer => Batcher::Leaves(Vec::new()),
+            _ if keep_meshes => Batcher::Plain(Box::default(), 0),
+            _ => Batcher::Drop,
+        };
+        let mut own_batcher = match &encoder {
+            Some(e) if !workers_encode => Some(Batcher::Encode(Box::new(e.another()), 0)),
+            _ => None,
+        };
+        let mut summary = Summary {
+            lots: lots.len(),
+            ..Summary::default()
+        };
+        let mut take = |i: usize, taken: Taken<Piece, Done>| -> Result<(), Error> {
+            let mut result = Ok(());
+            let mut write = |piece| {
+                if let (Some(w), Ok(())) = (writer.as_deref_mut(), &result) {
+                    result = write_piece(w, piece);
+                }
+            };
+            let done = match (taken, &mut own_batcher) {
+                (Taken::Piece(Piece::Leaves(batch)), Some(own)) => {
+                    for leaf in batch {
+                        own.add(leaf, &mut write);
+                    }
+                    return result.map_err(Error::Export);
+                }
+                (Taken::Piece(piece), _) => {
+                    write(piece);
+                    return result.map_err(Error::Export);
+                }
+                (Taken::Done(done), own) => {
+                    if let Some(own) = own {
+                        own.flush(&mut write);
+                    }
+                    result.map_err(Error::Export)?;
+                    done
+                }
+            };
+            if done
+                .error
+                .as_ref()
+                .is_some_and(|e| e.kind == RtErrorKind::Cancelled)
+            {
+                return Err(Error::Cancelled);
+            }
+            let lot = self.lot_result(i, &lots[i], done);
+            summary.failed += lot.error.is_some() as usize;
+            summary.shapes += lot.shapes;
+            summary.leaves += lot.leaf_count;
+            each(lot);
+            Ok(())
+        };
+        let generate_one = |batcher: &mut Batcher, i: usize, send: &mut dyn FnMut(Piece)| {
+            let mut leaves = 0usize;
+            let mut origins = Vec::new();
+            let (out, error) = generate_lot_streaming(
+                program,
+                assets,
+                rule.0,
+                &lots[i],
+                i,
+                &engine_options,
+                |leaf| {
+                    leaves += 1;
+                    batcher.add_origin(&leaf, program, &mut origins);
+                    batcher.add(leaf, send)
+                },
+            );
+            batcher.flush(send);
+            let model = batcher.take_model();
+            Done {
+                out,
+                error,
+                leaves,
+                model,
+                origins,
+            }
+        };
+        if lots.len() == 1 && !has_writer {
+            // One lot and nothing to overlap with: derived here (on a stack
+            // with room), without worker threads.
+            let mut batcher = new_batcher();
+            let done = on_big_stack(|| generate_one(&mut batcher, 0, &mut |_| {}));
+            take(0, Taken::Done(done))?;
+        } else {
+            run_pipeline(lots.len(), jobs, new_batcher, generate_one, &mut take)?;
+        }
+        summary.derived_after = started.elapsed().as_secs_f64();
+        Ok(summary)
+    }
+
+    /// Whether `options` name only attributes the rules have, with values
+    /// they can take (what [`Rules::generate_lots`] would refuse, found
+    /// before generating).
+    pub fn check_attributes(&self, options: &Options) -> Result<(), Error> {
+        self.engine_options(options).map(|_| ())
+    }
+
+    /// The engine's options for `options`: attribute names resolved.
+    fn engine_options(&self, options: &Options) -> Result<GenerateOptions, Error> {
+        let program = &self.inner.program;
+        let mut out = GenerateOptions {
+            seed: options.seed,
+            limits: options.limits,
+            // Leaves are placed where they are written: none is copied into
+            // object coordinates first.
+            leaves: true,
+            cancel: options.cancel.as_ref().map(|c| c.flag()),
+            ..GenerateOptions::default()
+        };
+        for (name, value) in &options.attrs {
+            match program.main_attr(name) {
+                Some(id) => out.attrs.push((id, value.clone())),
+                // As in CityEngine, `seed` is the initial shapes' random
+                // seed unless the rules declare an attribute of that name.
+                None if name == "seed" => {
+                    out.seed = match value {
+                        cga_value::Value::Float(x) if *x >= 0.0 && x.fract() == 0.0 => *x as u64,
+                        other => {
+                            return Err(Error::Value(format!(
+                                "the seed must be a whole number, found `{}`",
+                                cga_engine::values::to_text(other)
+                            )))
+                        }
+                    }
+                }
+                None => {
+                    return Err(Error::UnknownAttribute {
+                        name: name.clone(),
+                        known: program.main_attrs.iter().map(|(n, _)| n.clone()).collect(),
+                    })
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// The first pass of every lot (see `cga_engine::context`), for programs
+    /// with `inter` context queries, on `jobs` threads. Each lot's records
+    /// are put at its index, so the scene, and with it the output, does not
+    /// depend on the number of threads.
+    fn collect_scene(
+        &self,
+        rule: RuleRef,
+        lots: &[Lot],
+        options: &GenerateOptions,
+        jobs: usize,
+    ) -> Result<SceneContext, Error> {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        let (program, assets) = (&self.inner.program, &self.inner.assets);
+        let next = AtomicUsize::new(0);
+        let work = || {
+            let mut done = Vec::new();
+            loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                if i >= lots.len() {
+                    break;
+                }
+                done.push((
+                    i,
+                    collect_lot(program, assets, rule.0, &lots[i], i, options),
+                ));
+            }
+            done
+        };
+        let mut slots: Vec<Option<LotContext>> =
+            std::iter::repeat_with(|| None).take(lots.len()).collect();
+        std::thread::scope(|scope| {
+            let mut workers = Vec::new();
+            for _ in 0..jobs.min(lots.len()) {
+                let worker = std::thread::Builder::new()
+                    .stack_size(STACK_SIZE)
+                    .spawn_scoped(scope, work)
+                    .map_err(Error::Threads)?;
+                workers.push(worker);
+            }
+            for w in workers {
+                // A worker that panicked leaves its lots empty: their second
+                // pass runs again and reports what went wrong there.
+                for (i, records) in w.join().unwrap_or_default() {
+                    slots[i] = Some(records);
+                }
+            }
+            Ok::<(), Error>(())
+        })?;
+        let records = slots
+            .into_iter()
+            .map(|r| r.unwrap_or_else(|| LotContext::new(None)))
+            .collect();
+        Ok(SceneContext::new(
+            records,
+            options.context_use.unwrap_or_default(),
+        ))
+    }
+
+    fn lot_result(&self, index: usize, lot: &Lot, done: Done) -> LotResult {
+        let sources = &self.inner.sources;
+        let Done {
+            out,
+            error,
+            leaves,
+            model,
+            origins,
+        } = done;
+        let LotOutput {
+            prints,
+            reports,
+            warnings,
+            shapes,
+            ..
+        } = out;
+        LotResult {
+            index,
+            name: lot.name.clone(),
+            model,
+            leaves: origins,
+            leaf_count: leaves,
+            prints,
+            reports,
+            warnings: warnings
+                .iter()
+                .map(|w| Diagnostic::new(w, sources))
+                .collect(),
+            error: error.map(|e| Diagnostic::new(&e.to_diagnostic(), sources)),
+            shapes,
+        }
+    }
+}
+
+/// What a worker hands over at the end of a lot.
+struct Done {
+    out: LotOutput,
+    error: Option<RtError>,
+    leaves: usize,
+    model: cga_export::PlainModel,
+    origins: Vec<LeafOrigin>,
+}
+
+/// Writes a piece of a lot's output.
+fn write_piece(w: &mut ModelWriter, piece: Piece) -> Result<(), cga_export::ExportError> {
+    match piece {
+        Piece::Leaves(batch) => batch
+            .iter()
+            .try_for_each(|leaf| w.add_placed(&leaf.mesh, Some(&leaf.transform), &leaf.materials)),
+        Piece::Encoded(batch) => w.append(batch),
+    }
+}
+
+/// A piece of a lot's output on its way to the calling thread.
+enum Piece {
+    /// Leaves, for writers that take meshes (OBJ).
+    Leaves(Vec<Leaf>),
+    /// Leaves encoded into vertex data (glTF, GLB).
+    Encoded(cga_export::Encoded),
+}
+
+/// Leaves per piece at most: a message per leaf would wake the calling
+/// thread for each (a system call apiece).
+const LEAF_BATCH: usize = 512;
+
+/// Encoded vertex data per piece at most, in bytes: large enough that the
+/// calling thread is seldom woken, small enough to keep little in flight.
+const ENCODED_BATCH_BYTES: usize = 1 << 20;
+
+/// How a worker gathers its leaves.
+enum Batcher {
+    /// No geometry wanted: leaves are dropped where they are made.
+    Drop,
+    Leaves(Vec<Leaf>),
+    /// The leaves encoded so far into the encoder's batch, and their count.
+    Encode(Box<cga_export::Encoder>, usize),
+    /// Plain meshes of the lot, and the number of leaves added so far.
+    Plain(Box<PlainCollector>, u32),
+}
+
+impl Batcher {
+    fn add(&mut self, leaf: Leaf, send: &mut dyn FnMut(Piece)) {
+        match self {
+            Batcher::Drop => {}
+            Batcher::Leaves(batch) => {
+                batch.push(leaf);
+                if batch.len() == LEAF_BATCH {
+                    let full = std::mem::replace(batch, Vec::with_capacity(LEAF_BATCH));
+                    send(Piece::Leaves(full));
+                }
+            }
+            Batcher::Encode(encoder, n) => {
+                encoder.add_placed(&leaf.mesh, Some(&leaf.transform), &leaf.materials);
+                *n += 1;
+                if *n == LEAF_BATCH || encoder.bytes() >= ENCODED_BATCH_BYTES {
+                    *n = 0;
+                    send(Piece::Encoded(encoder.take()));
+                }
+            }
+            Batcher::Plain(collector, added) => {
+                // A leaf whose mesh cannot be placed (invalid indices) adds
+                // nothing; the writers report such meshes.
+                let _ = collector.add_placed(
+                    &leaf.mesh,
+                    Some(&leaf.transform),
+                    &leaf.materials,
+                    *added,
+                );
+                *added += 1;
+            }
+        }
+    }
+
+    /// Records where a leaf comes from, when plain meshes are kept (their
+    /// triangles name the leaf by its number).
+    fn add_origin(
+        &self,
+        leaf: &Leaf,
+        program: &cga_engine::Program,
+        origins: &mut Vec<LeafOrigin>,
+    ) {
+        if let Batcher::Plain(..) = self {
+            origins.push(LeafOrigin {
+                rule: leaf.rule.map(RuleRef),
+                shape: program.symbols[leaf.name as usize].clone(),
+            });
+        }
+    }
+
+    /// Sends what was gathered (at the end of a lot).
+    fn flush(&mut self, send: &mut dyn FnMut(Piece)) {
+        match self {
+            Batcher::Drop | Batcher::Plain(..) => {}
+            Batcher::Leaves(batch) => {
+                if !batch.is_empty() {
+                    send(Piece::Leaves(std::mem::take(batch)));
+                }
+            }
+            Batcher::Encode(encoder, n) => {
+                if *n > 0 {
+                    *n = 0;
+                    send(Piece::Encoded(encoder.take()));
+                }
+            }
+        }
+    }
+
+    /// The plain meshes of the lot that ended (empty unless kept).
+    fn take_model(&mut self) -> cga_export::PlainModel {
+        match self {
+            Batcher::Plain(collector, added) => {
+                *added = 0;
+                collector.take()
+            }
+            _ => cga_export::PlainModel::default(),
+        }
+    }
+}

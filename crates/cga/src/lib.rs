@@ -1,0 +1,69 @@
+//! The CGA engine as a library.
+//!
+//! CGA is the shape grammar of procedural buildings (the rule language of
+//! CityEngine). This crate is the engine's public surface: everything the
+//! `cga` command, the Python package, the language server and the live
+//! preview do, they do through it.
+//!
+//! - An [`Engine`] reads files through a [`World`]: the disk
+//!   ([`DiskWorld`]), files held in memory over another world
+//!   ([`MemoryWorld`]: unsaved buffers, rule text from a string), or a world
+//!   confined to given folders ([`ConfinedWorld`]) for rules one did not
+//!   write. It keeps what it read (assets, textures, tables), so reloading
+//!   rules after an edit rereads only what changed.
+//! - [`Engine::load`] gives [`Rules`], always: a file with errors still
+//!   gives everything that resolved, with its [`Diagnostic`]s. Rules list
+//!   their [`Attribute`]s with annotations (`@Range`, `@Enum`, `@Group`, ...).
+//! - [`Rules::generate`] derives one [`Lot`] into plain meshes
+//!   ([`LotResult`]); [`Rules::generate_lots`] derives many in parallel and
+//!   in order, into meshes or a model file ([`ModelWriter`], GLB into any
+//!   stream), handing each lot's prints, reports, warnings and error to the
+//!   caller as lots finish. Each leaf's [`Provenance`] says which rule made
+//!   it.
+//! - Any thread can call: deep grammars get stack room of their own, limits
+//!   stop runaway rules, and a [`Cancel`] stops a generation within
+//!   milliseconds.
+//!
+//! `docs/library.md` has a complete example.
+
+mod attributes;
+mod diagnostics;
+mod error;
+mod generate;
+pub mod lots;
+mod model;
+mod options;
+mod pipeline;
+mod rules;
+mod stack;
+
+pub use attributes::{Annotation, Attribute, Range};
+pub use cga_export::{ExportOptions, ExportStats, Format, Georeference, ModelWriter};
+pub use cga_value::{Value, ValueType};
+pub use cga_world::{decode_text, ConfinedWorld, DiskWorld, MemoryWorld, Metadata, World};
+pub use diagnostics::{Diagnostic, Location, Severity};
+pub use error::{Error, ExportError};
+pub use generate::Target;
+pub use lots::{GeoOrigin, Lot, LotSet};
+pub use model::{LeafOrigin, LotResult, Material, PlainMesh, PlainModel, Provenance, Summary};
+pub use options::{Cancel, Limits, Options};
+pub use rules::{Engine, ProgramSize, RuleInfo, RuleRef, Rules};
+
+/// Default largest asset file read, in MiB ([`Engine::max_asset_mib`]).
+pub use cga_engine::assets::DEFAULT_MAX_ASSET_MIB;
+/// The earth radius of the local projection of longitude/latitude lots.
+pub use cga_engine::geo::EARTH_RADIUS;
+/// Default vertex data a glTF/GLB writer holds before writing it out, in MiB.
+pub use cga_export::DEFAULT_FLUSH_MIB;
+
+/// A value as the `cga` command reads `--attr NAME=VALUE`: a number,
+/// `true`/`false`, else a string.
+pub fn parse_value(text: &str) -> Value {
+    cga_engine::generate::parse_value(text)
+}
+
+/// The guide `docs/library.md`, whose example is compiled and run as a
+/// test.
+#[doc = include_str!("../../../docs/library.md")]
+#[cfg(doctest)]
+pub struct LibraryGuide;

@@ -34,9 +34,11 @@ pub fn load_asset(path: &Path, read: &ReadFile) -> Result<ObjAsset, String> {
         "dwg" => Some("DWG"),
         "ifc" => Some("IFC"),
         "usd" | "usda" | "usdc" | "usdz" => Some("USD"),
-        _ => return Err(format!(
+        _ => {
+            return Err(format!(
             "cannot load asset {shown}: unknown asset format (expected .obj, .dae, .gltf or .glb)"
-        )),
+        ))
+        }
     };
     if let Some(format) = format {
         return Err(format!(

@@ -318,7 +318,7 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
     };
 
     let progress = progress_bar(lots.lots.len());
-    let mut reports = report::Reports::default();
+    let mut reports = args.report.as_ref().map(|_| report::ReportFile::default());
     let mut seen_warnings = std::collections::HashSet::new();
     let many = lots.lots.len() > 1;
     let each = |lot: LotResult| {
@@ -342,7 +342,9 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
             };
             progress.suspend(|| report_diagnostics([&e]));
         }
-        reports.add(&lot.reports);
+        if let Some(r) = &mut reports {
+            r.add_lot(lot.index, &lot.name, &lot.reports);
+        }
         progress.inc(1);
     };
     let target = match &mut writer {
@@ -400,7 +402,7 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
             peak_memory().map_or("unknown".to_string(), |kb| format!("{:.1} MiB", kb as f64 / 1024.0))
         );
     }
-    if let Some(path) = &args.report {
+    if let (Some(path), Some(reports)) = (&args.report, &reports) {
         std::fs::write(path, reports.to_json())
             .map_err(|e| Failure::Usage(format!("cannot write {}: {e}", path.display())))?;
     }

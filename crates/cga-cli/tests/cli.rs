@@ -447,8 +447,16 @@ fn reports_are_aggregated_per_key() {
     assert_eq!(v["x_min"], 3.0);
     assert_eq!(v["x_max"], 5.0);
     assert_eq!(v["ok_n"], 2.0);
+    // Bools and strings: how often each value was reported.
+    assert_eq!(v["ok_counts"], serde_json::json!({ "true": 2.0 }));
+    assert_eq!(v["kind_counts"], serde_json::json!({ "lot": 1.0 }));
     assert_eq!(v["ok_sum"], true);
     assert_eq!(v["kind_avg"], "lot");
+    // And each lot's own reports.
+    let lots = v["lots"].as_array().unwrap();
+    assert_eq!(lots.len(), 1);
+    assert_eq!(lots[0]["id"], "rect 20x30");
+    assert_eq!(lots[0]["reports"]["x_sum"], 8.0);
 }
 
 #[test]
@@ -882,4 +890,93 @@ fn rule_packages_are_read_directly() {
         "{}",
         stderr(&o)
     );
+}
+
+/// `--attr` values are read in the attribute's type: a float attribute
+/// given text that is not a number is a usage error naming it; bools read
+/// as the `bool` page converts; arrays in CGA's literal form; values outside
+/// `@Range` or `@Enum` are a warning naming the lot.
+#[test]
+fn attribute_values_take_the_attribute_type_and_annotations_warn() {
+    let dir = temp_dir("attr-types");
+    let rules = rule_file(
+        &dir,
+        "a.cga",
+        "@Range(min=1, max=20)\nattr floors = 3\nattr on = true\nattr heights = [1, 2]\n\
+         @Enum(\"flat\", \"gable\")\nattr roof = \"flat\"\n\
+         Lot --> print(floors) print(on) print(heights) print(roof)\n",
+    );
+    let r = rules.to_str().unwrap();
+    let bad = run(&["generate", r, "--attr", "floors=abc"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(
+        stderr(&bad).contains("attribute `floors` is a float: `abc` is not a number"),
+        "{}",
+        stderr(&bad)
+    );
+    let o = run(&[
+        "generate",
+        r,
+        "--attr",
+        "on=f",
+        "--attr",
+        "heights=[5,5]",
+        "--attr",
+        "floors=4",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(stdout(&o), "4\nfalse\n(2)[5,5]\nflat\n");
+    let o = run(&["generate", r, "--attr", "floors=99", "--attr", "roof=dome"]);
+    assert_eq!(o.status.code(), Some(0));
+    let err = stderr(&o);
+    assert!(
+        err.contains("warning: 99 is outside the @Range of attribute `floors` (1 to 20), in lot `rect 20x30`"),
+        "{err}"
+    );
+    assert!(
+        err.contains("dome is not one of the @Enum values of attribute `roof` (flat, gable)"),
+        "{err}"
+    );
+    assert!(err.contains("a.cga:2:6"), "{err}");
+}
+
+/// Each lot's seed: the run's seed for the first lot, a hash of the seed and
+/// the lot's index for the others (so `--seed 1` is not `--seed 0` shifted
+/// by a lot); a lot's own `seed` property, or `--attr seed=N`, sets it.
+#[test]
+fn every_seed_gives_another_city_and_lots_carry_their_own_seed() {
+    let dir = temp_dir("seeds");
+    let rules = rule_file(&dir, "s.cga", "Lot --> print(seedian) X.\n");
+    let r = rules.to_str().unwrap();
+    let seeds = |args: &[&str]| -> Vec<String> {
+        let mut all = vec!["generate", r];
+        all.extend_from_slice(args);
+        let o = run(&all);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        stdout(&o).lines().map(str::to_string).collect()
+    };
+    let s0 = seeds(&["--lot", "grid:4x1", "--seed", "0"]);
+    let s1 = seeds(&["--lot", "grid:4x1", "--seed", "1"]);
+    assert_eq!(s0[0], "0");
+    assert_eq!(s1[0], "1");
+    assert_ne!(&s0[1..], &s1[..3], "not shifted by a lot");
+    let all: std::collections::HashSet<_> = s0.iter().chain(&s1).collect();
+    assert_eq!(all.len(), 8);
+    // One lot with --seed 666 derives with seedian 666.
+    assert_eq!(seeds(&["--seed", "666"]), vec!["666"]);
+    // --attr seed=N: every lot's own seed.
+    assert_eq!(
+        seeds(&["--lot", "grid:2x1", "--attr", "seed=42"]),
+        vec!["42", "42"]
+    );
+    // A GeoJSON property `seed` is the lot's seed.
+    let geojson = dir.join("lots.geojson");
+    std::fs::write(
+        &geojson,
+        r#"{"type":"FeatureCollection","features":[
+        {"type":"Feature","properties":{"seed":7},"geometry":{"type":"Polygon","coordinates":[[[0,0],[10,0],[10,10],[0,10],[0,0]]]}},
+        {"type":"Feature","properties":{"seed":9},"geometry":{"type":"Polygon","coordinates":[[[20,0],[30,0],[30,10],[20,10],[20,0]]]}}]}"#,
+    )
+    .unwrap();
+    assert_eq!(seeds(&["--lot", geojson.to_str().unwrap()]), vec!["7", "9"]);
 }

@@ -49,11 +49,16 @@ fn check(case: &Case) {
         case.package
     );
 
-    let ours: serde_json::Value =
+    let mut ours: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     let expected: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(golden.join("reports.json")).unwrap())
             .unwrap();
+    // Our file has the reports of each lot beside the totals, and counts
+    // of bool and string values.
+    if let Some(map) = ours.as_object_mut() {
+        map.retain(|k, _| k != "lots" && !k.ends_with("_counts"));
+    }
     assert_eq!(ours, expected, "reports of {}", case.package);
 
     let diffs = compare(

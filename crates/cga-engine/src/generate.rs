@@ -17,7 +17,12 @@ use crate::values::to_text;
 pub struct GenerateOptions {
     /// `--attr NAME=VALUE` values (resolved to attribute ids).
     pub attrs: Vec<(AttrId, Value)>,
+    /// The run's seed: lot `i` derives with [`lot_seed`]`(seed, i)`.
     pub seed: u64,
+    /// Every lot's own seed, when given (the initial shapes' `seed`
+    /// attribute, as CityEngine's shapes carry one): instead of the one
+    /// [`lot_seed`] derives from `seed`.
+    pub lot_seed: Option<u64>,
     pub limits: Limits,
     /// Hand leaf geometry out unbaked (`LotOutput::leaves`: each leaf's
     /// mesh shared with its shape, with the map that places it) instead of
@@ -199,9 +204,10 @@ fn derive<'a>(
     sink: Option<Box<dyn FnMut(Leaf) + 'a>>,
     context: Option<Box<ContextState>>,
 ) -> (LotOutput, Option<RtError>, Option<Box<ContextState>>) {
-    // Each lot has its own seed: the run's seed for the first lot, then the
-    // following numbers (`--seed 666` on one lot gives `seedian` 666).
-    let seed = options.seed.wrapping_add(lot_index as u64);
+    let seed = options
+        .lot_seed
+        .or_else(|| own_seed(program, lot))
+        .unwrap_or_else(|| lot_seed(options.seed, lot_index));
     let shape = initial_shape(lot, seed, program.rule_symbol(rule));
     let info = InitialInfo {
         name: lot.name.clone(),
@@ -236,6 +242,36 @@ fn derive<'a>(
     }
     let context = interp.context.take();
     (std::mem::take(&mut interp.out), error, context)
+}
+
+/// The seed of lot `index` in a run with seed `seed`: the run's seed for
+/// the first lot (one lot generated with seed 666 has `seedian` 666), a hash
+/// of the seed and the index for the others, so that every seed gives a
+/// different city (not the same buildings shifted by a lot) and
+/// neighbouring lots are unrelated. Below 2^31, as CityEngine's seeds are.
+pub fn lot_seed(seed: u64, index: usize) -> u64 {
+    if index == 0 {
+        return seed;
+    }
+    let mut state = seed;
+    let mut state = crate::shape::splitmix64(&mut state) ^ index as u64;
+    crate::shape::splitmix64(&mut state) & 0x7FFF_FFFF
+}
+
+/// A lot's own seed: its `seed` property (GIS data), when the rules have no
+/// attribute of that name.
+fn own_seed(program: &Program, lot: &Lot) -> Option<u64> {
+    if program.main_attr("seed").is_some() {
+        return None;
+    }
+    lot.attrs
+        .iter()
+        .find(|(n, _)| n == "seed")
+        .and_then(|(_, v)| match v {
+            Value::Float(x) if *x >= 0.0 && x.is_finite() => Some(*x as u64),
+            Value::Str(s) => s.trim().parse().ok(),
+            _ => None,
+        })
 }
 
 /// The values the attributes `ids` take on `lot` before any rule runs
@@ -318,6 +354,22 @@ mod tests {
     /// Leaves handed out unbaked (collected or streamed) bake to exactly
     /// the meshes the derivation gives otherwise: positions, normals, UVs,
     /// faces and materials, also under mirroring, rotation and inserts.
+    #[test]
+    fn lot_seeds_differ_per_seed_and_lot() {
+        assert_eq!(lot_seed(666, 0), 666);
+        let a: Vec<u64> = (0..100).map(|i| lot_seed(0, i)).collect();
+        let b: Vec<u64> = (0..100).map(|i| lot_seed(1, i)).collect();
+        // Seed 1 is not seed 0 shifted by a lot.
+        assert_ne!(&a[1..], &b[..99]);
+        let mut all: Vec<u64> = a.iter().chain(&b).copied().collect();
+        all.sort();
+        all.dedup();
+        // All different: lot 0 keeps the run's seed (0 and 1), the others
+        // are hashes.
+        assert_eq!(all.len(), 200);
+        assert!(all.iter().all(|&s| s < 1 << 31));
+    }
+
     #[test]
     fn leaves_bake_to_the_meshes() {
         let dir = std::env::temp_dir().join(format!("cga-engine-leaves-{}", std::process::id()));

@@ -397,7 +397,7 @@ pub fn local_bounds(mesh: &Mesh) -> Option<(DVec3, DVec3)> {
     Some(it.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
 }
 
-fn splitmix64(state: &mut u64) -> u64 {
+pub(crate) fn splitmix64(state: &mut u64) -> u64 {
     *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
     let mut z = *state;
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);

@@ -147,7 +147,10 @@ impl Rules {
             {
                 return Err(Error::Cancelled);
             }
-            let lot = self.lot_result(i, &lots[i], done);
+            let mut lot = self.lot_result(i, &lots[i], done);
+            let mut warnings = self.annotation_warnings(options, &lots[i]);
+            warnings.append(&mut lot.warnings);
+            lot.warnings = warnings;
             summary.failed += lot.error.is_some() as usize;
             summary.shapes += lot.shapes;
             summary.leaves += lot.leaf_count;
@@ -214,12 +217,22 @@ impl Rules {
         };
         for (name, value) in &options.attrs {
             match program.main_attr(name) {
-                Some(id) => out.attrs.push((id, value.clone())),
-                // As in CityEngine, `seed` is the initial shapes' random
-                // seed unless the rules declare an attribute of that name.
+                Some(id) => {
+                    let value = match self.attribute(name).and_then(|a| a.ty) {
+                        Some(ty) => crate::values::convert(value, ty).map_err(|why| {
+                            Error::Value(format!("attribute `{name}` is a {}: {why}", ty.name()))
+                        })?,
+                        None => value.clone(),
+                    };
+                    out.attrs.push((id, value))
+                }
+                // As in CityEngine, `seed` is the initial shapes' own seed
+                // unless the rules declare an attribute of that name.
                 None if name == "seed" => {
-                    out.seed = match value {
-                        cga_value::Value::Float(x) if *x >= 0.0 && x.fract() == 0.0 => *x as u64,
+                    out.lot_seed = match value {
+                        cga_value::Value::Float(x) if *x >= 0.0 && x.fract() == 0.0 => {
+                            Some(*x as u64)
+                        }
                         other => {
                             return Err(Error::Value(format!(
                                 "the seed must be a whole number, found `{}`",
@@ -295,6 +308,36 @@ impl Rules {
             records,
             options.context_use.unwrap_or_default(),
         ))
+    }
+
+    /// Warnings for the values `options` and `lot` give attributes that
+    /// their `@Range` or `@Enum` do not allow.
+    fn annotation_warnings(&self, options: &Options, lot: &Lot) -> Vec<Diagnostic> {
+        let given = lot
+            .attrs
+            .iter()
+            .filter(|(n, _)| !options.attrs.iter().any(|(o, _)| o == n))
+            .chain(&options.attrs);
+        let mut out = Vec::new();
+        for (name, value) in given {
+            let Some(attr) = self.attribute(name) else {
+                continue;
+            };
+            let value = attr
+                .ty
+                .and_then(|ty| crate::values::convert(value, ty).ok())
+                .unwrap_or_else(|| value.clone());
+            if let Some(why) = crate::values::outside_annotations(attr, &value) {
+                let Some(id) = self.inner.program.main_attr(name) else {
+                    continue;
+                };
+                let span = self.inner.program.attrs[id as usize].span;
+                let d =
+                    cga_syntax::Diagnostic::warning(format!("{why}, in lot `{}`", lot.name), span);
+                out.push(Diagnostic::new(&d, &self.inner.sources));
+            }
+        }
+        out
     }
 
     fn lot_result(&self, index: usize, lot: &Lot, done: Done) -> LotResult {

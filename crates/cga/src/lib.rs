@@ -36,6 +36,7 @@ mod options;
 mod pipeline;
 mod rules;
 mod stack;
+mod values;
 
 pub use attributes::{Annotation, Attribute, Range};
 pub use cga_export::{ExportOptions, ExportStats, Format, Georeference, ModelWriter};
@@ -55,11 +56,11 @@ pub use cga_engine::assets::DEFAULT_MAX_ASSET_MIB;
 pub use cga_engine::geo::EARTH_RADIUS;
 /// Default vertex data a glTF/GLB writer holds before writing it out, in MiB.
 pub use cga_export::DEFAULT_FLUSH_MIB;
+pub use values::parse_value;
 
-/// A value as the `cga` command reads `--attr NAME=VALUE`: a number,
-/// `true`/`false`, else a string.
-pub fn parse_value(text: &str) -> Value {
-    cga_engine::generate::parse_value(text)
+/// A value's text form, as `print()` and `str()` write it.
+pub fn value_text(value: &Value) -> String {
+    cga_engine::values::to_text(value)
 }
 
 /// The guide `docs/library.md`, whose example is compiled and run as a

@@ -12,8 +12,11 @@ use cga_value::Value;
 /// and a thread per core.
 #[derive(Clone, Debug, Default)]
 pub struct Options {
-    /// The random seed: lot `i` of a generation derives with seed
-    /// `seed + i` (its `seedian`).
+    /// The run's random seed: the first lot derives with this seed (its
+    /// `seedian`), every other lot with a hash of it and the lot's index,
+    /// so that each seed gives a different city. A lot's own `seed`
+    /// property (GIS data), or the attribute value `seed` when the rules
+    /// declare no attribute of that name, sets the lots' seeds instead.
     pub seed: u64,
     /// The start rule; `None`: the rule marked `@StartRule`, else `Lot`.
     pub start_rule: Option<String>,

@@ -18,7 +18,7 @@
 
 mod arrays;
 mod color;
-mod convert;
+pub mod convert;
 mod lists;
 mod math;
 mod strings;

@@ -130,11 +130,11 @@ impl AssetStore {
         Ok(())
     }
 
-    /// The geometry of the OBJ file `file`.
+    /// The geometry of the asset file `file` (OBJ, COLLADA, glTF).
     fn mesh(&self, file: &Path) -> Result<Arc<Mesh>, String> {
         self.check_size(file)?;
         self.cached(&self.meshes, &file.to_path_buf(), file, || {
-            load_obj(&*self.world, file).map(Arc::new)
+            load_any(&*self.world, file).map(Arc::new)
         })
     }
 
@@ -322,7 +322,7 @@ impl Assets {
     }
 
     /// The geometry of the asset `path`: a built-in (`builtin:cube`, ...)
-    /// or an OBJ file, loaded once.
+    /// or an OBJ, COLLADA or glTF file, loaded once.
     pub fn mesh(&self, from: FileId, path: &str) -> Result<Arc<Mesh>, String> {
         if let Some(name) = path.strip_prefix("builtin:") {
             return builtin_geometry(name)
@@ -473,24 +473,19 @@ fn builtin_geometry(name: &str) -> Option<Arc<Mesh>> {
         .map(|(_, m)| m.clone())
 }
 
-/// Loads an OBJ asset and its material libraries from `world`; its
-/// warnings (missing MTL, unknown materials) are dropped here: the asset
-/// still loads with default materials.
-fn load_obj(world: &dyn World, path: &Path) -> Result<Mesh, String> {
-    let bytes = world
-        .read(path)
-        .map_err(|e| format!("cannot load asset {}: {e}", path.display()))?;
-    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let text = String::from_utf8_lossy(&bytes);
-    cga_geometry::obj::parse_obj(&text, &dir, |name| {
-        let p = dir.join(name);
+/// Loads an asset from `world` in any format the engine reads (OBJ with
+/// its material libraries, COLLADA, glTF with its buffers; see
+/// `cga_geometry::load_asset`); its warnings (missing MTL, unknown
+/// materials, skipped polygons) are dropped here: the asset still loads.
+/// A file that cannot be read, in a format that is not read, or without
+/// polygons is an error message: the caller warns, naming it.
+fn load_any(world: &dyn World, path: &Path) -> Result<Mesh, String> {
+    cga_geometry::load_asset(path, &|p: &Path| {
         world
-            .read(&p)
-            .map(|b| String::from_utf8_lossy(&b).into_owned())
-            .map_err(|e| format!("cannot read material library '{}': {e}", p.display()))
+            .read(p)
+            .map_err(|e| format!("cannot read '{}': {e}", p.display()))
     })
     .map(|asset| asset.mesh)
-    .map_err(|e| format!("cannot load asset {}: {e}", path.display()))
 }
 
 /// The project folder of a rule file: the nearest ancestor holding an

@@ -9,6 +9,12 @@ use crate::program::{AttrId, FuncId};
 use crate::shape::Shape;
 use crate::values as vs;
 
+/// Stream ordinals of attribute defaults (plus the attribute's index) and
+/// of const functions (plus the function's index): far from the ordinals
+/// of a shape's successors.
+const ATTR_STREAMS: u64 = 1 << 40;
+const CONST_STREAMS: u64 = 2 << 40;
+
 impl Interp<'_> {
     pub fn eval(&mut self, e: &RExpr, frame: &[Value], shape: &Shape) -> Result<Value, RtError> {
         match &e.kind {
@@ -224,7 +230,7 @@ impl Interp<'_> {
         self.attr_values[id as usize] = AttrSlot::InProgress;
         let program = self.program;
         let def = &program.attrs[id as usize];
-        let initial = self.initial.clone();
+        let initial = self.initial_with_own_stream(ATTR_STREAMS + id as u64);
         let r = self.eval_with_locals(&[], &def.default, &initial);
         match r {
             Ok(v) => {
@@ -236,6 +242,18 @@ impl Interp<'_> {
                 Err(err)
             }
         }
+    }
+
+    /// The initial shape with a random stream of its own for one attribute
+    /// or const default (`ordinal`: [`ATTR_STREAMS`] or [`CONST_STREAMS`]
+    /// plus its index). Each default draws its own numbers, so that
+    /// `attr height = rand(10, 30)` and `attr roofAngle = rand(20, 45)` are
+    /// not the same point of one stream (perfectly correlated over a city),
+    /// and what one draws does not depend on which is evaluated first.
+    fn initial_with_own_stream(&self, ordinal: u64) -> Shape {
+        let initial = self.initial.clone();
+        initial.rng.set(self.initial.child_rng(ordinal));
+        initial
     }
 
     fn eval_with_locals(
@@ -265,7 +283,7 @@ impl Interp<'_> {
             if let Some(v) = &self.const_values[f as usize] {
                 return Ok(v.clone());
             }
-            let initial = self.initial.clone();
+            let initial = self.initial_with_own_stream(CONST_STREAMS + f as u64);
             self.enter(at, &def.name)?;
             let r = self.eval_with_locals(&def.locals, &def.body, &initial);
             self.depth -= 1;

@@ -13,11 +13,23 @@
 //!
 //! Planes are fixed in space: they are stored in object coordinates and do
 //! not move with the scope, so a shape translated after the split is still
-//! cut where the faces met. Each plane is classified by its edge: if the
-//! edge makes less than 40 degrees with the xz-plane of the new shape's
-//! pivot, the plane is *horizontal*, otherwise *vertical*
-//! (attr_trim.md). `trim.vertical` (default true) and `trim.horizontal`
-//! (default false) switch the two classes when the planes are applied.
+//! cut where the faces met. Each plane is classified by its edge when it is
+//! applied: if the edge makes less than 40 degrees with the xz-plane of the
+//! shape's pivot *at that moment*, the plane is *horizontal*, otherwise
+//! *vertical* (attr_trim.md). Right after the split the pivot is the new
+//! face's (its y-axis in the face, across the first edge), so a facade's
+//! vertical edges and a roof face's hip edges are vertical; an operation
+//! that turns the pivot before the insert (`alignScopeToAxes`, `setPivot`)
+//! reclassifies them. CityEngine keeps a cube inserted beside a roof-top
+//! face whole after `alignScopeToAxes(y)` (`s(4,0,2) center(xz) extrude(3)
+//! comp(f){ top : T }`, `T --> extrude(1) alignScopeToAxes(y) t(4,0,0)
+//! primitiveCube()`: area 28, measured with its runtime): the pivot is then
+//! level and all four edges of the top face are horizontal. Classifying
+//! against the pivot of the shape being split instead breaks the Candler
+//! building's match (faces split again after a roof-top split), and
+//! `extrude` keeps the planes (op_trim.md: "A roof face is extruded and
+//! trimmed"). `trim.vertical` (default true) and `trim.horizontal` (default
+//! false) switch the two classes when the planes are applied.
 
 use std::sync::Arc;
 
@@ -34,8 +46,25 @@ pub struct TrimPlane {
     pub point: DVec3,
     /// Unit normal pointing towards the kept side (into the face).
     pub normal: DVec3,
-    /// Classified vertical (switched by `trim.vertical`) or horizontal.
-    pub vertical: bool,
+    /// Unit direction of the generating edge: classifies the plane against
+    /// the pivot in force when it is applied ([`TrimPlane::is_vertical`]).
+    pub edge: DVec3,
+}
+
+impl TrimPlane {
+    /// Whether the plane is vertical (switched by `trim.vertical`) for a
+    /// shape whose pivot has the y-axis `pivot_y` (unit, same frame as the
+    /// plane); else horizontal (`trim.horizontal`).
+    pub fn is_vertical(&self, pivot_y: DVec3) -> bool {
+        let angle = self
+            .edge
+            .dot(pivot_y)
+            .abs()
+            .clamp(0.0, 1.0)
+            .asin()
+            .to_degrees();
+        angle >= HORIZONTAL_LIMIT_DEGREES
+    }
 }
 
 /// The trim planes of a shape (shared between a shape and its successors).
@@ -51,24 +80,16 @@ pub const HORIZONTAL_LIMIT_DEGREES: f64 = 40.0;
 /// bisects the two half-planes: its normal is `m_face - m_other` (which is
 /// perpendicular to both the edge and the bisector `m_face + m_other`), so
 /// for coplanar faces it is the plane perpendicular to both through the
-/// edge. `pivot_y` (unit) decides the classification. All vectors in one
-/// frame; the result is in that frame.
-pub fn bisecting_plane(
-    a: DVec3,
-    b: DVec3,
-    m_face: DVec3,
-    m_other: DVec3,
-    pivot_y: DVec3,
-) -> Option<TrimPlane> {
+/// edge. All vectors in one frame; the result is in that frame.
+pub fn bisecting_plane(a: DVec3, b: DVec3, m_face: DVec3, m_other: DVec3) -> Option<TrimPlane> {
     let d = (b - a).try_normalize()?;
     let normal = (m_face - m_other)
         .try_normalize()
         .or_else(|| m_face.try_normalize())?;
-    let angle = d.dot(pivot_y).abs().clamp(0.0, 1.0).asin().to_degrees();
     Some(TrimPlane {
         point: a,
         normal,
-        vertical: angle >= HORIZONTAL_LIMIT_DEGREES,
+        edge: d,
     })
 }
 
@@ -93,6 +114,7 @@ pub fn apply(shape: &mut Shape, bounds: Option<(DVec3, DVec3)>) {
     }
     let frame = shape.scope.frame;
     let to_local = frame.axes.transpose();
+    let pivot_y = shape.pivot.axes.y_axis;
     let bounds = match bounds {
         Some(b) => Some(b),
         None => local_bounds(shape.geometry.local()),
@@ -109,7 +131,7 @@ pub fn apply(shape: &mut Shape, bounds: Option<(DVec3, DVec3)>) {
     // Planes in scope-local coordinates that actually cut the box.
     let mut cutting: Vec<(DVec3, f64)> = Vec::new();
     for p in planes.iter() {
-        if !(if p.vertical { use_v } else { use_h }) {
+        if !(if p.is_vertical(pivot_y) { use_v } else { use_h }) {
             continue;
         }
         let n = to_local * p.normal;
@@ -251,25 +273,28 @@ mod tests {
             DVec3::new(1.0, 1.0, 0.0),
             -DVec3::X,
             -DVec3::Z,
-            DVec3::Y,
         )
         .unwrap();
         let s = std::f64::consts::FRAC_1_SQRT_2;
         assert!((p.normal - DVec3::new(-s, 0.0, s)).length() < 1e-12);
-        assert!(p.vertical);
+        assert!(p.is_vertical(DVec3::Y));
         // A horizontal edge of the same face is horizontal.
-        let h = bisecting_plane(DVec3::ZERO, DVec3::X, DVec3::Y, -DVec3::Z, DVec3::Y).unwrap();
-        assert!(!h.vertical);
+        let h = bisecting_plane(DVec3::ZERO, DVec3::X, DVec3::Y, -DVec3::Z).unwrap();
+        assert!(!h.is_vertical(DVec3::Y));
+        // With a pivot whose y-axis is horizontal (the pivot of a top face),
+        // the same edges swap classes.
+        assert!(!p.is_vertical(DVec3::Z));
+        assert!(h.is_vertical(DVec3::X));
     }
 
     #[test]
     fn coplanar_neighbours_give_the_perpendicular_plane() {
-        let p = bisecting_plane(DVec3::ZERO, DVec3::Y, -DVec3::X, DVec3::X, DVec3::Y).unwrap();
+        let p = bisecting_plane(DVec3::ZERO, DVec3::Y, -DVec3::X, DVec3::X).unwrap();
         assert!((p.normal + DVec3::X).length() < 1e-12);
     }
 
     #[test]
     fn degenerate_edge_gives_no_plane() {
-        assert!(bisecting_plane(DVec3::ONE, DVec3::ONE, DVec3::X, DVec3::Z, DVec3::Y).is_none());
+        assert!(bisecting_plane(DVec3::ONE, DVec3::ONE, DVec3::X, DVec3::Z).is_none());
     }
 }

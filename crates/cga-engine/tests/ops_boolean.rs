@@ -63,13 +63,14 @@ fn single(g: &Gen) -> &Mesh {
 /// `off` (in the scope's x and z), that lies within the scope's `w` × `w`
 /// square, computed in 2D (independently of the 3D Boolean).
 fn disk_in_square(d: f64, off: f64, w: f64) -> (f64, f64) {
+    // 16 vertices half a step off the axes, the flat sides touching the
+    // d x d square (as CityEngine makes its disks and cylinders).
+    let step = std::f64::consts::TAU / 16.0;
+    let r = d / 2.0 / (step / 2.0).cos();
     let disk: Vec<DVec2> = (0..16)
         .map(|k| {
-            let a = std::f64::consts::TAU * k as f64 / 16.0;
-            DVec2::new(
-                off + d / 2.0 * (1.0 + a.cos()),
-                off + d / 2.0 * (1.0 + a.sin()),
-            )
+            let a = step * (k as f64 + 0.5);
+            DVec2::new(off + d / 2.0 + r * a.cos(), off + d / 2.0 + r * a.sin())
         })
         .collect();
     let square = vec![

@@ -27,9 +27,11 @@ fn run(body: &str, opts: &Opts) -> (ScopeLine, [f64; 4], Gen) {
     (scope_line(&p[0]), [geo[0], geo[1], geo[2], geo[3]], g)
 }
 
-/// Area of a regular polygon with `n` vertices on a circle of radius `r`.
+/// Area of a regular polygon with `n` sides (a multiple of 4) whose flat
+/// sides touch the square of side `2 r`, as CityEngine makes its disks,
+/// cylinders and cones (vertices half a step off the axes): apothem `r`.
 fn ngon_area(n: f64, r: f64) -> f64 {
-    0.5 * n * r * r * (std::f64::consts::TAU / n).sin()
+    n * r * r * (std::f64::consts::PI / n).tan()
 }
 
 // ---------------------------------------------------------------------------
@@ -91,7 +93,7 @@ fn primitive_quad_with_size_on_a_lot() {
 
 /// op_primitive, primitiveDisk example 1: after rotateScope(-90, 0, 0)
 /// scope.sz is 0; the 16-vertex disk is fit into the scope's xy extent
-/// (the lot's 20 x 30): a 16-gon inscribed in the ellipse of radii 10, 15.
+/// (the lot's 20 x 30): a 16-gon filling it, its flat sides touching it.
 #[test]
 fn primitive_disk_fits_the_xy_scope() {
     let (s, geo, g) = run(
@@ -223,16 +225,18 @@ fn primitive_solids_with_dimensions() {
 /// 9, a scope of 9 x 9 x 0 a depth of (9/1 + 9/1) / 2 = 9.
 #[test]
 fn primitive_cube_in_zero_sized_scopes() {
-    for (op, size) in [
-        ("s(0,0,0)", [1.0, 1.0, 1.0]),
-        ("s(9,0,0)", [9.0, 9.0, 9.0]),
-        ("s(0,9,0)", [9.0, 9.0, 9.0]),
-        ("s(9,9,0)", [9.0, 9.0, 9.0]),
-        ("s(4,0,8)", [4.0, 6.0, 8.0]),
+    // The unit cube, as an asset, is centred on its origin in x and z and
+    // stands on y = 0; a zero size keeps (scaled) the asset's position.
+    for (op, size, t) in [
+        ("s(0,0,0)", [1.0, 1.0, 1.0], [-0.5, 0.0, -30.5]),
+        ("s(9,0,0)", [9.0, 9.0, 9.0], [0.0, 0.0, -34.5]),
+        ("s(0,9,0)", [9.0, 9.0, 9.0], [-4.5, 0.0, -34.5]),
+        ("s(9,9,0)", [9.0, 9.0, 9.0], [0.0, 0.0, -30.0]),
+        ("s(4,0,8)", [4.0, 6.0, 8.0], [0.0, 0.0, -30.0]),
     ] {
         let (s, geo, _) = run(&format!("{op} primitiveCube()"), &Opts::default());
         assert_vec_near(s.s, size, EPS);
-        assert_vec_near(s.t, [0.0, 0.0, -30.0], EPS);
+        assert_vec_near(s.t, t, EPS);
         assert_near(geo[1], size[0] * size[1] * size[2], 1e-9);
     }
 }

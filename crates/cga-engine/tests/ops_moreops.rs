@@ -959,10 +959,15 @@ fn modify_without_selection_and_continuation() {
 /// The Leaf rule of the scatter examples.
 const LEAF: &str = "Leaf-->\n\tprimitiveCube()\n\ts(0.2,0.3,0.1)\n\tcolor(\"#ff0000\")\n";
 
-/// The scattered points: the scope origins of the leaves (the cube's
-/// minimum corner on a lot, whose point scopes are not turned).
+/// The scattered points: the leaves' point scopes (on a lot, whose point
+/// scopes are not turned), where the unit cube is inserted centred in x
+/// and z, as an asset keeps its position in a point scope; `s()` then
+/// scales it from its minimum corner, half a unit off the point.
 fn points(g: &Gen) -> Vec<DVec3> {
-    g.meshes().iter().map(|m| mesh_bounds(m).0).collect()
+    g.meshes()
+        .iter()
+        .map(|m| mesh_bounds(m).0 + DVec3::new(0.5, 0.0, 0.5))
+        .collect()
 }
 
 fn mean(v: &[f64]) -> f64 {
@@ -987,9 +992,10 @@ fn scatter_uniform_on_surface() {
         let (lo, hi) = mesh_bounds(m);
         assert_vec_near(hi - lo, [0.2, 0.3, 0.1], 1e-9);
         assert_near(lo.y, 0.0, 1e-9);
+        let p = lo + DVec3::new(0.5, 0.0, 0.5);
         assert!(
-            (0.0..=20.0).contains(&lo.x) && (-30.0..=0.0).contains(&lo.z),
-            "{lo}"
+            (0.0..=20.0).contains(&p.x) && (-30.0..=0.0).contains(&p.z),
+            "{p}"
         );
         assert_eq!(
             rgb255(&m.materials[m.faces[0].material as usize]),

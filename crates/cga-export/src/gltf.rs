@@ -44,7 +44,7 @@ use json::validation::{Checked::Valid, USize64};
 
 use crate::bucket::Bucket;
 use crate::encode::Buckets;
-use crate::materials::{srgb_to_linear, MaterialTable};
+use crate::materials::{color_to_linear, MaterialTable};
 use crate::textures::{uri_encode, Textures};
 use crate::{ExportError, ExportStats, FaceData};
 
@@ -1005,7 +1005,7 @@ fn gltf_material(
     textures: Vec<(Slot, json::texture::Info)>,
     alpha_map: bool,
 ) -> json::Material {
-    let linear = m.color.map(|c| srgb_to_linear(c) as f32);
+    let linear = m.color.map(|c| color_to_linear(c) as f32);
     let opacity = m.opacity.clamp(0.0, 1.0) as f32;
     let unit = |x: f64| {
         if x.is_finite() {
@@ -1014,7 +1014,7 @@ fn gltf_material(
             0.0
         }
     };
-    let mut emissive = m.emissive.map(|c| srgb_to_linear(c) as f32);
+    let mut emissive = m.emissive.map(|c| color_to_linear(c) as f32);
     let (mut metallic, mut roughness) = (unit(m.metallic), unit(m.roughness));
     let (alpha_mode, alpha_cutoff) = match (alpha_map, &*m.opacitymap_mode) {
         (true, "mask") => (

@@ -174,16 +174,13 @@ fn unique_name(wanted: &str, taken: &mut HashSet<String>) -> String {
     name
 }
 
-/// Converts a non-linear sRGB component to linear, as glTF requires for
-/// colour factors (CGA's `material.color` is sRGB, like the colour pickers
-/// that produce it).
-pub(crate) fn srgb_to_linear(c: f64) -> f64 {
-    let c = c.clamp(0.0, 1.0);
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
+/// Converts a CGA colour component (non-linear, as the colour pickers that
+/// produce it) to the linear value glTF colour factors hold, as CityEngine's
+/// runtime writes it: a pure 2.2 power curve, not the piecewise sRGB curve
+/// (measured on its GLB: `#cccccc` gives 0.612, where sRGB gives 0.604), so
+/// that a model looks the same from both engines.
+pub(crate) fn color_to_linear(c: f64) -> f64 {
+    c.clamp(0.0, 1.0).powf(2.2)
 }
 
 #[cfg(test)]
@@ -240,10 +237,17 @@ mod tests {
     }
 
     #[test]
-    fn srgb_to_linear_known_values() {
-        assert_eq!(srgb_to_linear(0.0), 0.0);
-        assert_eq!(srgb_to_linear(1.0), 1.0);
-        assert!((srgb_to_linear(0.5) - 0.214_041_140_482_232_5).abs() < 1e-12);
-        assert!((srgb_to_linear(0.04) - 0.04 / 12.92).abs() < 1e-15);
+    fn colours_follow_cityengines_power_curve() {
+        assert_eq!(color_to_linear(0.0), 0.0);
+        assert_eq!(color_to_linear(1.0), 1.0);
+        // CityEngine's GLB: #cccccc gives 0.612.
+        assert!((color_to_linear(0.8) - 0.612).abs() < 5e-4);
+        // Candler's bricks (#fcefe2): 0.974, 0.867, 0.767.
+        let bricks = [252.0, 239.0, 226.0].map(|c: f64| color_to_linear(c / 255.0));
+        for (got, want) in bricks.iter().zip([0.974, 0.867, 0.767]) {
+            assert!((got - want).abs() < 5e-4, "{got} vs {want}");
+        }
+        assert_eq!(color_to_linear(-0.5), 0.0);
+        assert_eq!(color_to_linear(2.0), 1.0);
     }
 }

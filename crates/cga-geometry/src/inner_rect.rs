@@ -258,6 +258,29 @@ fn segment_crosses_box(a: DVec2, b: DVec2, x0: f64, x1: f64, y0: f64, y1: f64) -
     t1 - t0 > 1e-12
 }
 
+/// The direction of the first edge of a loop of positive length.
+fn first_edge(l: &[DVec2]) -> DVec2 {
+    (0..l.len())
+        .map(|i| l[(i + 1) % l.len()] - l[i])
+        .find(|d| d.length_squared() > 0.0)
+        .unwrap_or(DVec2::X)
+}
+
+/// The rectangle's corners rotated (still counter-clockwise) so that its
+/// first edge points most nearly along `dir`.
+fn first_edge_like(r: [DVec2; 4], dir: DVec2) -> [DVec2; 4] {
+    let d = dir.normalize_or(DVec2::X);
+    let along = |k: usize| (r[(k + 1) % 4] - r[k]).normalize_or_zero().dot(d);
+    let mut k = 0;
+    for i in 1..4 {
+        // Of two equally good edges (rounding), the earlier one.
+        if along(i) > along(k) + 1e-9 {
+            k = i;
+        }
+    }
+    [r[k], r[(k + 1) % 4], r[(k + 2) % 4], r[(k + 3) % 4]]
+}
+
 /// `innerRectangle(scope | edge)` on face `face` of `mesh`: the rectangle
 /// (a face in the face's plane, counter-clockwise) and the remainder (the
 /// original face with the rectangle cut out as an extra hole loop, which
@@ -331,7 +354,12 @@ pub fn inner_rectangle(mesh: &Mesh, face: usize, axis: Option<DVec3>) -> Option<
                     }
                 }
             }
-            best
+            // CityEngine keeps the face's edge order: the rectangle's first
+            // edge is the one that runs most nearly like the face's first
+            // edge (parallel and the same way when the rectangle has such
+            // an edge), measured with its runtime on rectangles in every
+            // vertex rotation, squares, trapezoids and an L.
+            best.map(|r| first_edge_like(r, first_edge(&loops[0])))
         }
     }?;
     let lift = |p: DVec2| o + u * p.x + v * p.y;

@@ -32,13 +32,16 @@
 //! | [`tags`] | component tags: tag sets, tag queries, tagging faces, edges, vertices |
 
 pub mod area_split;
+pub mod asset_mesh;
 pub mod boolean;
 pub mod cleanup;
+pub mod collada;
 pub mod convexify;
 pub mod cut;
 pub mod envelope;
 pub mod extrude;
 pub mod footprint;
+pub mod gltf_asset;
 pub mod inner_rect;
 pub mod material;
 pub mod measure;
@@ -60,6 +63,7 @@ pub mod triangulate;
 pub mod uv_carry;
 
 pub use area_split::{split_by_areas, AreaProfile, Flatness};
+pub use asset_mesh::load_asset;
 pub use cut::{cut_by_plane, split_along_axis, split_by_parallel_planes};
 pub use extrude::{extrude, extrude_with_roles, ExtrudeRole, Extrusion};
 pub use glam::{DAffine3, DMat3, DQuat, DVec2, DVec3};
@@ -69,7 +73,7 @@ pub use mesh::{Face, Loop, Mesh, UV_SETS};
 pub use obj::{load_obj, parse_obj, ObjAsset, ObjError};
 pub use roof::{roof, Roof, RoofEdgeKind, RoofFaceRole, RoofKind, RoofSlope, SourceEdge};
 pub use setback::{
-    merge_strips, offset, setback, setback_to_area, Offset, OffsetFace, SetbackEdgeTag,
+    merge_strips, offset, setback, setback_luo, setback_to_area, Offset, OffsetFace, SetbackEdgeTag,
 };
 pub use skeleton::{skeleton, straight_skeleton, Skeleton, SkeletonError, StopAt, WeightChange};
 pub use tags::{TagQuery, TagSet, TagTarget};

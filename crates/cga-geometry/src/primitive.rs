@@ -63,30 +63,75 @@ pub fn quad(width: f64, depth: f64) -> Mesh {
     m
 }
 
-/// Angle and ring point `k` of `n` on the ellipse inscribed in the
-/// `width` × `depth` rectangle, counter-clockwise seen from above starting
-/// at +x.
-fn ring(k: usize, n: usize, width: f64, depth: f64) -> (f64, DVec3) {
-    let a = TAU * k as f64 / n as f64;
-    let (rx, rz) = (0.5 * width, 0.5 * depth);
-    (a, DVec3::new(rx + rx * a.cos(), 0.0, rz - rz * a.sin()))
+/// The `n` points of a disk, cylinder or cone ring, filling the `width` ×
+/// `depth` rectangle: as CityEngine places them, half a step off the axes
+/// (8 sides: at 22.5° + k·45°), counter-clockwise seen from above starting
+/// just after +x, scaled so that the polygon's bounding box is the
+/// rectangle (with 8 sides the flat sides touch it). Each point comes with
+/// its angle and its position in the unit square (for texture coordinates).
+fn ring(n: usize, width: f64, depth: f64) -> Vec<RingPoint> {
+    let unit: Vec<(f64, DVec2)> = (0..n)
+        .map(|k| {
+            let a = TAU * (k as f64 + 0.5) / n as f64;
+            (a, DVec2::new(a.cos(), -a.sin()))
+        })
+        .collect();
+    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    for (_, p) in &unit {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    let ext = hi - lo;
+    unit.into_iter()
+        .map(|(a, p)| {
+            let t = (p - lo) / ext;
+            RingPoint {
+                angle: a,
+                unit: t,
+                pos: DVec3::new(t.x * width, 0.0, t.y * depth),
+                radii: DVec2::new(width, depth) / ext,
+            }
+        })
+        .collect()
 }
 
-fn disk_uv(a: f64) -> DVec2 {
-    DVec2::new(0.5 + 0.5 * a.cos(), 0.5 + 0.5 * a.sin())
+/// A point of [`ring`].
+struct RingPoint {
+    /// Its angle from +x, counter-clockwise seen from above.
+    angle: f64,
+    /// Its position in the unit square (x, z).
+    unit: DVec2,
+    /// Its position in the `width` × `depth` rectangle.
+    pos: DVec3,
+    /// The radii of the ellipse the ring lies on (x, z).
+    radii: DVec2,
 }
 
-/// `primitiveDisk`: a polygon of `n_vertices` (at least 3, default 16) on
-/// the ellipse inscribed in `width` × `depth`, in the xz-plane facing +y.
-/// UVs map the disk onto the unit square's inscribed circle.
+impl RingPoint {
+    /// Texture coordinates mapping the rectangle onto the unit square, seen
+    /// from above (`mirrored`: seen from below).
+    fn uv(&self, mirrored: bool) -> DVec2 {
+        let v = 1.0 - self.unit.y;
+        DVec2::new(self.unit.x, if mirrored { 1.0 - v } else { v })
+    }
+
+    /// The horizontal outward normal of the ellipse through the point.
+    fn radial(&self) -> DVec3 {
+        let a = self.angle;
+        DVec3::new(a.cos() / self.radii.x, 0.0, -a.sin() / self.radii.y).normalize_or_zero()
+    }
+}
+
+/// `primitiveDisk`: a polygon of `n_vertices` (at least 3, default 16)
+/// filling `width` × `depth` ([`ring`]), in the xz-plane facing +y. UVs map
+/// the rectangle onto the unit square.
 pub fn disk(n_vertices: usize, width: f64, depth: f64) -> Mesh {
     let n = sanitize(n_vertices, 3);
     let mut m = new_mesh();
     let mut c = Vec::with_capacity(n);
-    for k in 0..n {
-        let (a, p) = ring(k, n, width, depth);
-        m.positions.push(p);
-        c.push((k as u32, disk_uv(a), DVec3::Y));
+    for (k, p) in ring(n, width, depth).iter().enumerate() {
+        m.positions.push(p.pos);
+        c.push((k as u32, p.uv(false), DVec3::Y));
     }
     face(&mut m, &c);
     m
@@ -127,42 +172,34 @@ pub fn builtin_cube() -> Mesh {
 }
 
 /// `primitiveCylinder`: `sides` (at least 3, default 16) quads around the
-/// y axis on the ellipse inscribed in the xz extent, and two caps. Faces:
-/// bottom, top, then the sides (u around from 0 to 1 starting at +x, v up).
+/// y axis filling the xz extent ([`ring`]), and two caps. Faces:
+/// bottom, top, then the sides (u around from 0 to 1 starting just after
+/// +x, v up).
 /// Side normals are smooth (radial), cap normals flat.
 pub fn cylinder(sides: usize, size: DVec3) -> Mesh {
     let n = sanitize(sides, 3);
     let mut m = new_mesh();
-    let mut angles = Vec::with_capacity(n);
-    for k in 0..n {
-        let (a, p) = ring(k, n, size.x, size.z);
-        m.positions.push(p);
-        angles.push(a);
-    }
-    for k in 0..n {
-        let p = m.positions[k];
-        m.positions.push(p + DVec3::new(0.0, size.y, 0.0));
-    }
+    let pts = ring(n, size.x, size.z);
+    m.positions.extend(pts.iter().map(|p| p.pos));
+    m.positions
+        .extend(pts.iter().map(|p| p.pos + DVec3::new(0.0, size.y, 0.0)));
     let n32 = n as u32;
     // Bottom: the base ring reversed (p1 p0 pn-1 .. p2), as extrude does.
     let bottom: Vec<_> = (0..n)
         .map(|k| {
             let i = (n + 1 - k) % n;
-            (i as u32, disk_uv(-angles[i]), -DVec3::Y)
+            (i as u32, pts[i].uv(true), -DVec3::Y)
         })
         .collect();
     face(&mut m, &bottom);
     let top: Vec<_> = (0..n)
-        .map(|k| (n32 + k as u32, disk_uv(angles[k]), DVec3::Y))
+        .map(|k| (n32 + k as u32, pts[k].uv(false), DVec3::Y))
         .collect();
     face(&mut m, &top);
-    let radial = |a: f64| {
-        DVec3::new(a.cos() / (0.5 * size.x), 0.0, -a.sin() / (0.5 * size.z)).normalize_or_zero()
-    };
     for k in 0..n {
         let j = (k + 1) % n;
         let (u0, u1) = (k as f64 / n as f64, (k + 1) as f64 / n as f64);
-        let (na, nb) = (radial(angles[k]), radial(angles[j]));
+        let (na, nb) = (pts[k].radial(), pts[j].radial());
         face(
             &mut m,
             &[
@@ -176,42 +213,40 @@ pub fn cylinder(sides: usize, size: DVec3) -> Mesh {
     m
 }
 
-/// `primitiveCone`: a base polygon of `sides` (at least 3, default 16) on
-/// the ellipse inscribed in the xz extent, and `sides` triangles up to the
-/// apex at the top centre. Faces: bottom, then the sides.
+/// `primitiveCone`: a base polygon of `sides` (at least 3, default 16)
+/// filling the xz extent ([`ring`]), and `sides` triangles up to the apex
+/// at the top centre. Faces: bottom, then the sides.
 pub fn cone(sides: usize, size: DVec3) -> Mesh {
     let n = sanitize(sides, 3);
     let mut m = new_mesh();
-    let mut angles = Vec::with_capacity(n);
-    for k in 0..n {
-        let (a, p) = ring(k, n, size.x, size.z);
-        m.positions.push(p);
-        angles.push(a);
-    }
+    let pts = ring(n, size.x, size.z);
+    m.positions.extend(pts.iter().map(|p| p.pos));
     let apex = n as u32;
     m.positions
         .push(DVec3::new(0.5 * size.x, size.y, 0.5 * size.z));
     let bottom: Vec<_> = (0..n)
         .map(|k| {
             let i = (n + 1 - k) % n;
-            (i as u32, disk_uv(-angles[i]), -DVec3::Y)
+            (i as u32, pts[i].uv(true), -DVec3::Y)
         })
         .collect();
     face(&mut m, &bottom);
     // Normal of the cone surface above the ring point at angle a.
+    let (rx, rz) = (pts[0].radii.x, pts[0].radii.y);
     let slope = |a: f64| {
         let up = if size.y != 0.0 { 1.0 / size.y } else { 1.0 };
-        DVec3::new(a.cos() / (0.5 * size.x), up, -a.sin() / (0.5 * size.z)).normalize_or_zero()
+        DVec3::new(a.cos() / rx, up, -a.sin() / rz).normalize_or_zero()
     };
     for k in 0..n {
         let j = (k + 1) % n;
         let (u0, u1) = (k as f64 / n as f64, (k + 1) as f64 / n as f64);
-        let mid = 0.5 * (angles[k] + if j == 0 { TAU } else { angles[j] });
+        let (ak, aj) = (pts[k].angle, pts[j].angle);
+        let mid = 0.5 * (ak + if j == 0 { aj + TAU } else { aj });
         face(
             &mut m,
             &[
-                (k as u32, DVec2::new(u0, 0.0), slope(angles[k])),
-                (j as u32, DVec2::new(u1, 0.0), slope(angles[j])),
+                (k as u32, DVec2::new(u0, 0.0), slope(ak)),
+                (j as u32, DVec2::new(u1, 0.0), slope(aj)),
                 (apex, DVec2::new(0.5 * (u0 + u1), 1.0), slope(mid)),
             ],
         );
@@ -329,15 +364,25 @@ mod tests {
         assert_eq!(face_area(&q, 0), 200.0);
         assert_eq!(face_normal(&q, 0), DVec3::Y);
         assert_eq!(bounds(&q), Some((DVec3::ZERO, DVec3::new(10.0, 0.0, 20.0))));
+        // 16 sides half a step off the axes: the flat sides touch the
+        // 2 x 2 square, the polygon's apothem is 1.
         let d = disk(16, 2.0, 2.0);
         assert_eq!(d.corners.len(), 16);
-        let expected = 0.5 * 16.0 * (TAU / 16.0).sin();
+        let expected = 16.0 * (PI / 16.0).tan();
         assert!((face_area(&d, 0) - expected).abs() < 1e-12);
         assert_eq!(face_normal(&d, 0), DVec3::Y);
+        assert_eq!(bounds(&d), Some((DVec3::ZERO, DVec3::new(2.0, 0.0, 2.0))));
         assert_eq!(disk(2, 1.0, 1.0).corners.len(), 3);
-        // primitiveDisk(8, 10): radius 10, an octagon.
+        // primitiveDisk(8, 10): an octagon of apothem 10, its first vertex at
+        // 22.5 degrees from +x (counter-clockwise seen from above: -z).
         let d = disk(8, 20.0, 20.0);
-        assert!((face_area(&d, 0) - 0.5 * 8.0 * 100.0 * (TAU / 8.0).sin()).abs() < 1e-9);
+        assert!((face_area(&d, 0) - 8.0 * 100.0 * (PI / 8.0).tan()).abs() < 1e-9);
+        let p0 = d.positions[0] - DVec3::new(10.0, 0.0, 10.0);
+        assert!((p0.z.atan2(p0.x) + PI / 8.0).abs() < 1e-12, "{p0}");
+        // A triangle fills its box too: vertices at 60, 180 and 300 degrees.
+        let t = disk(3, 3.0, 2.0);
+        assert_eq!(bounds(&t), Some((DVec3::ZERO, DVec3::new(3.0, 0.0, 2.0))));
+        assert!((face_area(&t, 0) - 3.0).abs() < 1e-12);
     }
 
     #[test]
@@ -372,7 +417,7 @@ mod tests {
         // primitiveCylinder(8, 10, 15): radius 10, height 15.
         let c = cylinder(8, DVec3::new(20.0, 15.0, 20.0));
         check_solid(&c);
-        let base = 0.5 * 8.0 * 100.0 * (TAU / 8.0).sin();
+        let base = 8.0 * 100.0 * (PI / 8.0).tan();
         assert!((volume(&c) - base * 15.0).abs() < 1e-9);
         assert_eq!(c.faces.len(), 10);
         assert_eq!(counts(&c, &Topology::new(&c)).vertices, 16);
@@ -383,8 +428,9 @@ mod tests {
 
         let k = cone(16, DVec3::new(2.0, 3.0, 2.0));
         check_solid(&k);
-        let base = 0.5 * 16.0 * (TAU / 16.0).sin();
+        let base = 16.0 * (PI / 16.0).tan();
         assert!((volume(&k) - base * 3.0 / 3.0).abs() < 1e-12);
+        assert_eq!(bounds(&k), Some((DVec3::ZERO, DVec3::new(2.0, 3.0, 2.0))));
         assert_eq!(k.faces.len(), 17);
 
         // primitiveSphere(8, 4, 10).

@@ -28,7 +28,8 @@
 //! so its first edge is the eave. Without overhang, base and roof faces are
 //! closed together (watertight) and the roof faces project exactly onto the
 //! footprint; with overhang the roof faces are extended outwards and down
-//! along their planes and the base stays where it was (a lid above the base,
+//! along their planes (a negative overhang pulls them in and up, as
+//! CityEngine does) and the base stays where it was (a lid above the base,
 //! as CityEngine draws it). Edges of length zero get no face.
 //!
 //! Roof edges are classified for `comp(e)`'s `eave`, `hip`, `valley` and
@@ -201,6 +202,12 @@ fn tan_of(angle_deg: f64) -> f64 {
 
 /// Per-edge outward offset of closed loops (mitred): edge `i` of loop `l`
 /// moves out by `d[l][i]`.
+/// Twice the signed area of a loop (positive counter-clockwise).
+fn loop_area(pts: &[DVec2]) -> f64 {
+    let n = pts.len();
+    (0..n).map(|i| pts[i].perp_dot(pts[(i + 1) % n])).sum()
+}
+
 fn offset_out(loops: &[Vec<DVec2>], d: &[Vec<f64>]) -> Vec<Vec<DVec2>> {
     loops
         .iter()
@@ -485,16 +492,12 @@ impl Builder {
         lift: &dyn Fn(DVec2, f64) -> DVec3,
         up: (DVec3, f64),
     ) -> Result<(), SkeletonError> {
-        let over_x = if over_x.is_finite() {
-            over_x.max(0.0)
-        } else {
-            0.0
-        };
-        let over_y = if over_y.is_finite() {
-            over_y.max(0.0)
-        } else {
-            0.0
-        };
+        // Overhangs are not clamped at zero: CityEngine pulls the eaves or
+        // the gable ends in by a negative overhang (measured with its
+        // runtime: `roofGable(30, 0, -2)` on a 20 x 30 lot has roof planes
+        // from z = -28 to -2).
+        let finite = |o: f64| if o.is_finite() { o } else { 0.0 };
+        let (over_x, over_y) = (finite(over_x), finite(over_y));
         let base_sk = skeleton(loops2, w, StopAt::Collapse, &[])?;
         let k = match slope {
             RoofSlope::Angle(a) => tan_of(a),
@@ -507,7 +510,7 @@ impl Builder {
             }
         };
         let angle = k.atan();
-        let overhang = over_x > 0.0 || over_y > 0.0;
+        let overhang = over_x != 0.0 || over_y != 0.0;
         let (sk, drop, shared) = if overhang {
             let d: Vec<Vec<f64>> = w
                 .iter()
@@ -524,6 +527,14 @@ impl Builder {
                 })
                 .collect();
             let ext = offset_out(loops2, &d);
+            // An overhang pulling the outline in past itself leaves no roof.
+            if ext
+                .iter()
+                .zip(loops2)
+                .any(|(e, l)| loop_area(e) * loop_area(l) <= 0.0)
+            {
+                return Err(SkeletonError::Empty);
+            }
             (
                 skeleton(&ext, w, StopAt::Collapse, &[])?,
                 over_x * angle.sin(),

@@ -431,6 +431,28 @@ fn solve_single(mesh: &Mesh, area: f64, lo: &[f64], cap: &[f64]) -> Option<f64> 
     }
 }
 
+/// The setback behind `shapeL`/`shapeU`/`shapeO`: [`setback`] with the
+/// remainder tagged as the page's figure shows it (op_shapeLUO: "exactly
+/// like the setback operation", with the remainder's original edges,
+/// shortened by a wing or whole, `setback.remainder`).
+pub fn setback_luo(mesh: &Mesh, distances: &[f64]) -> Offset {
+    let mut o = setback(mesh, distances);
+    let mut corner = 0;
+    for f in 0..o.mesh.faces.len() {
+        let n: usize = o.mesh.face_loops(f).iter().map(|l| l.len as usize).sum();
+        if o.kinds[f] == OffsetFace::Inside {
+            for c in corner..corner + n {
+                if o.corner_tags[c] == SetbackEdgeTag::Side && o.corner_source[c] != NO_SOURCE {
+                    o.corner_tags[c] = SetbackEdgeTag::Remainder;
+                }
+            }
+        }
+        corner += n;
+    }
+    finish_edge_tags(&mut o, mesh, true);
+    o
+}
+
 /// Strips of `shapeL`/`shapeU`/`shapeO` merged into one shape: the union of
 /// the strip faces of a [`setback`] (faces sharing mitre edges are joined),
 /// as faces with holes (an O shape is a ring). The remainder is the setback's
@@ -494,7 +516,63 @@ pub fn merge_strips(o: &Offset) -> Mesh {
     let n = strips
         .first()
         .map_or(DVec3::Y, |&f| face_normal(&o.mesh, f));
-    faces_from_loops(&loops3, n, o.mesh.faces.first().map_or(0, |f| f.material))
+    let mut m = faces_from_loops(&loops3, n, o.mesh.faces.first().map_or(0, |f| f.material));
+    m.tags = o.mesh.tags.clone();
+    if let Some(&f) = strips.first() {
+        let tags = o.mesh.faces[f].tags;
+        for face in &mut m.faces {
+            face.tags = tags;
+        }
+    }
+    copy_strip_edge_tags(&mut m, o, &strips, topo_tol);
+    m
+}
+
+/// Gives every edge of the merged strips `m` the edge tags of the strip
+/// edge it lies on (the strips' front, back and side edges keep their
+/// auto-tags and inherited tags through the merge).
+fn copy_strip_edge_tags(m: &mut Mesh, o: &Offset, strips: &[usize], tol: f64) {
+    let Some(src_tags) = o.mesh.edge_tags.as_ref() else {
+        return;
+    };
+    // Every strip edge: its end points and its tag set.
+    let mut edges: Vec<(DVec3, DVec3, u32)> = Vec::new();
+    for &f in strips {
+        for &l in o.mesh.face_loops(f) {
+            let idx = o.mesh.loop_indices(l);
+            for i in 0..idx.len() {
+                let c = l.start as usize + i;
+                let a = o.mesh.positions[idx[i] as usize];
+                let b = o.mesh.positions[idx[(i + 1) % idx.len()] as usize];
+                edges.push((a, b, src_tags[c]));
+            }
+        }
+    }
+    let tol = tol.max(1e-9);
+    let on = |a: DVec3, b: DVec3, p: DVec3| {
+        let ab = b - a;
+        let len2 = ab.length_squared();
+        if len2 == 0.0 {
+            return false;
+        }
+        let t = (p - a).dot(ab) / len2;
+        (-1e-9..=1.0 + 1e-9).contains(&t) && (a + ab * t).distance(p) <= tol
+    };
+    let mut list = vec![0u32; m.corners.len()];
+    for f in 0..m.faces.len() {
+        for &l in m.face_loops(f) {
+            let idx = m.loop_indices(l).to_vec();
+            for i in 0..idx.len() {
+                let a = m.positions[idx[i] as usize];
+                let b = m.positions[idx[(i + 1) % idx.len()] as usize];
+                let mid = (a + b) * 0.5;
+                if let Some(&(_, _, t)) = edges.iter().find(|(p, q, _)| on(*p, *q, mid)) {
+                    list[l.start as usize + i] = t;
+                }
+            }
+        }
+    }
+    m.edge_tags = (!list.iter().all(|&t| t == 0)).then_some(list);
 }
 
 /// Faces from closed loops in a plane of normal `n`: counter-clockwise loops

@@ -716,8 +716,9 @@ impl Components {
     }
 
     /// The trim planes of face `f` (parent scope-local coordinates): one
-    /// per edge shared with another face. `pivot_y`: the new pivot's y axis.
-    fn trim_planes(&mut self, f: usize, pivot_y: DVec3) -> Vec<TrimPlane> {
+    /// per edge shared with another face (classified when applied, against
+    /// the pivot then in force: `crate::trim`).
+    fn trim_planes(&mut self, f: usize) -> Vec<TrimPlane> {
         self.topology();
         let topo = self.topo.as_ref().expect("just computed");
         let mesh = &*self.mesh;
@@ -744,7 +745,7 @@ impl Components {
                 let (a, b) = self.corner_edge(c);
                 let m_face = self.inward(f, c);
                 let m_other = self.inward(other.face as usize, other.corner as usize);
-                let Some(plane) = bisecting_plane(a, b, m_face, m_other, pivot_y) else {
+                let Some(plane) = bisecting_plane(a, b, m_face, m_other) else {
                     continue;
                 };
                 // Collinear edges with the same neighbour give the same plane.
@@ -826,9 +827,7 @@ impl Components {
         if trim {
             if let Item::Faces { start, len: 1 } = first {
                 let f = self.face_list[start as usize] as usize;
-                // Planes are classified against the new pivot's xz-plane.
-                let pivot_y = p.scope.frame.axes.transpose() * pivot.axes.y_axis;
-                let planes = self.trim_planes(f, pivot_y);
+                let planes = self.trim_planes(f);
                 if !planes.is_empty() {
                     let frame = p.scope.frame;
                     let planes: Vec<TrimPlane> = planes
@@ -836,7 +835,7 @@ impl Components {
                         .map(|t| TrimPlane {
                             point: frame.to_object(t.point),
                             normal: frame.axes * t.normal,
-                            vertical: t.vertical,
+                            edge: frame.axes * t.edge,
                         })
                         .collect();
                     shape.trim.planes = Some(Arc::from(planes));

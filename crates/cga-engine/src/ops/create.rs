@@ -101,6 +101,16 @@ fn primitive(shape: &mut Shape, op: Primitive, args: &[Arg]) -> Result<(), RtErr
         }
     };
     let mut mesh = mesh;
+    if !sized {
+        // The unit primitive, as an asset, is centred on its origin in x
+        // and z and stands on y = 0: a zero-size scope keeps that position,
+        // as `i()` keeps an asset's (measured with CityEngine's runtime: a
+        // quad into a point scope is centred on the point).
+        cga_geometry::transform::transform(
+            &mut mesh,
+            &DAffine3::from_translation(DVec3::new(-0.5, 0.0, -0.5)),
+        );
+    }
     // A flat primitive goes into the plane of the scope's non-zero sizes,
     // and with dimensions it is centred within that plane.
     let plane = if flat {
@@ -283,6 +293,9 @@ fn insert_fitted_in(
     }
 }
 
+/// Below this distance (absolute, in metres) `extrude` does nothing.
+const NEGLIGIBLE_EXTRUSION: f64 = 1.8e-3;
+
 fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {
     use cga_geometry::Extrusion;
     let (kind, dist) = match args {
@@ -311,7 +324,12 @@ fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {
         _ => unreachable!("arity checked by the resolver"),
     };
     // Extrude in object coordinates, where "world up" is +y.
-    if shape.geometry.is_empty() {
+    // CityEngine leaves the face as it is when the distance is (nearly)
+    // nothing: one face, no zero-height box (measured with its runtime on
+    // lots from 2 x 3 to 200 x 300: the threshold is absolute). A flat top's
+    // distance counts from the highest vertex: 0 still builds a solid.
+    let negligible = kind != "world.up.flatTop" && dist.abs() < NEGLIGIBLE_EXTRUSION;
+    if shape.geometry.is_empty() || negligible {
         return Ok(());
     }
     let mesh = shape.take_object_mesh();

@@ -532,7 +532,7 @@ fn shape_luo(
             }
         })
         .collect();
-    let o = cga_geometry::setback(&mesh, &d);
+    let o = cga_geometry::setback_luo(&mesh, &d);
     warn_failed(cx, call.span, name, &o.failed);
     let mut shape_mesh = cga_geometry::merge_strips(&o);
     cga_geometry::uv_carry::carry_uvs(&mesh, &mut shape_mesh);

@@ -59,7 +59,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Derive lots with a rule file and write the model.
-    Generate(GenerateArgs),
+    Generate(Box<GenerateArgs>),
     /// Parse and resolve a rule file; report every error.
     Check {
         /// The rule file.
@@ -79,10 +79,19 @@ enum Command {
 struct GenerateArgs {
     /// The rule file (.cga).
     rules: PathBuf,
-    /// A lot: `rect:W,D`, an .obj file (each face one lot) or a .geojson
-    /// file (each polygon one lot). Repeatable. Default: `rect:20,30`.
+    /// A lot: `rect:W,D`, `grid:COLSxROWS`, an .obj file (each face one
+    /// lot) or a .geojson, .fgb, .gpkg or .shp file (each polygon one lot).
+    /// Repeatable. Default: `rect:20,30`.
     #[arg(long = "lot", value_name = "SPEC")]
     lots: Vec<String>,
+    /// The coordinate reference system of every lot file, whatever they
+    /// declare: `EPSG:N`, or `local` (metres of a plane, not georeferenced).
+    #[arg(long, value_name = "EPSG:N")]
+    crs: Option<cga::CrsOption>,
+    /// Invalid lots (crossing rings, stray holes, slivers): `repair` them,
+    /// `skip` them or stop with an `error`; each is named in a warning.
+    #[arg(long, value_name = "WHAT", default_value = "repair")]
+    invalid: cga::InvalidPolicy,
     /// The start rule (default: the rule marked @StartRule, else `Lot`).
     #[arg(long, value_name = "NAME")]
     start_rule: Option<String>,
@@ -174,7 +183,7 @@ fn main() -> ExitCode {
     let worker = std::thread::Builder::new()
         .stack_size(MAIN_STACK)
         .spawn(move || match cli.command {
-            Command::Generate(args) => generate(args),
+            Command::Generate(args) => generate(*args),
             Command::Check {
                 rules,
                 format,
@@ -280,9 +289,16 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
         })?),
         None => None,
     };
-    let lots = cga::lots::read(&args.lots)?;
+    let lot_options = cga::LotOptions {
+        crs: args.crs.clone(),
+        invalid: args.invalid,
+    };
+    let lots = cga::lots::read_with(&args.lots, &lot_options)?;
     for note in &lots.notes {
         eprintln!("note: {note}");
+    }
+    for warning in &lots.warnings {
+        eprintln!("warning: {warning}");
     }
     let engine = Engine::on_disk()
         .max_asset_mib(args.max_asset_mib)
@@ -320,7 +336,7 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
                 georeference: lots.origin.map(|o| Georeference {
                     longitude: o.lon,
                     latitude: o.lat,
-                    earth_radius: cga::EARTH_RADIUS,
+                    projection: o.proj_string(),
                 }),
                 flush_mib: args.held_mib,
                 ..rules.export_options()

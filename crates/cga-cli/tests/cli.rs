@@ -498,11 +498,14 @@ fn obj_and_geojson_lots_give_one_initial_shape_per_polygon() {
            "coordinates":[[[[20,0],[22,0],[22,2],[20,2],[20,0]]],[[[30,0],[31,0],[31,1],[30,0]]]]}}]}"#,
     )
     .unwrap();
+    // Plain metres: GeoJSON is longitude/latitude unless told otherwise.
     let out = run(&[
         "generate",
         rules.to_str().unwrap(),
         "--lot",
         gj.to_str().unwrap(),
+        "--crs",
+        "local",
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert_eq!(stdout(&out), "a 96 12\nb 4 3\nb.1 0.5 3\n");
@@ -599,13 +602,9 @@ fn geographic_geojson_is_projected_to_metres() {
         stderr(&out)
     );
     let area: f64 = stdout(&out).trim().parse().unwrap();
-    let k = std::f64::consts::PI / 180.0 * 6_371_008.8;
-    let expected = (0.0004 * k * (47.3701f64.to_radians()).cos()) * (0.0002 * k);
-    assert!(
-        (area - expected).abs() < 0.01 * expected,
-        "{area} vs {expected}"
-    );
-    assert!((area - 30.1 * 22.2).abs() < 5.0, "{area}");
+    // On the WGS84 ellipsoid at 47.37 N: 0.0004 deg of longitude is
+    // 30.21 m, 0.0002 deg of latitude 22.24 m (geodesic lengths).
+    assert!((area - 30.21 * 22.24).abs() < 0.5, "{area}");
 }
 
 #[test]
@@ -648,23 +647,23 @@ fn geographic_origin_is_recorded_in_the_output_and_shared_by_all_files() {
         serde_json::from_str(&std::fs::read_to_string(&glb).unwrap()).unwrap();
     let g = &doc["asset"]["extras"]["georeference"];
     assert_eq!(g["crs"], "EPSG:4326");
-    // The first file's centre: the mean of its five ring positions.
+    // The centre of both files' extent: 8.5400..8.5414 E, 47.3700..47.3702 N.
     let lon = g["origin"]["longitude"].as_f64().unwrap();
     let lat = g["origin"]["latitude"].as_f64().unwrap();
+    assert!((lon - 8.5407).abs() < 1e-9, "{lon}");
+    assert!((lat - 47.3701).abs() < 1e-9, "{lat}");
+    let projection = g["projection"].as_str().unwrap();
     assert!(
-        (lon - (8.5400 * 3.0 + 8.5404 * 2.0) / 5.0).abs() < 1e-12,
-        "{lon}"
+        projection.starts_with(&format!("+proj=tmerc +lat_0={lat} +lon_0={lon} +k_0=1")),
+        "{projection}"
     );
-    assert!(
-        (lat - (47.3700 * 3.0 + 47.3702 * 2.0) / 5.0).abs() < 1e-12,
-        "{lat}"
-    );
-    assert_eq!(g["earthRadius"].as_f64(), Some(6_371_008.8));
-    // The second block lies 0.001 deg (about 75.4 m) east of the first.
+    // The blocks span 0.0014 deg of longitude: 105.74 m on the parallel
+    // of 47.37 N (radius N cos(lat) = 4,327 km on the ellipsoid).
     let s = summarize_gltf_bounds(&glb);
-    let k = std::f64::consts::PI / 180.0 * 6_371_008.8 * lat.to_radians().cos();
-    let width = (0.0014 * k) as f32;
+    let frame = cga::GeoOrigin { lon, lat };
+    let width = (frame.to_local(8.5414, 47.37).0 - frame.to_local(8.54, 47.37).0) as f32;
     assert!((s.1[0] - s.0[0] - width).abs() < 0.01, "{s:?} vs {width}");
+    assert!((width - 105.74).abs() < 0.01, "{width}");
 
     let obj = dir.join("city.obj");
     let out = run(&[
@@ -678,10 +677,18 @@ fn geographic_origin_is_recorded_in_the_output_and_shared_by_all_files() {
     assert!(out.status.success(), "{}", stderr(&out));
     let text = std::fs::read_to_string(&obj).unwrap();
     let header = text.lines().nth(1).unwrap();
+    // One file: its own centre.
+    let origin: Vec<f64> = header
+        .split(' ')
+        .filter_map(|w| w.parse().ok())
+        .take(2)
+        .collect();
     assert!(
-        header.starts_with(&format!(
-            "# georeference: origin longitude {lon} latitude {lat}"
-        )),
+        (origin[0] - 8.5402).abs() < 1e-9 && (origin[1] - 47.3701).abs() < 1e-9,
+        "{header}"
+    );
+    assert!(
+        header.starts_with("# georeference: origin longitude ") && header.contains("+proj=tmerc"),
         "{header}"
     );
     // Lots in metres carry no georeference.
@@ -749,6 +756,18 @@ fn flatgeobuf_lots_with_attributes() {
         "f.cga",
         "attr height = 1\nLot --> extrude(height) print(geometry.volume)\n",
     );
+    // Without a CRS in its header, numbers within longitude/latitude
+    // ranges are taken for them (with a warning); --crs local says metres.
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--lot",
+        path.to_str().unwrap(),
+        "--crs",
+        "local",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(stdout(&out), "2400\n1500\n");
     let out = run(&[
         "generate",
         rules.to_str().unwrap(),
@@ -756,7 +775,13 @@ fn flatgeobuf_lots_with_attributes() {
         path.to_str().unwrap(),
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
-    assert_eq!(stdout(&out), "2400\n1500\n");
+    assert!(
+        stderr(&out).contains("declares no coordinate reference system; its coordinates are within longitude/latitude ranges"),
+        "{}",
+        stderr(&out)
+    );
+    let volumes: Vec<f64> = stdout(&out).lines().map(|l| l.parse().unwrap()).collect();
+    assert!(volumes[0] > 1e12, "{volumes:?}");
 }
 
 #[test]
@@ -830,6 +855,72 @@ fn assets_over_the_size_limit_are_a_warning() {
     assert_eq!(stdout(&out), "1\n", "the lot keeps its own geometry");
     let out = run(&["generate", rules.to_str().unwrap()]);
     assert_eq!(stdout(&out), "300\n");
+}
+
+#[test]
+fn crs_and_invalid_options() {
+    let dir = temp_dir("gis-options");
+    let rules = rule_file(
+        &dir,
+        "a.cga",
+        "Lot --> print(initialShape.name + \" \" + geometry.area)\n",
+    );
+    let gj = dir.join("eight.geojson");
+    std::fs::write(
+        &gj,
+        r#"{"type":"FeatureCollection","features":[
+{"type":"Feature","id":"eight","properties":{},"geometry":{"type":"Polygon","coordinates":[[[0,0],[10,10],[10,0],[0,10],[0,0]]]}},
+{"type":"Feature","id":"ok","properties":{},"geometry":{"type":"Polygon","coordinates":[[[20,0],[30,0],[30,10],[20,10],[20,0]]]}}]}"#,
+    )
+    .unwrap();
+    let args = |extra: &[&str]| {
+        let mut a = vec![
+            "generate",
+            rules.to_str().unwrap(),
+            "--lot",
+            gj.to_str().unwrap(),
+        ];
+        a.extend_from_slice(extra);
+        run(&a)
+    };
+    // Repaired by default: two triangles of 25 m², with a warning.
+    let out = args(&["--crs", "local"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(stdout(&out), "eight 25\neight-1 25\nok 100\n");
+    assert!(
+        stderr(&out).contains("warning: ") && stderr(&out).contains("crosses itself at (5, 5)"),
+        "{}",
+        stderr(&out)
+    );
+    let out = args(&["--crs", "local", "--invalid", "skip"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(stdout(&out), "ok 100\n");
+    let out = args(&["--crs", "local", "--invalid", "error"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("lot `eight` is invalid"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(stdout(&out), "");
+    // Bad option values are usage errors.
+    let out = args(&["--crs", "EPSG:99999999"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("EPSG:99999999"), "{}", stderr(&out));
+    let out = args(&["--invalid", "ignore"]);
+    assert_eq!(out.status.code(), Some(2));
+    // Web Mercator at the equator: east-west metres are ground metres,
+    // north-south ones are the sphere's, 1 - e² = 0.99331 of the ground's.
+    let out = args(&["--crs", "EPSG:3857", "--invalid", "skip"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let area: f64 = stdout(&out)
+        .trim()
+        .rsplit_once(' ')
+        .unwrap()
+        .1
+        .parse()
+        .unwrap();
+    assert!((area - 99.3306).abs() < 0.001, "{area}");
 }
 
 /// A rule package as CityEngine shares them (here a zip archive): `cga

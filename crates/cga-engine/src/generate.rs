@@ -266,7 +266,7 @@ fn own_seed(program: &Program, lot: &Lot) -> Option<u64> {
     }
     lot.attrs
         .iter()
-        .find(|(n, _)| n == "seed")
+        .find(|(n, _)| &**n == "seed")
         .and_then(|(_, v)| match v {
             Value::Float(x) if *x >= 0.0 && x.is_finite() => Some(*x as u64),
             Value::Str(s) => s.trim().parse().ok(),

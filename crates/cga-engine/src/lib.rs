@@ -9,6 +9,7 @@ pub mod expr;
 pub mod file_fns;
 pub mod generate;
 pub mod geo;
+pub mod gis;
 pub mod locate;
 pub mod lot;
 pub mod material_attr;

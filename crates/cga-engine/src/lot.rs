@@ -1,4 +1,5 @@
-//! Initial shapes: lots from a `W,D` rectangle, OBJ faces or GeoJSON polygons.
+//! Initial shapes: lots from a `W,D` rectangle, a grid of them, OBJ faces,
+//! or GIS files (see [`crate::gis`]).
 //!
 //! Conventions: y is up, lots lie in the x-z plane, counter-clockwise seen
 //! from above, and the first edge is the street front. The initial pivot
@@ -6,8 +7,8 @@
 //! axis along the lot's normal; the scope is the lot's bounding box in that
 //! frame. A polygon given clockwise keeps its orientation: its normal points
 //! down and so do its extrusions, as in CityEngine's runtime (a clockwise
-//! 10 x 10 OBJ lot extruded by 7 spans y -7..0 there). GeoJSON rings are
-//! oriented by their own convention when read.
+//! 10 x 10 OBJ lot extruded by 7 spans y -7..0 there). Rings of GIS files
+//! are oriented counter-clockwise (holes clockwise) when read.
 
 use std::sync::Arc;
 
@@ -22,10 +23,11 @@ use crate::shape::{Frame, Geometry, Scope, Shape, TrimFlags};
 pub struct Lot {
     pub name: String,
     pub mesh: Mesh,
-    /// Values for rule attributes of the same name (GeoJSON properties).
-    pub attrs: Vec<(String, Value)>,
-    /// Where the lot's frame lies on the globe, for lots given in
-    /// longitude/latitude (`getGeoCoord(lon|lat)`).
+    /// Values for rule attributes of the same name (feature properties;
+    /// the names are shared by the lots of a file).
+    pub attrs: Vec<(Arc<str>, Value)>,
+    /// Where the lot's frame lies on the globe, for lots of georeferenced
+    /// GIS files (`getGeoCoord(lon|lat)`).
     pub geo_origin: Option<crate::geo::GeoOrigin>,
 }
 
@@ -258,139 +260,49 @@ fn first_edge_frame(mesh: &Mesh) -> (DVec3, DVec3) {
     (n, x)
 }
 
-/// Each polygon of a GeoJSON file is one lot (MultiPolygons give one lot
-/// per polygon); holes are kept; feature properties become attribute values.
-/// GeoJSON `[x, y, z]` maps to `(x, z, -y)`: y up, north away from the viewer.
-pub fn from_geojson(path: &std::path::Path) -> Result<Vec<Lot>, String> {
-    from_geojson_georeferenced(path, None).map(|(lots, _)| lots)
-}
-
-/// The lots of a GeoJSON file and, when its coordinates are geographic
-/// (longitude, latitude in degrees, as RFC 7946 specifies), the origin of
-/// the local metric frame they were projected into: x east and -z north in
-/// metres from that origin (see [`crate::geo`]). `frame`: the origin to
-/// project into (an earlier file's, so that lots of several files share one
-/// frame); `None`: the centre of this file's data.
-pub fn from_geojson_georeferenced(
-    path: &std::path::Path,
-    frame: Option<crate::geo::GeoOrigin>,
-) -> Result<(Vec<Lot>, Option<crate::geo::GeoOrigin>), String> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("cannot read lot file {}: {e}", path.display()))?;
-    lots_from_geojson_text(path, &text, frame)
-}
-
-/// The lots of a FlatGeobuf file (each polygon one lot, attributes from the
-/// feature properties), like [`from_geojson_georeferenced`].
-pub fn from_flatgeobuf(
-    path: &std::path::Path,
-    frame: Option<crate::geo::GeoOrigin>,
-) -> Result<(Vec<Lot>, Option<crate::geo::GeoOrigin>), String> {
-    use geozero::GeozeroDatasource;
-    let bad = |e: &dyn std::fmt::Display| format!("cannot read FlatGeobuf {}: {e}", path.display());
-    let file = std::fs::File::open(path).map_err(|e| bad(&e))?;
-    let mut reader = std::io::BufReader::new(file);
-    let mut fgb = flatgeobuf::FgbReader::open(&mut reader)
-        .and_then(|r| r.select_all())
-        .map_err(|e| bad(&e))?;
-    let mut json = Vec::new();
-    fgb.process(&mut geozero::geojson::GeoJsonWriter::new(&mut json))
-        .map_err(|e| bad(&e))?;
-    let text = String::from_utf8(json).map_err(|e| bad(&e))?;
-    lots_from_geojson_text(path, &text, frame)
-}
-
-fn lots_from_geojson_text(
-    path: &std::path::Path,
-    text: &str,
-    frame: Option<crate::geo::GeoOrigin>,
-) -> Result<(Vec<Lot>, Option<crate::geo::GeoOrigin>), String> {
-    let mut gj: geojson::GeoJson = text
-        .parse()
-        .map_err(|e| format!("{} is not valid GeoJSON: {e}", path.display()))?;
-    let origin = crate::geo::localize_geojson(&mut gj, frame);
-    let features: Vec<geojson::Feature> = match gj {
-        geojson::GeoJson::FeatureCollection(fc) => fc.features,
-        geojson::GeoJson::Feature(f) => vec![f],
-        geojson::GeoJson::Geometry(g) => vec![geojson::Feature {
-            geometry: Some(g),
-            ..Default::default()
-        }],
+/// `grid:COLSxROWS` (20 x 30 lots) or `grid:COLSxROWS:LOTS.obj` (copies of
+/// the OBJ's lots): a synthetic city of lots in a grid, for benchmarks.
+pub fn grid(spec: &str) -> Result<Vec<Lot>, String> {
+    let (dims, source) = match spec.split_once(':') {
+        Some((d, s)) => (d, Some(s)),
+        None => (spec, None),
     };
-    let mut lots = Vec::new();
-    for (fi, feature) in features.iter().enumerate() {
-        let attrs: Vec<(String, Value)> = feature
-            .properties
-            .iter()
-            .flatten()
-            .filter_map(|(k, v)| {
-                let v = match v {
-                    serde_json::Value::Number(n) => Value::Float(n.as_f64()?),
-                    serde_json::Value::Bool(b) => Value::Bool(*b),
-                    serde_json::Value::String(s) => Value::Str(Arc::from(s.as_str())),
-                    _ => return None,
-                };
-                Some((k.clone(), v))
-            })
-            .collect();
-        let Some(geometry) = &feature.geometry else {
-            continue;
-        };
-        let polygons: Vec<&Vec<Vec<Vec<f64>>>> = match &geometry.value {
-            geojson::Value::Polygon(p) => vec![p],
-            geojson::Value::MultiPolygon(mp) => mp.iter().collect(),
-            _ => continue,
-        };
-        for (pi, rings) in polygons.into_iter().enumerate() {
-            let mut mesh = Mesh::new();
-            let mut loops: Vec<Vec<u32>> = Vec::new();
-            for ring in rings {
-                let mut pts: Vec<DVec3> = ring
-                    .iter()
-                    .filter(|c| c.len() >= 2 && c.iter().all(|x| x.is_finite()))
-                    .map(|c| DVec3::new(c[0], c.get(2).copied().unwrap_or(0.0), -c[1]))
-                    .collect();
-                // GeoJSON rings repeat their first point at the end.
-                if pts.len() > 1 && pts.first() == pts.last() {
-                    pts.pop();
-                }
-                if pts.len() < 3 {
-                    continue;
-                }
-                let start = mesh.positions.len() as u32;
-                mesh.positions.extend(pts.iter().copied());
-                loops.push((start..mesh.positions.len() as u32).collect());
+    let bad = || format!("expected grid:COLSxROWS[:LOTS.obj], found `grid:{spec}`");
+    let (c, r) = dims.split_once('x').ok_or_else(bad)?;
+    let cols: usize = c.trim().parse().map_err(|_| bad())?;
+    let rows: usize = r.trim().parse().map_err(|_| bad())?;
+    if cols == 0 || rows == 0 || cols.saturating_mul(rows) > 10_000_000 {
+        return Err(bad());
+    }
+    let base = match source {
+        Some(path) => from_obj(std::path::Path::new(path))?,
+        None => vec![rect(20.0, 30.0)],
+    };
+    let (lo, hi) = base
+        .iter()
+        .filter_map(|l| cga_geometry::measure::bounds(&l.mesh))
+        .fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(lo, hi), (a, b)| (lo.min(a), hi.max(b)),
+        );
+    let step = (hi - lo) + DVec3::splat(10.0);
+    let mut lots = Vec::with_capacity(cols * rows * base.len());
+    for row in 0..rows {
+        for col in 0..cols {
+            let shift = DVec3::new(col as f64 * step.x, 0.0, -(row as f64) * step.z);
+            for b in &base {
+                let mut l = b.clone();
+                l.mesh.map_positions(|p| p + shift);
+                l.name = format!("grid {col},{row} {}", b.name);
+                lots.push(l);
             }
-            if loops.is_empty() {
-                continue;
-            }
-            orient_rings(&mesh.positions, &mut loops);
-            let refs: Vec<&[u32]> = loops.iter().map(|l| l.as_slice()).collect();
-            mesh.add_face(&refs, 0);
-            let id = feature
-                .id
-                .as_ref()
-                .map(|id| match id {
-                    geojson::feature::Id::String(s) => s.clone(),
-                    geojson::feature::Id::Number(n) => n.to_string(),
-                })
-                .unwrap_or_else(|| fi.to_string());
-            lots.push(Lot {
-                name: if pi == 0 { id } else { format!("{id}.{pi}") },
-                mesh,
-                attrs: attrs.clone(),
-                geo_origin: origin,
-            });
         }
     }
-    if lots.is_empty() {
-        return Err(format!("{} has no polygons to use as lots", path.display()));
-    }
-    Ok((lots, origin))
+    Ok(lots)
 }
 
 /// Outer ring counter-clockwise seen from above (+y), holes clockwise.
-fn orient_rings(positions: &[DVec3], loops: &mut [Vec<u32>]) {
+pub(crate) fn orient_rings(positions: &[DVec3], loops: &mut [Vec<u32>]) {
     for (i, l) in loops.iter_mut().enumerate() {
         // Signed area in the x-z plane seen from +y: positive = counter-clockwise.
         let mut a = 0.0;

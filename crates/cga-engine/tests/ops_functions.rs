@@ -76,10 +76,13 @@ fn get_geo_coord() {
     )
     .ok();
     let p: Vec<f64> = g.prints().iter().map(|l| l.parse().unwrap()).collect();
-    // The scope origin is 30 m north of the frame's origin.
+    // The scope origin is 30 m north of the frame's origin, on its central
+    // meridian: 30 m along the meridian on the WGS84 ellipsoid.
     assert_near(p[2], 8.54, 1e-12);
-    let metres_per_degree = 6_371_008.8 * std::f64::consts::PI / 180.0;
-    assert_near(p[3], 47.37 + 30.0 / metres_per_degree, 1e-12);
+    use geographiclib_rs::DirectGeodesic;
+    let (lat, _lon): (f64, f64) =
+        geographiclib_rs::Geodesic::wgs84().direct(47.37, 8.54, 0.0, 30.0);
+    assert_near(p[3], lat, 1e-10);
     let back = origin.to_local(p[2], p[3]);
     assert_near(back.0, 0.0, 1e-6);
     assert_near(back.1, 30.0, 1e-6);

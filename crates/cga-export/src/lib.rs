@@ -120,33 +120,34 @@ impl Default for ExportOptions {
 
 /// The geographic origin of a model's local metric frame: x is east, y up
 /// and -z north, in metres, of the point (`longitude`, `latitude`) (WGS84
-/// degrees), by the local equirectangular projection
-/// x = R·cos(lat0)·Δlon, -z = R·Δlat with R = `earth_radius`.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// degrees), by the transverse Mercator projection on the WGS84 ellipsoid
+/// centred there (scale 1 on the central meridian), `projection` as a PROJ
+/// string.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Georeference {
     pub longitude: f64,
     pub latitude: f64,
-    pub earth_radius: f64,
+    pub projection: String,
 }
 
 impl Georeference {
     /// The record written into glTF `asset.extras`.
-    fn to_json(self) -> serde_json::Value {
+    fn to_json(&self) -> serde_json::Value {
         serde_json::json!({
             "georeference": {
                 "crs": "EPSG:4326",
                 "origin": { "longitude": self.longitude, "latitude": self.latitude },
-                "projection": "local equirectangular: x = R*cos(latitude)*dLongitude east, -z = R*dLatitude north, y up; metres",
-                "earthRadius": self.earth_radius,
+                "projection": self.projection,
+                "axes": "x = easting, -z = northing, y = up (metres in the projection)",
             }
         })
     }
 
     /// The comment line written at the top of an OBJ file.
-    fn obj_comment(self) -> String {
+    fn obj_comment(&self) -> String {
         format!(
-            "# georeference: origin longitude {} latitude {} (EPSG:4326); x east, y up, -z north in metres (local equirectangular, R = {})",
-            self.longitude, self.latitude, self.earth_radius
+            "# georeference: origin longitude {} latitude {} (EPSG:4326); x east, y up, -z north in metres of {}",
+            self.longitude, self.latitude, self.projection
         )
     }
 }
@@ -246,8 +247,8 @@ enum Sink {
 /// Streams meshes into a GLB, glTF or OBJ file; see the crate docs.
 ///
 /// Nothing is complete on disk until [`finish`](ModelWriter::finish)
-/// returns: GLB and glTF are written there, OBJ writes its vertices as meshes
-/// come and its faces and materials there.
+/// returns: GLB and glTF are written there, OBJ writes its vertices and
+/// faces as meshes come and its materials there.
 pub struct ModelWriter {
     table: MaterialTable,
     textures: Textures,
@@ -276,7 +277,7 @@ impl ModelWriter {
                     path,
                     format == Format::Glb,
                     options.embed_textures,
-                    options.georeference.map(Georeference::to_json),
+                    options.georeference.as_ref().map(Georeference::to_json),
                     options.flush_mib,
                 )?;
                 let reserved = w.file_names();
@@ -285,7 +286,7 @@ impl ModelWriter {
             Format::Obj => {
                 let w = obj::ObjWriter::create(
                     path,
-                    options.georeference.map(Georeference::obj_comment),
+                    options.georeference.as_ref().map(Georeference::obj_comment),
                 )?;
                 let reserved = w.file_names();
                 (
@@ -320,7 +321,7 @@ impl ModelWriter {
             Path::new(name),
             true,
             true,
-            options.georeference.map(Georeference::to_json),
+            options.georeference.as_ref().map(Georeference::to_json),
             options.flush_mib,
         );
         Ok(ModelWriter::with_sink(
@@ -407,7 +408,12 @@ impl ModelWriter {
                     let material = slots.id(f.material, || {
                         let (id, new) = table.intern(&materials[f.material as usize]);
                         if new {
-                            w.new_material(table.get(id), textures, &mut stats.warnings);
+                            w.new_material(
+                                table.name(id),
+                                table.get(id),
+                                textures,
+                                &mut stats.warnings,
+                            );
                         }
                         id
                     });

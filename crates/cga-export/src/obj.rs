@@ -1,11 +1,10 @@
 //! Wavefront OBJ + MTL output.
 //!
-//! Vertices (`v`, `vt`, `vn`) are written as meshes come: a position used by
-//! several faces of a mesh is one `v`; equal UVs and normals share one `vt` /
-//! `vn`, also across meshes. Faces are
-//! grouped per material so each material has one `usemtl` group: the
-//! writer keeps them as compact index triples (12 bytes per corner) and
-//! writes them, and the MTL file, in `finish`.
+//! Everything is written as meshes come, so memory does not grow with the
+//! model: vertices (`v`, `vt`, `vn`; a position used by several faces of a
+//! mesh is one `v`; equal UVs and normals share one `vt` / `vn`, also
+//! across meshes), then each face, after a `usemtl` line where its material
+//! differs from the face before. The MTL file is written in `finish`.
 //!
 //! Faces are written as polygons; faces with holes are written as their
 //! triangles, since OBJ has no holes. Numbers are written with at most six
@@ -45,14 +44,6 @@ enum MapRef {
     Missing(Arc<str>),
 }
 
-/// The faces of one material: per face its corner count, and per corner
-/// its 1-based (v, vt, vn) indices (vt = 0: none).
-#[derive(Default)]
-struct Group {
-    sizes: Vec<u32>,
-    refs: Vec<[u32; 3]>,
-}
-
 pub(crate) struct ObjWriter {
     path: PathBuf,
     out: BufWriter<File>,
@@ -67,7 +58,11 @@ pub(crate) struct ObjWriter {
     vn_ids: FastMap<[u64; 3], u32>,
     /// (v, vt, vn) of each corner of the face being added.
     corner_refs: Vec<[u32; 3]>,
-    groups: Vec<Group>,
+    /// Per material: its MTL name and whether a face used it.
+    names: Vec<String>,
+    used: Vec<bool>,
+    /// The material of the last `usemtl` line.
+    current: Option<u32>,
     maps: Vec<[Option<MapRef>; MAPS.len()]>,
 }
 
@@ -97,7 +92,9 @@ impl ObjWriter {
             vt_ids: FastMap::default(),
             vn_ids: FastMap::default(),
             corner_refs: Vec::new(),
-            groups: Vec::new(),
+            names: Vec::new(),
+            used: Vec::new(),
+            current: None,
             maps: Vec::new(),
         })
     }
@@ -113,6 +110,7 @@ impl ObjWriter {
 
     pub(crate) fn new_material(
         &mut self,
+        name: &str,
         material: &Material,
         textures: &mut Textures,
         warnings: &mut Vec<String>,
@@ -128,7 +126,8 @@ impl ObjWriter {
             })
         });
         self.maps.push(maps);
-        self.groups.push(Group::default());
+        self.names.push(name.to_string());
+        self.used.push(false);
     }
 
     pub(crate) fn begin_mesh(&mut self, mesh: &Mesh) {
@@ -197,17 +196,23 @@ impl ObjWriter {
                 self.corner_refs[c] = [v, vt, vn];
             }
         }
-        let group = &mut self.groups[f.material as usize];
+        let io = |e| ExportError::io(&self.path, e);
+        if self.current != Some(f.material) {
+            self.current = Some(f.material);
+            self.used[f.material as usize] = true;
+            writeln!(self.out, "usemtl {}", self.names[f.material as usize]).map_err(io)?;
+        }
+        let (line, refs) = (&mut self.line, &self.corner_refs);
         if loops.len() == 1 {
-            let outer = mesh.loop_corners(loops[0]);
-            group.sizes.push(outer.len() as u32);
-            group.refs.extend(outer.map(|c| self.corner_refs[c]));
+            write_face(
+                &mut self.out,
+                line,
+                mesh.loop_corners(loops[0]).map(|c| refs[c]),
+            )
+            .map_err(io)?;
         } else {
             for t in f.triangles {
-                group.sizes.push(3);
-                group
-                    .refs
-                    .extend(t.iter().map(|&c| self.corner_refs[c as usize]));
+                write_face(&mut self.out, line, t.iter().map(|&c| refs[c as usize])).map_err(io)?;
             }
         }
         Ok(())
@@ -220,34 +225,10 @@ impl ObjWriter {
         stats: &mut ExportStats,
     ) -> Result<(), ExportError> {
         let path = self.path.clone();
-        let io = |e| ExportError::io(&path, e);
-        let used: Vec<u32> = (0..self.groups.len() as u32)
-            .filter(|&id| !self.groups[id as usize].sizes.is_empty())
+        self.out.flush().map_err(|e| ExportError::io(&path, e))?;
+        let used: Vec<u32> = (0..self.used.len() as u32)
+            .filter(|&id| self.used[id as usize])
             .collect();
-        let out = &mut self.out;
-        for &id in &used {
-            let group = &self.groups[id as usize];
-            writeln!(out, "usemtl {}", table.name(id)).map_err(io)?;
-            let mut refs = group.refs.iter();
-            for &size in &group.sizes {
-                let line = &mut self.line;
-                line.clear();
-                line.push(b'f');
-                for &[v, vt, vn] in refs.by_ref().take(size as usize) {
-                    line.push(b' ');
-                    push_u32(line, v);
-                    line.push(b'/');
-                    if vt != 0 {
-                        push_u32(line, vt);
-                    }
-                    line.push(b'/');
-                    push_u32(line, vn);
-                }
-                line.push(b'\n');
-                out.write_all(line).map_err(io)?;
-            }
-        }
-        out.flush().map_err(io)?;
 
         let mtl_path = self.path.with_file_name(&self.mtl_name);
         let file = File::create(&mtl_path).map_err(|e| ExportError::io(&mtl_path, e))?;
@@ -305,6 +286,28 @@ fn write_material(
         }
     }
     writeln!(w)
+}
+
+/// Writes `f v/vt/vn ...` and a newline.
+fn write_face(
+    w: &mut impl Write,
+    line: &mut Vec<u8>,
+    corners: impl Iterator<Item = [u32; 3]>,
+) -> std::io::Result<()> {
+    line.clear();
+    line.push(b'f');
+    for [v, vt, vn] in corners {
+        line.push(b' ');
+        push_u32(line, v);
+        line.push(b'/');
+        if vt != 0 {
+            push_u32(line, vt);
+        }
+        line.push(b'/');
+        push_u32(line, vn);
+    }
+    line.push(b'\n');
+    w.write_all(line)
 }
 
 /// The next 1-based index of a counter.

@@ -58,7 +58,7 @@ fn cube_with_one_material() {
 }
 
 #[test]
-fn one_usemtl_group_per_material() {
+fn usemtl_where_the_material_changes() {
     let dir = out_dir("obj_materials");
     let path = dir.join("materials.obj");
     let red = || colored("red", [0.8, 0.1, 0.1]);
@@ -86,7 +86,8 @@ fn one_usemtl_group_per_material() {
     let stats = write(&path, &meshes, ExportOptions::default());
     assert_eq!((stats.materials, stats.faces, stats.vertices), (3, 4, 16));
     let obj = read_obj(&path);
-    assert_eq!(obj.usemtl, ["red", "glass", "red_2"]);
+    // Faces are written as they come: `usemtl` where the material changes.
+    assert_eq!(obj.usemtl, ["red", "glass", "red", "red_2"]);
     // All four quads face +z: one shared `vn`.
     assert_eq!(obj.vn, [DVec3::Z]);
     let areas = obj.area_by_material();

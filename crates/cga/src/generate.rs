@@ -316,8 +316,9 @@ impl Rules {
         let given = lot
             .attrs
             .iter()
-            .filter(|(n, _)| !options.attrs.iter().any(|(o, _)| o == n))
-            .chain(&options.attrs);
+            .map(|(n, v)| (&**n, v))
+            .filter(|(n, _)| !options.attrs.iter().any(|(o, _)| o.as_str() == *n))
+            .chain(options.attrs.iter().map(|(n, v)| (n.as_str(), v)));
         let mut out = Vec::new();
         for (name, value) in given {
             let Some(attr) = self.attribute(name) else {

@@ -47,15 +47,13 @@ pub use cga_world::{decode_text, ConfinedWorld, DiskWorld, MemoryWorld, Metadata
 pub use diagnostics::{Diagnostic, Location, Severity};
 pub use error::{Error, ExportError};
 pub use generate::Target;
-pub use lots::{GeoOrigin, Lot, LotSet};
+pub use lots::{CrsOption, GeoOrigin, InvalidPolicy, Lot, LotOptions, LotSet};
 pub use model::{LeafOrigin, LotResult, Material, PlainMesh, PlainModel, Provenance, Summary};
 pub use options::{Cancel, Limits, Options};
 pub use rules::{Engine, ProgramSize, RuleInfo, RuleRef, Rules};
 
 /// Default largest asset file read, in MiB ([`Engine::max_asset_mib`]).
 pub use cga_engine::assets::DEFAULT_MAX_ASSET_MIB;
-/// The earth radius of the local projection of longitude/latitude lots.
-pub use cga_engine::geo::EARTH_RADIUS;
 /// Default vertex data a glTF/GLB writer holds before writing it out, in MiB.
 pub use cga_export::DEFAULT_FLUSH_MIB;
 pub use values::parse_value;

@@ -1,26 +1,30 @@
 //! Lots: the initial shapes a generation starts from, made in code or read
 //! from files by the same specifications the `cga` command takes.
 
-use std::path::Path;
-
 use cga_geometry::DVec3;
 
 pub use cga_engine::geo::GeoOrigin;
+use cga_engine::gis::Message;
+pub use cga_engine::gis::{CrsOption, InvalidPolicy, LotOptions};
 pub use cga_engine::lot::Lot;
 
 use crate::Error;
 
 /// Lots read from specifications, and where their frame lies on the globe
-/// when some were given in longitude/latitude.
+/// when some were georeferenced.
 #[derive(Default)]
 pub struct LotSet {
     pub lots: Vec<Lot>,
-    /// The geographic origin of the lots' metric frame: every geographic
-    /// file is projected about the first one's origin, so they share it.
+    /// The geographic origin of the lots' metric frame (a transverse
+    /// Mercator projection on WGS84 centred on all georeferenced lots; see
+    /// [`GeoOrigin::proj_string`]).
     pub origin: Option<GeoOrigin>,
-    /// What reading said on the way (geographic data projected, ...), for
-    /// the user.
+    /// What reading said on the way (each file's coordinate reference
+    /// system, the frame), for the user.
     pub notes: Vec<String>,
+    /// What the user should look at: features that gave no lot, invalid
+    /// lots and what was done with them, files without a declared CRS.
+    pub warnings: Vec<String>,
 }
 
 /// The lot `(0,0,0) (w,0,0) (w,0,-d) (0,0,-d)`: a `w` × `d` rectangle in
@@ -42,106 +46,33 @@ pub fn polygon(name: impl Into<String>, points: &[DVec3]) -> Lot {
 
 /// Lots from specifications as the `cga` command takes them (`--lot`):
 /// `rect:W,D`, `grid:COLSxROWS[:LOTS.obj]` (a synthetic city of lots in a
-/// grid), an `.obj` file (each face one lot), a `.geojson`/`.json` or
-/// `.fgb` file (each polygon one lot, feature properties as attributes;
-/// longitude/latitude projected to metres). No specification: `rect:20,30`.
+/// grid), an `.obj` file (each face one lot), or a GIS file: `.geojson`,
+/// `.json`, `.fgb`, `.gpkg` or `.shp` (each polygon one lot, feature
+/// properties as attributes, projected into one local metric frame when
+/// georeferenced; see `docs/geographic.md`). No specification:
+/// `rect:20,30`. Each file's own CRS, invalid lots repaired: see
+/// [`read_with`].
 pub fn read(specs: &[impl AsRef<str>]) -> Result<LotSet, Error> {
-    let mut set = LotSet::default();
-    if specs.is_empty() {
-        set.lots.push(rect(20.0, 30.0));
-        return Ok(set);
-    }
-    for spec in specs {
-        let spec = spec.as_ref();
-        if let Some(r) = spec.strip_prefix("rect:") {
-            set.lots
-                .push(cga_engine::lot::parse_rect(r).map_err(Error::Lot)?);
-            continue;
-        }
-        if let Some(grid) = spec.strip_prefix("grid:") {
-            set.lots.extend(grid_lots(grid)?);
-            continue;
-        }
-        let path = Path::new(spec);
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(|e| e.to_ascii_lowercase());
-        let more = match ext.as_deref() {
-            Some("obj") => cga_engine::lot::from_obj(path),
-            Some(ext @ ("geojson" | "json" | "fgb")) => {
-                let read = if ext == "fgb" {
-                    cga_engine::lot::from_flatgeobuf(path, set.origin)
-                } else {
-                    cga_engine::lot::from_geojson_georeferenced(path, set.origin)
-                };
-                read.map(|(lots, origin)| {
-                    if let Some(o) = origin {
-                        set.notes.push(format!(
-                            "{} is in longitude/latitude; lots are in metres east (x) and north (-z) of lon {:.7}, lat {:.7} (recorded in the output)",
-                            path.display(),
-                            o.lon,
-                            o.lat
-                        ));
-                        set.origin = Some(o);
-                    }
-                    lots
-                })
-            }
-            _ => {
-                return Err(Error::Lot(format!(
-                    "unknown lot `{spec}`: expected rect:W,D, grid:COLSxROWS, an .obj, a .geojson or a .fgb (FlatGeobuf) file"
-                )))
-            }
-        };
-        set.lots.extend(more.map_err(Error::Lot)?);
-    }
-    Ok(set)
+    read_with(specs, &LotOptions::default())
 }
 
-/// `grid:COLSxROWS` (20 x 30 lots) or `grid:COLSxROWS:LOTS.obj` (copies of
-/// the OBJ's lots): a synthetic city of lots in a grid, for benchmarks.
-fn grid_lots(spec: &str) -> Result<Vec<Lot>, Error> {
-    let (dims, source) = match spec.split_once(':') {
-        Some((d, s)) => (d, Some(s)),
-        None => (spec, None),
+/// [`read`] with a CRS for every lot file (`--crs`) and what to do with
+/// invalid lots (`--invalid`).
+pub fn read_with(specs: &[impl AsRef<str>], options: &LotOptions) -> Result<LotSet, Error> {
+    let specs: Vec<String> = specs.iter().map(|s| s.as_ref().to_string()).collect();
+    let read = cga_engine::gis::read_lots(&specs, options).map_err(Error::Lot)?;
+    let mut set = LotSet {
+        lots: read.lots,
+        origin: read.frame,
+        ..LotSet::default()
     };
-    let bad = || {
-        Error::Lot(format!(
-            "expected grid:COLSxROWS[:LOTS.obj], found `grid:{spec}`"
-        ))
-    };
-    let (c, r) = dims.split_once('x').ok_or_else(bad)?;
-    let cols: usize = c.trim().parse().map_err(|_| bad())?;
-    let rows: usize = r.trim().parse().map_err(|_| bad())?;
-    if cols == 0 || rows == 0 || cols.saturating_mul(rows) > 10_000_000 {
-        return Err(bad());
-    }
-    let base = match source {
-        Some(path) => cga_engine::lot::from_obj(Path::new(path)).map_err(Error::Lot)?,
-        None => vec![rect(20.0, 30.0)],
-    };
-    let (lo, hi) = base
-        .iter()
-        .filter_map(|l| cga_geometry::measure::bounds(&l.mesh))
-        .fold(
-            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-            |(lo, hi), (a, b)| (lo.min(a), hi.max(b)),
-        );
-    let step = (hi - lo) + DVec3::splat(10.0);
-    let mut lots = Vec::with_capacity(cols * rows * base.len());
-    for row in 0..rows {
-        for col in 0..cols {
-            let shift = DVec3::new(col as f64 * step.x, 0.0, -(row as f64) * step.z);
-            for b in &base {
-                let mut l = b.clone();
-                l.mesh.map_positions(|p| p + shift);
-                l.name = format!("grid {col},{row} {}", b.name);
-                lots.push(l);
-            }
+    for m in read.messages {
+        match m {
+            Message::Note(n) => set.notes.push(n),
+            Message::Warning(w) => set.warnings.push(w),
         }
     }
-    Ok(lots)
+    Ok(set)
 }
 
 #[cfg(test)]

@@ -24,6 +24,9 @@
 //!   stop runaway rules, and a [`Cancel`] stops a generation within
 //!   milliseconds.
 //!
+//! - [`syntax`]: the syntax tree of a rule file's text and where the paths
+//!   it names lead, for editors and formatters.
+//!
 //! `docs/library.md` has a complete example.
 
 mod attributes;
@@ -37,6 +40,7 @@ mod options;
 mod pipeline;
 mod rules;
 mod stack;
+pub mod syntax;
 mod values;
 
 pub use attributes::{Annotation, Attribute, Range};

@@ -76,6 +76,15 @@ enum Command {
         #[arg(long = "workspace", value_name = "DIR")]
         workspaces: Vec<PathBuf>,
     },
+    /// Language server for editors, on standard input and output.
+    Lsp {
+        /// Accepted for editor clients that pass it; stdio is the only transport.
+        #[arg(long)]
+        stdio: bool,
+        /// Where `/Project/...` paths are looked for (as for `check`).
+        #[arg(long = "workspace", value_name = "DIR")]
+        workspaces: Vec<PathBuf>,
+    },
 }
 
 #[derive(Args)]
@@ -197,6 +206,9 @@ fn main() -> ExitCode {
                 style,
                 workspaces,
             } => check(&rules, format, style.as_deref(), &workspaces),
+            Command::Lsp { workspaces, .. } => {
+                cga_lsp::run_stdio(&workspaces).map_err(|e| Failure::Error(e.to_string()))
+            }
         });
     let result = match worker.map(|w| w.join()) {
         Ok(Ok(r)) => r,

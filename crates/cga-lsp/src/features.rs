@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use cga::operations::{self, ArgMode, OpDef, Status};
+use cga::World;
 use lsp_types::*;
 use serde::de::DeserializeOwned;
 use serde_json::Value;
@@ -40,14 +41,14 @@ pub fn capabilities() -> ServerCapabilities {
         })),
         document_symbol_provider: Some(OneOf::Left(true)),
         workspace_symbol_provider: Some(OneOf::Left(true)),
-        semantic_tokens_provider: Some(
-            SemanticTokensServerCapabilities::SemanticTokensOptions(SemanticTokensOptions {
+        semantic_tokens_provider: Some(SemanticTokensServerCapabilities::SemanticTokensOptions(
+            SemanticTokensOptions {
                 legend: legend(),
                 full: Some(SemanticTokensFullOptions::Bool(true)),
                 range: None,
                 work_done_progress_options: Default::default(),
-            }),
-        ),
+            },
+        )),
         folding_range_provider: Some(FoldingRangeProviderCapability::Simple(true)),
         ..Default::default()
     }
@@ -77,7 +78,10 @@ pub fn dispatch(s: &mut Server, method: &str, params: Value) -> Result<Value, Fa
 }
 
 /// The document and byte offset of a position.
-fn locate_pos(s: &Server, at: &TextDocumentPositionParams) -> Option<(PathBuf, Arc<FileIndex>, usize)> {
+fn locate_pos(
+    s: &Server,
+    at: &TextDocumentPositionParams,
+) -> Option<(PathBuf, Arc<FileIndex>, usize)> {
     let path = at.text_document.uri.to_file_path().ok()?;
     let index = s.index(&path)?;
     let offset = index.lines.offset(&index.text, at.position);
@@ -164,7 +168,12 @@ enum Target {
 }
 
 /// The target at `offset` and the span of what names it.
-fn target_at(s: &Server, path: &Path, index: &Arc<FileIndex>, offset: usize) -> Option<(Target, Range<usize>)> {
+fn target_at(
+    s: &Server,
+    path: &Path,
+    index: &Arc<FileIndex>,
+    offset: usize,
+) -> Option<(Target, Range<usize>)> {
     for import in &index.imports {
         if import.path_span.start < offset && offset < import.path_span.end {
             let found = s.locate(path, &import.path)?;
@@ -245,14 +254,23 @@ fn describe_def(from: &Path, found: &Found) -> String {
     let mut out = String::new();
     match def.kind {
         DefKind::Param | DefKind::Local => {
-            let owner = def.owner.map(|o| found.index.defs[o].name.as_str()).unwrap_or("");
-            out.push_str(&format!("```cga\n{}\n```\n{} of `{owner}`", def.name, def.kind.word()));
+            let owner = def
+                .owner
+                .map(|o| found.index.defs[o].name.as_str())
+                .unwrap_or("");
+            out.push_str(&format!(
+                "```cga\n{}\n```\n{} of `{owner}`",
+                def.name,
+                def.kind.word()
+            ));
             return out;
         }
         _ => {}
     }
     let decl = text.get(def.span.clone()).unwrap_or("");
-    let name_line = text[def.span.start..def.name_span.start.max(def.span.start)].matches('\n').count();
+    let name_line = text[def.span.start..def.name_span.start.max(def.span.start)]
+        .matches('\n')
+        .count();
     let extra = if def.kind == DefKind::Rule { 0 } else { 2 };
     let lines: Vec<&str> = decl.lines().collect();
     let keep = (name_line + 1 + extra).min(lines.len());
@@ -262,11 +280,14 @@ fn describe_def(from: &Path, found: &Found) -> String {
     }
     out.push_str(&format!("```cga\n{shown}\n```\n"));
     if let Some(doc) = &def.doc {
-        out.push_str("\n");
+        out.push('\n');
         out.push_str(doc);
         out.push('\n');
     }
-    let file = found.path.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned());
+    let file = found
+        .path
+        .file_name()
+        .map_or(String::new(), |n| n.to_string_lossy().into_owned());
     if found.path != from {
         out.push_str(&format!("\n*{} in `{file}`*", def.kind.word()));
     } else {
@@ -292,13 +313,19 @@ fn describe_op(op: &OpDef) -> String {
     match op.status() {
         Status::Runs => {}
         Status::Deprecated(why) => out.push_str(&format!("\n\n**Deprecated**: {why}")),
-        Status::NotRun => out.push_str("\n\n**Not run by this engine yet** (a warning; the shape is left unchanged)."),
+        Status::NotRun => out.push_str(
+            "\n\n**Not run by this engine yet** (a warning; the shape is left unchanged).",
+        ),
     }
     out
 }
 
 fn describe_function(f: &Function) -> String {
-    format!("```cga\n{}\n```\n{}\n\n*built-in function*", f.signatures().join("\n"), f.summary)
+    format!(
+        "```cga\n{}\n```\n{}\n\n*built-in function*",
+        f.signatures().join("\n"),
+        f.summary
+    )
 }
 
 // ---------------------------------------------------------------- completion
@@ -310,9 +337,14 @@ enum Ctx {
     Nothing,
     /// In the string of an import (`cga`), `i(`/`insert(` (assets),
     /// `texture(` (images): the text typed since the quote.
-    Path { kinds: &'static [&'static str], typed: String },
+    Path {
+        kinds: &'static [&'static str],
+        typed: String,
+    },
     /// After `prefix.`.
-    Member { prefix: String },
+    Member {
+        prefix: String,
+    },
     /// `set(` first argument.
     SetAttr,
     /// Selector words.
@@ -322,7 +354,9 @@ enum Ctx {
 
 const CGA_FILES: &[&str] = &["cga"];
 const ASSET_FILES: &[&str] = &["obj", "fbx", "dae", "glb", "gltf", "3ds", "dxf", "shp"];
-const IMAGE_FILES: &[&str] = &["png", "jpg", "jpeg", "tif", "tiff", "bmp", "tga", "gif", "webp", "exr", "hdr"];
+const IMAGE_FILES: &[&str] = &[
+    "png", "jpg", "jpeg", "tif", "tiff", "bmp", "tga", "gif", "webp", "exr", "hdr",
+];
 const ANY_FILE: &[&str] = &[];
 
 fn context(text: &str, offset: usize) -> Ctx {
@@ -349,14 +383,18 @@ fn context(text: &str, offset: usize) -> Ctx {
         let typed = line[q + 1..].to_string();
         let before = line[..q].trim_end();
         if line.trim_start().starts_with("import") {
-            return Ctx::Path { kinds: CGA_FILES, typed };
+            return Ctx::Path {
+                kinds: CGA_FILES,
+                typed,
+            };
         }
         if let Some(head) = before.strip_suffix('(') {
             let name = last_word(head);
             let kinds = match name {
                 "i" | "insert" => ASSET_FILES,
                 "texture" | "setupProjection" | "projectUV" => IMAGE_FILES,
-                "fileExists" | "readTextFile" | "readFloatTable" | "readStringTable" | "assetInfo" | "imageInfo" => ANY_FILE,
+                "fileExists" | "readTextFile" | "readFloatTable" | "readStringTable"
+                | "assetInfo" | "imageInfo" => ANY_FILE,
                 _ => return Ctx::Nothing,
             };
             return Ctx::Path { kinds, typed };
@@ -416,9 +454,8 @@ fn context(text: &str, offset: usize) -> Ctx {
                 let name = last_word(&call[..matching_open(call)]);
                 return match name {
                     "comp" => Ctx::Selectors(builtins::COMP_SELECTORS),
-                    "setback" | "offset" | "setbackPerimeter" | "setbackToArea" | "shapeL" | "shapeU" | "shapeO" => {
-                        Ctx::Selectors(builtins::SETBACK_SELECTORS)
-                    }
+                    "setback" | "offset" | "setbackPerimeter" | "setbackToArea" | "shapeL"
+                    | "shapeU" | "shapeO" => Ctx::Selectors(builtins::SETBACK_SELECTORS),
                     _ => Ctx::General,
                 };
             }
@@ -478,7 +515,10 @@ fn completion(s: &Server, p: CompletionParams) -> Option<CompletionResponse> {
                 if let Some(target) = s.locate(&path, &import.path) {
                     if let Some(imported) = s.index(&target) {
                         for d in imported.defs.iter().filter(|d| d.owner.is_none()) {
-                            if matches!(d.kind, DefKind::Rule | DefKind::Attr | DefKind::Function | DefKind::Const) {
+                            if matches!(
+                                d.kind,
+                                DefKind::Rule | DefKind::Attr | DefKind::Function | DefKind::Const
+                            ) {
                                 items.push(def_item(d, &d.name));
                             }
                         }
@@ -496,7 +536,10 @@ fn completion(s: &Server, p: CompletionParams) -> Option<CompletionResponse> {
                     items.push(function_item(f, rest));
                 }
             }
-            for sel in builtins::COMP_SELECTORS.iter().chain(builtins::OTHER_SELECTORS) {
+            for sel in builtins::COMP_SELECTORS
+                .iter()
+                .chain(builtins::OTHER_SELECTORS)
+            {
                 if let Some(rest) = sel.strip_prefix(&dotted) {
                     items.push(simple(rest, CompletionItemKind::ENUM_MEMBER, "selector"));
                 }
@@ -559,7 +602,10 @@ fn def_item(d: &Def, label: &str) -> CompletionItem {
     let (insert_text, format) = if d.params.is_empty() {
         (None, None)
     } else {
-        (Some(snippet(label, d.params.iter().map(String::as_str))), Some(InsertTextFormat::SNIPPET))
+        (
+            Some(snippet(label, d.params.iter().map(String::as_str))),
+            Some(InsertTextFormat::SNIPPET),
+        )
     };
     CompletionItem {
         label: label.to_string(),
@@ -618,7 +664,13 @@ fn op_item(op: &'static OpDef) -> CompletionItem {
     }
 }
 
-fn general_items(s: &Server, path: &Path, index: &Arc<FileIndex>, offset: usize, items: &mut Vec<CompletionItem>) {
+fn general_items(
+    s: &Server,
+    path: &Path,
+    index: &Arc<FileIndex>,
+    offset: usize,
+    items: &mut Vec<CompletionItem>,
+) {
     let owner = index
         .defs
         .iter()
@@ -634,7 +686,11 @@ fn general_items(s: &Server, path: &Path, index: &Arc<FileIndex>, offset: usize,
     // Names of files imported without a prefix.
     for import in index.imports.iter().filter(|i| i.alias.is_none()) {
         if let Some(imported) = s.locate(path, &import.path).and_then(|t| s.index(&t)) {
-            for d in imported.defs.iter().filter(|d| d.owner.is_none() && d.kind != DefKind::Import) {
+            for d in imported
+                .defs
+                .iter()
+                .filter(|d| d.owner.is_none() && d.kind != DefKind::Import)
+            {
                 items.push(def_item(d, &d.name));
             }
         }
@@ -656,8 +712,16 @@ fn general_items(s: &Server, path: &Path, index: &Arc<FileIndex>, offset: usize,
 /// Files and folders for the path typed so far: relative to the rule
 /// file's folder (and, for assets, each ancestor's `assets/`), or, for
 /// `/Project/...`, the projects of the workspace.
-fn path_items(s: &Server, from: &Path, kinds: &[&str], typed: &str, items: &mut Vec<CompletionItem>) {
-    let (dir, _) = typed.rsplit_once('/').map_or(("", typed), |(d, rest)| (d, rest));
+fn path_items(
+    s: &Server,
+    from: &Path,
+    kinds: &[&str],
+    typed: &str,
+    items: &mut Vec<CompletionItem>,
+) {
+    let (dir, _) = typed
+        .rsplit_once('/')
+        .map_or(("", typed), |(d, rest)| (d, rest));
     let folder = from.parent().unwrap_or(Path::new("/"));
     let mut places: Vec<PathBuf> = Vec::new();
     if let Some(rel) = typed.strip_prefix('/') {
@@ -692,10 +756,18 @@ fn path_items(s: &Server, from: &Path, kinds: &[&str], typed: &str, items: &mut 
             if s.world.is_dir(&e) {
                 let mut item = simple(&format!("{name}/"), CompletionItemKind::FOLDER, "folder");
                 // Ask for the next part right away.
-                item.command = Some(Command::new("".into(), "editor.action.triggerSuggest".into(), None));
+                item.command = Some(Command::new(
+                    "".into(),
+                    "editor.action.triggerSuggest".into(),
+                    None,
+                ));
                 items.push(item);
             } else {
-                let ext = e.extension().and_then(|x| x.to_str()).unwrap_or("").to_ascii_lowercase();
+                let ext = e
+                    .extension()
+                    .and_then(|x| x.to_str())
+                    .unwrap_or("")
+                    .to_ascii_lowercase();
                 if kinds.is_empty() || kinds.contains(&ext.as_str()) {
                     items.push(simple(name, CompletionItemKind::FILE, "file"));
                 }
@@ -747,11 +819,19 @@ fn signature_help(s: &Server, p: SignatureHelpParams) -> Option<SignatureHelp> {
         signatures.push((d.name.clone(), d.params.clone(), d.doc.clone()));
     } else if let Some(op) = operations::find(name) {
         for form in op.forms {
-            signatures.push((op.name.to_string(), form.iter().map(|p| p.name.to_string()).collect(), Some(op.summary.to_string())));
+            signatures.push((
+                op.name.to_string(),
+                form.iter().map(|p| p.name.to_string()).collect(),
+                Some(op.summary.to_string()),
+            ));
         }
     } else if let Some(f) = builtins::function(name) {
         for form in f.forms {
-            signatures.push((f.name.to_string(), form.iter().map(|p| p.to_string()).collect(), Some(f.summary.to_string())));
+            signatures.push((
+                f.name.to_string(),
+                form.iter().map(|p| p.to_string()).collect(),
+                Some(f.summary.to_string()),
+            ));
         }
     }
     if signatures.is_empty() {
@@ -790,7 +870,10 @@ fn def_location(found: &Found) -> Option<Location> {
     let d = found.def();
     Some(Location::new(
         url(&found.path)?,
-        found.index.lines.range(&found.index.text, d.name_span.clone()),
+        found
+            .index
+            .lines
+            .range(&found.index.text, d.name_span.clone()),
     ))
 }
 
@@ -799,29 +882,27 @@ fn definition(s: &Server, p: GotoDefinitionParams) -> Option<GotoDefinitionRespo
     let (target, _) = target_at(s, &path, &index, offset)?;
     let location = match target {
         Target::User(found) => def_location(&found)?,
-        Target::File(file) => Location::new(url(&file)?, Range::default_lsp()),
+        Target::File(file) => Location::new(url(&file)?, lsp_types::Range::default()),
         _ => return None,
     };
     Some(GotoDefinitionResponse::Scalar(location))
 }
 
-trait DefaultRange {
-    fn default_lsp() -> Self;
-}
-
-impl DefaultRange for lsp_types::Range {
-    fn default_lsp() -> Self {
-        lsp_types::Range::new(Position::new(0, 0), Position::new(0, 0))
-    }
-}
-
 /// Every place naming `target`: (file, index, span of the part a rename
 /// replaces), the declaration first when asked for.
-fn uses(s: &Server, target: &Found, with_decl: bool) -> Vec<(PathBuf, Arc<FileIndex>, Range<usize>)> {
+fn uses(
+    s: &Server,
+    target: &Found,
+    with_decl: bool,
+) -> Vec<(PathBuf, Arc<FileIndex>, Range<usize>)> {
     let d = target.def();
     let mut out = Vec::new();
     if with_decl {
-        out.push((target.path.clone(), target.index.clone(), d.name_span.clone()));
+        out.push((
+            target.path.clone(),
+            target.index.clone(),
+            d.name_span.clone(),
+        ));
     }
     match d.kind {
         DefKind::Param | DefKind::Local => {
@@ -834,8 +915,14 @@ fn uses(s: &Server, target: &Found, with_decl: bool) -> Vec<(PathBuf, Arc<FileIn
         DefKind::Import => {
             for r in &target.index.refs {
                 if let Some((alias, _)) = r.split_prefix() {
-                    if alias == d.name && target.index.import_named(alias).map(|i| i.def) == Some(target.def) {
-                        out.push((target.path.clone(), target.index.clone(), r.span.start..r.span.start + alias.len()));
+                    if alias == d.name
+                        && target.index.import_named(alias).map(|i| i.def) == Some(target.def)
+                    {
+                        out.push((
+                            target.path.clone(),
+                            target.index.clone(),
+                            r.span.start..r.span.start + alias.len(),
+                        ));
                     }
                 }
             }
@@ -847,10 +934,12 @@ fn uses(s: &Server, target: &Found, with_decl: bool) -> Vec<(PathBuf, Arc<FileIn
                     continue;
                 };
                 for r in &index.refs {
-                    if r.kind == RefKind::Leaf || r.name.rsplit('.').next() != Some(d.name.as_str()) {
+                    if r.kind == RefKind::Leaf || r.name.rsplit('.').next() != Some(d.name.as_str())
+                    {
                         continue;
                     }
-                    let Some(found) = resolve_name(s, &file, &index, &r.name, r.kind, r.owner, 0) else {
+                    let Some(found) = resolve_name(s, &file, &index, &r.name, r.kind, r.owner, 0)
+                    else {
                         continue;
                     };
                     if found.def == target.def && s.world.canonical(&found.path) == want {
@@ -871,19 +960,36 @@ fn references(s: &Server, p: ReferenceParams) -> Option<Vec<Location>> {
     Some(
         uses(s, &found, p.context.include_declaration)
             .into_iter()
-            .filter_map(|(file, index, span)| Some(Location::new(url(&file)?, index.lines.range(&index.text, span))))
+            .filter_map(|(file, index, span)| {
+                Some(Location::new(
+                    url(&file)?,
+                    index.lines.range(&index.text, span),
+                ))
+            })
             .collect(),
     )
 }
 
-fn prepare_rename(s: &Server, p: TextDocumentPositionParams) -> Result<Option<PrepareRenameResponse>, Failure> {
+fn prepare_rename(
+    s: &Server,
+    p: TextDocumentPositionParams,
+) -> Result<Option<PrepareRenameResponse>, Failure> {
     let Some((path, index, offset)) = locate_pos(s, &p) else {
         return Ok(None);
     };
     match target_at(s, &path, &index, offset) {
         Some((Target::User(found), span)) => {
-            if found.def().kind == DefKind::Import && index.defs[found.def].name_span.start == index.imports.iter().find(|i| i.def == found.def).map_or(usize::MAX, |i| i.path_span.start) {
-                return Err(Failure::Refused("an import without a name cannot be renamed".into()));
+            if found.def().kind == DefKind::Import
+                && index.defs[found.def].name_span.start
+                    == index
+                        .imports
+                        .iter()
+                        .find(|i| i.def == found.def)
+                        .map_or(usize::MAX, |i| i.path_span.start)
+            {
+                return Err(Failure::Refused(
+                    "an import without a name cannot be renamed".into(),
+                ));
             }
             Ok(Some(PrepareRenameResponse::RangeWithPlaceholder {
                 range: index.lines.range(&index.text, span.clone()),
@@ -897,7 +1003,10 @@ fn prepare_rename(s: &Server, p: TextDocumentPositionParams) -> Result<Option<Pr
 
 fn rename(s: &Server, p: RenameParams) -> Result<Option<WorkspaceEdit>, Failure> {
     let new = p.new_name.trim();
-    let valid = new.chars().next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+    let valid = new
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
         && new.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
     if !valid {
         return Err(Failure::Refused(format!("`{new}` is not a CGA name")));
@@ -906,7 +1015,10 @@ fn rename(s: &Server, p: RenameParams) -> Result<Option<WorkspaceEdit>, Failure>
         return Ok(None);
     };
     let Some((Target::User(found), _)) = target_at(s, &path, &index, offset) else {
-        return Err(Failure::Refused("only rules, attributes, functions, consts, parameters and imports can be renamed".into()));
+        return Err(Failure::Refused(
+            "only rules, attributes, functions, consts, parameters and imports can be renamed"
+                .into(),
+        ));
     };
     let mut changes: HashMap<Url, Vec<TextEdit>> = HashMap::new();
     for (file, index, span) in uses(s, &found, true) {
@@ -998,17 +1110,26 @@ fn fuzzy(query: &str, name: &str) -> bool {
 fn workspace_symbols(s: &Server, p: WorkspaceSymbolParams) -> Option<Vec<SymbolInformation>> {
     let mut out = Vec::new();
     for file in s.workspace_files() {
-        let Some(index) = s.index(&file) else { continue };
+        let Some(index) = s.index(&file) else {
+            continue;
+        };
         let Some(u) = url(&file) else { continue };
         let container = file.file_name().map(|n| n.to_string_lossy().into_owned());
-        for d in index.defs.iter().filter(|d| d.owner.is_none() && d.kind != DefKind::Import) {
+        for d in index
+            .defs
+            .iter()
+            .filter(|d| d.owner.is_none() && d.kind != DefKind::Import)
+        {
             if fuzzy(&p.query, &d.name) {
                 out.push(SymbolInformation {
                     name: d.name.clone(),
                     kind: symbol_kind(d.kind),
                     tags: None,
                     deprecated: None,
-                    location: Location::new(u.clone(), index.lines.range(&index.text, d.name_span.clone())),
+                    location: Location::new(
+                        u.clone(),
+                        index.lines.range(&index.text, d.name_span.clone()),
+                    ),
                     container_name: container.clone(),
                 });
             }
@@ -1100,12 +1221,18 @@ fn semantic_tokens(s: &Server, p: SemanticTokensParams) -> Option<SemanticTokens
     for (span, t, m) in raw {
         let mut start = span.start;
         while start < span.end {
-            let end = text[start..span.end].find('\n').map_or(span.end, |e| start + e);
+            let end = text[start..span.end]
+                .find('\n')
+                .map_or(span.end, |e| start + e);
             if end > start {
                 let a = index.lines.position(text, start);
                 let b = index.lines.position(text, end);
                 let delta_line = a.line - last_line;
-                let delta_start = if delta_line == 0 { a.character - last_col } else { a.character };
+                let delta_start = if delta_line == 0 {
+                    a.character - last_col
+                } else {
+                    a.character
+                };
                 data.push(SemanticToken {
                     delta_line,
                     delta_start,
@@ -1165,7 +1292,11 @@ fn folding_ranges(s: &Server, p: FoldingRangeParams) -> Option<Vec<FoldingRange>
     let line = |o: usize| index.lines.position(text, o).line;
     let mut out: Vec<FoldingRange> = Vec::new();
     let mut push = |start: u32, end: u32, kind: Option<FoldingRangeKind>| {
-        if end > start && !out.iter().any(|f| f.start_line == start && f.end_line == end) {
+        if end > start
+            && !out
+                .iter()
+                .any(|f| f.start_line == start && f.end_line == end)
+        {
             out.push(FoldingRange {
                 start_line: start,
                 end_line: end,
@@ -1179,7 +1310,10 @@ fn folding_ranges(s: &Server, p: FoldingRangeParams) -> Option<Vec<FoldingRange>
     }
     // Comments: a block comment, or a run of line comments.
     let mut run: Option<(u32, u32)> = None;
-    for tok in scan(text).into_iter().filter(|t| t.kind == TokKind::Comment) {
+    for tok in scan(text)
+        .into_iter()
+        .filter(|t| t.kind == TokKind::Comment)
+    {
         let (a, b) = (line(tok.span.start), line(tok.span.end));
         if b > a {
             push(a, b, Some(FoldingRangeKind::Comment));
@@ -1206,27 +1340,56 @@ mod tests {
     use super::*;
 
     fn ctx(text_with_cursor: &str) -> Ctx {
-        let offset = text_with_cursor.find('|').unwrap();
-        let text = text_with_cursor.replacen('|', "", 1);
+        let offset = text_with_cursor.find('^').unwrap();
+        let text = text_with_cursor.replacen('^', "", 1);
         context(&text, offset)
     }
 
     #[test]
     fn completion_contexts() {
-        assert_eq!(ctx("Lot --> comp(f) { fr| }"), Ctx::Selectors(builtins::COMP_SELECTORS));
-        assert_eq!(ctx("Lot --> comp(f) { front : A \n| si| }"), Ctx::Selectors(builtins::COMP_SELECTORS));
-        assert_eq!(ctx("Lot --> comp(f) { front : A | }"), Ctx::General);
-        assert_eq!(ctx("Lot --> comp(|"), Ctx::Selectors(builtins::COMP_TYPES));
-        assert_eq!(ctx("Lot --> split(|) { 1 : A }"), Ctx::Selectors(builtins::SPLIT_AXES));
-        assert_eq!(ctx("Lot --> setback(2) { str| }"), Ctx::Selectors(builtins::SETBACK_SELECTORS));
-        assert_eq!(ctx("Lot --> set(|"), Ctx::SetAttr);
-        assert_eq!(ctx("Lot --> set(height, h|"), Ctx::General);
-        assert_eq!(ctx("Lot --> imp.|"), Ctx::Member { prefix: "imp".into() });
-        assert_eq!(ctx("Lot --> i(\"assets/wi|"), Ctx::Path { kinds: ASSET_FILES, typed: "assets/wi".into() });
-        assert_eq!(ctx("import x : \"/Lib/ru|"), Ctx::Path { kinds: CGA_FILES, typed: "/Lib/ru".into() });
-        assert_eq!(ctx("Lot --> print(\"a|"), Ctx::Nothing);
-        assert_eq!(ctx("// Lot --> ex|"), Ctx::Nothing);
-        assert_eq!(ctx("/* Lot --> ex|"), Ctx::Nothing);
-        assert_eq!(ctx("Lot --> ex|"), Ctx::General);
+        assert_eq!(
+            ctx("Lot --> comp(f) { fr^ }"),
+            Ctx::Selectors(builtins::COMP_SELECTORS)
+        );
+        assert_eq!(
+            ctx("Lot --> comp(f) { front : A \n| si^ }"),
+            Ctx::Selectors(builtins::COMP_SELECTORS)
+        );
+        assert_eq!(ctx("Lot --> comp(f) { front : A ^ }"), Ctx::General);
+        assert_eq!(ctx("Lot --> comp(^"), Ctx::Selectors(builtins::COMP_TYPES));
+        assert_eq!(
+            ctx("Lot --> split(^) { 1 : A }"),
+            Ctx::Selectors(builtins::SPLIT_AXES)
+        );
+        assert_eq!(
+            ctx("Lot --> setback(2) { str^ }"),
+            Ctx::Selectors(builtins::SETBACK_SELECTORS)
+        );
+        assert_eq!(ctx("Lot --> set(^"), Ctx::SetAttr);
+        assert_eq!(ctx("Lot --> set(height, h^"), Ctx::General);
+        assert_eq!(
+            ctx("Lot --> imp.^"),
+            Ctx::Member {
+                prefix: "imp".into()
+            }
+        );
+        assert_eq!(
+            ctx("Lot --> i(\"assets/wi^"),
+            Ctx::Path {
+                kinds: ASSET_FILES,
+                typed: "assets/wi".into()
+            }
+        );
+        assert_eq!(
+            ctx("import x : \"/Lib/ru^"),
+            Ctx::Path {
+                kinds: CGA_FILES,
+                typed: "/Lib/ru".into()
+            }
+        );
+        assert_eq!(ctx("Lot --> print(\"a^"), Ctx::Nothing);
+        assert_eq!(ctx("// Lot --> ex^"), Ctx::Nothing);
+        assert_eq!(ctx("/* Lot --> ex^"), Ctx::Nothing);
+        assert_eq!(ctx("Lot --> ex^"), Ctx::General);
     }
 }

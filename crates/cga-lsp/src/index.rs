@@ -45,8 +45,6 @@ pub struct Def {
     /// The whole declaration, annotations included.
     pub span: Range<usize>,
     pub params: Vec<String>,
-    /// Annotations as written (`@Range(min=0, max=10)`).
-    pub annotations: Vec<String>,
     /// `@Group("Name", ...)`'s name.
     pub group: Option<String>,
     /// The comment lines just above the declaration, without markers.
@@ -83,7 +81,10 @@ impl Ref {
     /// the part a rename of the definition replaces.
     pub fn last_span(&self) -> Range<usize> {
         let last = self.name.rsplit('.').next().unwrap_or(&self.name);
-        self.span.end.saturating_sub(last.len()).max(self.span.start)..self.span.end
+        self.span
+            .end
+            .saturating_sub(last.len())
+            .max(self.span.start)..self.span.end
     }
 
     /// `("imp", "Facade")` for `imp.Facade`.
@@ -111,23 +112,18 @@ pub struct FileIndex {
     pub imports: Vec<Import>,
     /// Spans worth folding: declarations, blocks.
     pub folds: Vec<Range<usize>>,
-    /// The parser's errors: span and message.
-    pub syntax_errors: Vec<(Range<usize>, String)>,
 }
 
 impl FileIndex {
     pub fn new(text: String) -> FileIndex {
-        let (module, diagnostics) = parse(FileId(0), &text);
+        // The parser's errors are the engine's diagnostics' business.
+        let (module, _errors) = parse(FileId(0), &text);
         let mut index = FileIndex {
             lines: LineIndex::new(&text),
             defs: Vec::new(),
             refs: Vec::new(),
             imports: Vec::new(),
             folds: Vec::new(),
-            syntax_errors: diagnostics
-                .iter()
-                .map(|d| (d.span.map_or(0..0, |s| s.range()), d.message.clone()))
-                .collect(),
             text,
         };
         for item in &module.items {
@@ -138,7 +134,7 @@ impl FileIndex {
 
     /// The top-level definitions called `name` (parameters and locals
     /// excluded).
-    pub fn top_level(&self, name: &str) -> impl Iterator<Item = (usize, &Def)> {
+    pub fn top_level<'a>(&'a self, name: &'a str) -> impl Iterator<Item = (usize, &'a Def)> + 'a {
         self.defs
             .iter()
             .enumerate()
@@ -197,13 +193,23 @@ impl FileIndex {
         match item {
             ast::Item::Version { .. } => {}
             ast::Item::Import(import) => {
-                let name = import.alias.as_ref().map(|a| (a.name.clone(), a.span.range()));
+                let name = import
+                    .alias
+                    .as_ref()
+                    .map(|a| (a.name.clone(), a.span.range()));
                 let stem = std::path::Path::new(&import.path)
                     .file_stem()
                     .map(|s| s.to_string_lossy().into_owned())
                     .unwrap_or_default();
                 let (name, name_span) = name.unwrap_or((stem, import.path_span.range()));
-                let def = self.def(DefKind::Import, name, name_span, import.span, &import.annotations, &[]);
+                let def = self.def(
+                    DefKind::Import,
+                    name,
+                    name_span,
+                    import.span,
+                    &import.annotations,
+                    &[],
+                );
                 self.imports.push(Import {
                     alias: import.alias.as_ref().map(|a| a.name.clone()),
                     path: import.path.clone(),
@@ -215,23 +221,60 @@ impl FileIndex {
                 }
             }
             ast::Item::Attr(a) => {
-                let def = self.def(DefKind::Attr, a.name.name.clone(), a.name.span.range(), a.span, &a.annotations, &a.params);
+                let def = self.def(
+                    DefKind::Attr,
+                    a.name.name.clone(),
+                    a.name.span.range(),
+                    a.span,
+                    &a.annotations,
+                    &a.params,
+                );
                 self.locals(def, &a.params, &a.locals);
                 self.expr(&a.value, Some(def));
             }
             ast::Item::Function(f) => {
-                let kind = if f.is_const { DefKind::Const } else { DefKind::Function };
-                let def = self.def(kind, f.name.name.clone(), f.name.span.range(), f.span, &f.annotations, &f.params);
+                let kind = if f.is_const {
+                    DefKind::Const
+                } else {
+                    DefKind::Function
+                };
+                let def = self.def(
+                    kind,
+                    f.name.name.clone(),
+                    f.name.span.range(),
+                    f.span,
+                    &f.annotations,
+                    &f.params,
+                );
                 self.locals(def, &f.params, &f.locals);
                 self.expr(&f.value, Some(def));
             }
             ast::Item::Rule(r) => {
-                let def = self.def(DefKind::Rule, r.name.name.clone(), r.name.span.range(), r.span, &r.annotations, &r.params);
+                let def = self.def(
+                    DefKind::Rule,
+                    r.name.name.clone(),
+                    r.name.span.range(),
+                    r.span,
+                    &r.annotations,
+                    &r.params,
+                );
                 self.locals(def, &r.params, &r.locals);
                 self.body(&r.body, Some(def));
             }
-            ast::Item::Style { name, span, annotations, .. } => {
-                self.def(DefKind::Style, name.name.clone(), name.span.range(), *span, annotations, &[]);
+            ast::Item::Style {
+                name,
+                span,
+                annotations,
+                ..
+            } => {
+                self.def(
+                    DefKind::Style,
+                    name.name.clone(),
+                    name.span.range(),
+                    *span,
+                    annotations,
+                    &[],
+                );
             }
         }
     }
@@ -257,19 +300,17 @@ impl FileIndex {
         {
             self.folds.push(span.clone());
         }
-        let annotation_text: Vec<String> = annotations
-            .iter()
-            .map(|a| self.text.get(a.span.range()).unwrap_or("").to_string())
-            .collect();
         let group = annotations
             .iter()
             .find(|a| a.name.name == "Group")
             .and_then(|a| a.args.first())
             .and_then(|arg| match arg {
-                ast::AnnotationArg::Positional(e) | ast::AnnotationArg::Named(_, e) => match &e.kind {
-                    ast::ExprKind::Str(s) => Some(s.clone()),
-                    _ => None,
-                },
+                ast::AnnotationArg::Positional(e) | ast::AnnotationArg::Named(_, e) => {
+                    match &e.kind {
+                        ast::ExprKind::Str(s) => Some(s.clone()),
+                        _ => None,
+                    }
+                }
                 ast::AnnotationArg::Verbatim { .. } => None,
             });
         self.defs.push(Def {
@@ -279,7 +320,6 @@ impl FileIndex {
             doc: doc_comment(&self.text, span.start),
             span,
             params: params.iter().map(|p| p.name.name.clone()).collect(),
-            annotations: annotation_text,
             group,
             owner: None,
         });
@@ -294,7 +334,6 @@ impl FileIndex {
                 name_span: p.name.span.range(),
                 span: p.name.span.range(),
                 params: Vec::new(),
-                annotations: Vec::new(),
                 group: None,
                 doc: None,
                 owner: Some(owner),
@@ -307,7 +346,6 @@ impl FileIndex {
                 name_span: l.name.span.range(),
                 span: l.name.span.to(l.value.span).range(),
                 params: Vec::new(),
-                annotations: Vec::new(),
                 group: None,
                 doc: None,
                 owner: Some(owner),
@@ -322,15 +360,28 @@ impl FileIndex {
             None => name.to_string(),
         };
         match o {
-            ast::ImportOverride::Protect(id) => {
-                self.reference(qualified(&id.name), id.span.range(), RefKind::Value, Some(owner))
-            }
+            ast::ImportOverride::Protect(id) => self.reference(
+                qualified(&id.name),
+                id.span.range(),
+                RefKind::Value,
+                Some(owner),
+            ),
             ast::ImportOverride::Attr(id, e) => {
-                self.reference(qualified(&id.name), id.span.range(), RefKind::Value, Some(owner));
+                self.reference(
+                    qualified(&id.name),
+                    id.span.range(),
+                    RefKind::Value,
+                    Some(owner),
+                );
                 self.expr(e, Some(owner));
             }
             ast::ImportOverride::Rule { name, body, .. } => {
-                self.reference(qualified(&name.name), name.span.range(), RefKind::Stmt, Some(owner));
+                self.reference(
+                    qualified(&name.name),
+                    name.span.range(),
+                    RefKind::Stmt,
+                    Some(owner),
+                );
                 self.body(body, Some(owner));
             }
         }
@@ -340,7 +391,12 @@ impl FileIndex {
         if name.is_empty() || span.is_empty() {
             return;
         }
-        self.refs.push(Ref { name, span, kind, owner });
+        self.refs.push(Ref {
+            name,
+            span,
+            kind,
+            owner,
+        });
     }
 
     fn body(&mut self, body: &ast::Body, owner: Option<usize>) {
@@ -376,7 +432,12 @@ impl FileIndex {
             ast::Stmt::Call(call) => {
                 // `imp(h = 1).Lot`: the name's span covers the overrides;
                 // keep the name as written without them.
-                self.reference(call.name.name.clone(), call.name.span.range(), RefKind::Stmt, owner);
+                self.reference(
+                    call.name.name.clone(),
+                    call.name.span.range(),
+                    RefKind::Stmt,
+                    owner,
+                );
                 let alias = call.name.name.split_once('.').map(|(a, _)| a.to_string());
                 for o in call.import_overrides.iter().flatten() {
                     if let Some(import) = owner {
@@ -390,7 +451,9 @@ impl FileIndex {
                     self.block(block, owner);
                 }
             }
-            ast::Stmt::Leaf(id) => self.reference(id.name.clone(), id.span.range(), RefKind::Leaf, owner),
+            ast::Stmt::Leaf(id) => {
+                self.reference(id.name.clone(), id.span.range(), RefKind::Leaf, owner)
+            }
             ast::Stmt::Nil(_) => {}
             ast::Stmt::Push(body, _) => self.body(body, owner),
         }
@@ -555,9 +618,11 @@ Lot(h) --> extrude(h) comp(f) { side : f.Facade | top : Roof. }
     #[test]
     fn definitions_references_and_comments() {
         let index = FileIndex::new(TEXT.to_string());
-        assert!(index.syntax_errors.is_empty(), "{:?}", index.syntax_errors);
-        let names: Vec<(DefKind, &str)> =
-            index.defs.iter().map(|d| (d.kind, d.name.as_str())).collect();
+        let names: Vec<(DefKind, &str)> = index
+            .defs
+            .iter()
+            .map(|d| (d.kind, d.name.as_str()))
+            .collect();
         assert_eq!(
             names,
             [
@@ -573,8 +638,10 @@ Lot(h) --> extrude(h) comp(f) { side : f.Facade | top : Roof. }
         let height = &index.defs[1];
         assert_eq!(height.doc.as_deref(), Some("The building's height."));
         assert_eq!(height.group.as_deref(), Some("Massing"));
-        assert_eq!(height.annotations, ["@Range(min=3, max=60)", "@Group(\"Massing\")"]);
-        assert_eq!(&TEXT[height.span.clone()].lines().next(), &Some("@Range(min=3, max=60) @Group(\"Massing\")"));
+        assert_eq!(
+            &TEXT[height.span.clone()].lines().next(),
+            &Some("@Range(min=3, max=60) @Group(\"Massing\")")
+        );
 
         // `x` in `twice` is its parameter; `k` the const.
         let x = index.refs.iter().find(|r| r.name == "x").unwrap();
@@ -594,7 +661,7 @@ Lot(h) --> extrude(h) comp(f) { side : f.Facade | top : Roof. }
     #[test]
     fn a_broken_file_still_has_its_definitions() {
         let index = FileIndex::new("attr a = 1\nLot --> extrude(a\nB --> X.\n".to_string());
-        assert!(!index.syntax_errors.is_empty());
+        assert!(!parse(FileId(0), &index.text).1.is_empty());
         assert!(index.top_level("a").next().is_some());
         assert!(index.top_level("Lot").next().is_some());
     }

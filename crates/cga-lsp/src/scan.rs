@@ -31,7 +31,10 @@ pub fn scan(text: &str) -> Vec<Tok> {
             }
             // `scope.sx`: a dot followed by a letter continues the name;
             // `Leaf.` ends it.
-            if j + 1 < b.len() && b[j] == b'.' && (b[j + 1].is_ascii_alphabetic() || b[j + 1] == b'_') {
+            if j + 1 < b.len()
+                && b[j] == b'.'
+                && (b[j + 1].is_ascii_alphabetic() || b[j + 1] == b'_')
+            {
                 j += 1;
                 continue;
             }
@@ -103,7 +106,10 @@ pub fn scan(text: &str) -> Vec<Tok> {
 }
 
 fn line_end(b: &[u8], i: usize) -> usize {
-    b[i..].iter().position(|&c| c == b'\n').map_or(b.len(), |e| i + e)
+    b[i..]
+        .iter()
+        .position(|&c| c == b'\n')
+        .map_or(b.len(), |e| i + e)
 }
 
 #[cfg(test)]
@@ -112,9 +118,12 @@ mod tests {
 
     #[test]
     fn comments_strings_numbers_words() {
-        let text = "@Range(0, 1.5e2) attr a = \"x // y\" # c\nLot --> s('0.5) /* m\nn */ scope.sx Leaf.";
-        let toks: Vec<(TokKind, &str)> =
-            scan(text).iter().map(|t| (t.kind, &text[t.span.clone()])).collect();
+        let text =
+            "@Range(0, 1.5e2) attr a = \"x // y\" # c\nLot --> s('0.5) /* m\nn */ scope.sx Leaf.";
+        let toks: Vec<(TokKind, &str)> = scan(text)
+            .iter()
+            .map(|t| (t.kind, &text[t.span.clone()]))
+            .collect();
         use TokKind::*;
         assert_eq!(
             toks,

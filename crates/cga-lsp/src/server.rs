@@ -27,31 +27,33 @@ const STACK: usize = 64 << 20;
 type Error = Box<dyn std::error::Error + Send + Sync>;
 
 /// Serves the protocol on standard input and output until the client
-/// says `exit`.
-pub fn run_stdio() -> Result<(), Error> {
+/// says `exit`. `workspaces`: where `/Project/...` paths are looked for
+/// (`cga lsp --workspace DIR`), before those of the client's
+/// `initializationOptions.workspaces` and `CGA_WORKSPACE`.
+pub fn run_stdio(workspaces: &[PathBuf]) -> Result<(), Error> {
     let (connection, io_threads) = Connection::stdio();
-    run(connection)?;
+    run(connection, workspaces)?;
     io_threads.join()?;
     Ok(())
 }
 
 /// Serves the protocol over `connection` (stdio, or an in-memory pair in
 /// tests) until shutdown.
-pub fn run(connection: Connection) -> Result<(), Error> {
+pub fn run(connection: Connection, workspaces: &[PathBuf]) -> Result<(), Error> {
     std::thread::scope(|scope| {
         std::thread::Builder::new()
             .name("cga-lsp".into())
             .stack_size(STACK)
-            .spawn_scoped(scope, || serve(&connection))?
+            .spawn_scoped(scope, || serve(&connection, workspaces))?
             .join()
             .map_err(|_| Error::from("the language server stopped on an internal error"))?
     })
 }
 
-fn serve(connection: &Connection) -> Result<(), Error> {
+fn serve(connection: &Connection, workspaces: &[PathBuf]) -> Result<(), Error> {
     let (id, params) = connection.initialize_start()?;
     let init: lsp_types::InitializeParams = serde_json::from_value(params)?;
-    let mut server = Server::new(&init);
+    let mut server = Server::new(&init, workspaces);
     let result = lsp_types::InitializeResult {
         capabilities: crate::features::capabilities(),
         server_info: Some(lsp_types::ServerInfo {
@@ -61,7 +63,9 @@ fn serve(connection: &Connection) -> Result<(), Error> {
     };
     connection.initialize_finish(id, serde_json::to_value(result)?)?;
     loop {
-        let wait = server.next_deadline().map(|d| d.saturating_duration_since(Instant::now()));
+        let wait = server
+            .next_deadline()
+            .map(|d| d.saturating_duration_since(Instant::now()));
         let message = match wait {
             Some(wait) => match connection.receiver.recv_timeout(wait) {
                 Ok(m) => Some(m),
@@ -95,13 +99,18 @@ fn serve(connection: &Connection) -> Result<(), Error> {
                 diagnostics,
                 version,
             };
-            connection.sender.send(Message::Notification(Notification::new(
-                n::PublishDiagnostics::METHOD.to_string(),
-                params,
-            )))?;
+            connection
+                .sender
+                .send(Message::Notification(Notification::new(
+                    n::PublishDiagnostics::METHOD.to_string(),
+                    params,
+                )))?;
         }
     }
 }
+
+/// A file read from disk: its time and size when read, and its index.
+type DiskEntry = (Option<SystemTime>, u64, Arc<FileIndex>);
 
 /// An open document.
 pub struct Doc {
@@ -123,11 +132,11 @@ pub struct Server {
     /// Documents whose diagnostics are due, and when.
     pending: HashMap<PathBuf, Instant>,
     /// Indexes of files read from disk, with the metadata they were read at.
-    disk: Mutex<HashMap<PathBuf, (Option<SystemTime>, u64, Arc<FileIndex>)>>,
+    disk: Mutex<HashMap<PathBuf, DiskEntry>>,
 }
 
 impl Server {
-    pub fn new(init: &lsp_types::InitializeParams) -> Server {
+    pub fn new(init: &lsp_types::InitializeParams, workspaces: &[PathBuf]) -> Server {
         let world = Arc::new(MemoryWorld::over(Arc::new(DiskWorld)));
         let mut roots: Vec<PathBuf> = init
             .workspace_folders
@@ -142,13 +151,17 @@ impl Server {
         // `initializationOptions: { "workspaces": ["DIR", ...] }`: where
         // `/Project/...` paths are looked for besides the file's ancestors
         // (as `cga --workspace`), then `CGA_WORKSPACE`.
-        let dirs: Vec<PathBuf> = init
-            .initialization_options
-            .as_ref()
-            .and_then(|o| o.get("workspaces"))
-            .and_then(Value::as_array)
-            .map(|a| a.iter().filter_map(Value::as_str).map(PathBuf::from).collect())
-            .unwrap_or_default();
+        let mut dirs = workspaces.to_vec();
+        dirs.extend(
+            init.initialization_options
+                .as_ref()
+                .and_then(|o| o.get("workspaces"))
+                .and_then(Value::as_array)
+                .into_iter()
+                .flatten()
+                .filter_map(Value::as_str)
+                .map(PathBuf::from),
+        );
         let workspaces = Workspaces::with_env(&dirs);
         let engine = Engine::with_world(world.clone()).workspaces(workspaces.clone());
         Server {
@@ -169,7 +182,9 @@ impl Server {
     fn notification(&mut self, note: Notification) {
         match note.method.as_str() {
             m if m == n::DidOpenTextDocument::METHOD => {
-                let Ok(p) = serde_json::from_value::<lsp_types::DidOpenTextDocumentParams>(note.params) else {
+                let Ok(p) =
+                    serde_json::from_value::<lsp_types::DidOpenTextDocumentParams>(note.params)
+                else {
                     return;
                 };
                 let Ok(path) = p.text_document.uri.to_file_path() else {
@@ -189,7 +204,9 @@ impl Server {
                 self.pending.insert(path, Instant::now());
             }
             m if m == n::DidChangeTextDocument::METHOD => {
-                let Ok(p) = serde_json::from_value::<lsp_types::DidChangeTextDocumentParams>(note.params) else {
+                let Ok(p) =
+                    serde_json::from_value::<lsp_types::DidChangeTextDocumentParams>(note.params)
+                else {
                     return;
                 };
                 let Ok(path) = p.text_document.uri.to_file_path() else {
@@ -206,7 +223,8 @@ impl Server {
                 self.world.set(&path, doc.text.clone());
                 self.pending.insert(path.clone(), Instant::now() + DEBOUNCE);
                 // Files importing this one may change too.
-                let others: Vec<PathBuf> = self.docs.keys().filter(|k| **k != path).cloned().collect();
+                let others: Vec<PathBuf> =
+                    self.docs.keys().filter(|k| **k != path).cloned().collect();
                 for other in others {
                     if self.imports_of(&other).contains(&path) {
                         self.pending.insert(other, Instant::now() + DEBOUNCE);
@@ -214,7 +232,9 @@ impl Server {
                 }
             }
             m if m == n::DidCloseTextDocument::METHOD => {
-                let Ok(p) = serde_json::from_value::<lsp_types::DidCloseTextDocumentParams>(note.params) else {
+                let Ok(p) =
+                    serde_json::from_value::<lsp_types::DidCloseTextDocumentParams>(note.params)
+                else {
                     return;
                 };
                 if let Ok(path) = p.text_document.uri.to_file_path() {
@@ -243,8 +263,8 @@ impl Server {
                 continue;
             };
             let (uri, version) = (doc.uri.clone(), doc.version);
-            let diagnostics = catch_unwind(AssertUnwindSafe(|| self.diagnostics(&path)))
-                .unwrap_or_default();
+            let diagnostics =
+                catch_unwind(AssertUnwindSafe(|| self.diagnostics(&path))).unwrap_or_default();
             out.push((uri, diagnostics, Some(version)));
         }
         out
@@ -264,7 +284,8 @@ impl Server {
             .imports
             .iter()
             .filter_map(|i| {
-                let found = cga::syntax::locate(&*self.world, path, &i.path, &self.workspaces).ok()?;
+                let found =
+                    cga::syntax::locate(&*self.world, path, &i.path, &self.workspaces).ok()?;
                 Some((self.world.canonical(&found), index.defs[i.def].span.clone()))
             })
             .collect();
@@ -294,7 +315,9 @@ impl Server {
                     };
                     message = format!(
                         "in {}:{}:{}: {message}",
-                        l.file.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned()),
+                        l.file
+                            .file_name()
+                            .map_or(String::new(), |n| n.to_string_lossy().into_owned()),
                         l.line,
                         l.column
                     );
@@ -389,7 +412,9 @@ impl Server {
         self.ensure_indexed();
         let id = req.id.clone();
         let method = req.method.clone();
-        match catch_unwind(AssertUnwindSafe(|| crate::features::dispatch(self, &method, req.params))) {
+        match catch_unwind(AssertUnwindSafe(|| {
+            crate::features::dispatch(self, &method, req.params)
+        })) {
             Ok(Ok(value)) => Response::new_ok(id, value),
             Ok(Err(Failure::UnknownMethod)) => Response::new_err(
                 id,
@@ -439,7 +464,8 @@ fn walk(world: &dyn World, dir: &Path, out: &mut Vec<PathBuf>, depth: usize) {
         }
         if world.is_dir(&e) {
             walk(world, &e, out, depth + 1);
-        } else if e.extension().is_some_and(|x| x.eq_ignore_ascii_case("cga")) && !out.contains(&e) {
+        } else if e.extension().is_some_and(|x| x.eq_ignore_ascii_case("cga")) && !out.contains(&e)
+        {
             out.push(e);
         }
     }

@@ -93,7 +93,10 @@ mod tests {
         // é is one UTF-16 unit, 𝄞 two.
         assert_eq!(index.position(text, x), Position::new(1, 6));
         assert_eq!(index.offset(text, Position::new(1, 6)), x);
-        assert_eq!(index.offset(text, Position::new(1, 99)), text.rfind('\n').unwrap());
+        assert_eq!(
+            index.offset(text, Position::new(1, 99)),
+            text.rfind('\n').unwrap()
+        );
         assert_eq!(index.offset(text, Position::new(9, 0)), text.len());
         assert_eq!(index.offset_of_line_col(text, 2, 6), x);
         let mut edited = text.to_string();

@@ -993,7 +993,7 @@ fn prepare_rename(
             }
             Ok(Some(PrepareRenameResponse::RangeWithPlaceholder {
                 range: index.lines.range(&index.text, span.clone()),
-                placeholder: index.text[span].to_string(),
+                placeholder: index.text.get(span).unwrap_or("").to_string(),
             }))
         }
         Some(_) => Err(Failure::Refused("built-in names cannot be renamed".into())),

@@ -294,7 +294,8 @@ impl FileIndex {
             .min()
             .unwrap_or(span.start as usize)
             .min(span.start as usize);
-        let span = start..(span.end as usize).max(start);
+        let span = self.clamp(start..(span.end as usize).max(start));
+        let name_span = self.clamp(name_span);
         if self.lines.position(&self.text, span.start).line
             != self.lines.position(&self.text, span.end).line
         {
@@ -331,8 +332,8 @@ impl FileIndex {
             self.defs.push(Def {
                 kind: DefKind::Param,
                 name: p.name.name.clone(),
-                name_span: p.name.span.range(),
-                span: p.name.span.range(),
+                name_span: self.clamp(p.name.span.range()),
+                span: self.clamp(p.name.span.range()),
                 params: Vec::new(),
                 group: None,
                 doc: None,
@@ -343,8 +344,8 @@ impl FileIndex {
             self.defs.push(Def {
                 kind: DefKind::Local,
                 name: l.name.name.clone(),
-                name_span: l.name.span.range(),
-                span: l.name.span.to(l.value.span).range(),
+                name_span: self.clamp(l.name.span.range()),
+                span: self.clamp(l.name.span.to(l.value.span).range()),
                 params: Vec::new(),
                 group: None,
                 doc: None,
@@ -387,7 +388,15 @@ impl FileIndex {
         }
     }
 
+    /// `span` within the text: a placeholder the parser made at the end of
+    /// a cut text may reach past it.
+    fn clamp(&self, span: Range<usize>) -> Range<usize> {
+        let end = span.end.min(self.text.len());
+        span.start.min(end)..end
+    }
+
     fn reference(&mut self, name: String, span: Range<usize>, kind: RefKind, owner: Option<usize>) {
+        let span = self.clamp(span);
         if name.is_empty() || span.is_empty() {
             return;
         }

@@ -35,4 +35,7 @@ mod scan;
 mod server;
 mod text;
 
+#[cfg(test)]
+mod robust;
+
 pub use server::{run, run_stdio};

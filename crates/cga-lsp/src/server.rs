@@ -179,7 +179,7 @@ impl Server {
         self.pending.values().min().copied()
     }
 
-    fn notification(&mut self, note: Notification) {
+    pub(crate) fn notification(&mut self, note: Notification) {
         match note.method.as_str() {
             m if m == n::DidOpenTextDocument::METHOD => {
                 let Ok(p) =
@@ -408,7 +408,7 @@ impl Server {
         files
     }
 
-    fn request(&mut self, req: Request) -> Response {
+    pub(crate) fn request(&mut self, req: Request) -> Response {
         self.ensure_indexed();
         let id = req.id.clone();
         let method = req.method.clone();

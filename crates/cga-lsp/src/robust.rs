@@ -228,3 +228,69 @@ fn prefixes_and_random_edits_of_the_corpus_never_crash_the_server() {
         s.ask_document(&format!("{name} after edits"));
     }
 }
+
+/// Latency on the largest file of the corpus (a benchmark, not a timed
+/// test: `cargo test -p cga-lsp --release -- --ignored --nocapture
+/// latency`): median time of diagnostics after a change and of a
+/// completion, over 100 runs each.
+#[test]
+#[ignore]
+fn latency_on_the_largest_corpus_file() {
+    use std::time::Instant;
+    let Some(corpus) = cga_testkit::shared("corpus/workspace") else {
+        return;
+    };
+    let corpus = corpus.canonicalize().unwrap();
+    let mut files = Vec::new();
+    cga_files(&corpus, &mut files);
+    let path = files
+        .iter()
+        .max_by_key(|p| std::fs::metadata(p).map_or(0, |m| m.len()))
+        .unwrap()
+        .clone();
+    let text = cga::decode_text(&std::fs::read(&path).unwrap());
+    let mut s = Session {
+        server: Server::new(&lsp_types::InitializeParams::default(), &[]),
+        next_id: 0,
+        uri: lsp_types::Url::from_file_path(&path).unwrap().to_string(),
+        version: 1,
+    };
+    let uri = s.uri.clone();
+    s.notify(
+        "textDocument/didOpen",
+        json!({"textDocument": {"uri": uri, "languageId": "cga", "version": 1, "text": text}}),
+    );
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let mut diag = Vec::new();
+    let mut completion = Vec::new();
+    let line = text.lines().count() / 2;
+    for i in 0..100 {
+        s.version += 1;
+        s.notify(
+            "textDocument/didChange",
+            json!({"textDocument": {"uri": uri, "version": s.version}, "contentChanges": [{
+                "range": {"start": {"line": line, "character": 0}, "end": {"line": line, "character": 0}},
+                "text": if i % 2 == 0 { " " } else { "" }}]}),
+        );
+        let t = Instant::now();
+        s.server.diagnostics(&path);
+        diag.push(t.elapsed().as_secs_f64() * 1e3);
+        let t = Instant::now();
+        s.ask(
+            server::COMPLETION,
+            json!({"textDocument": {"uri": uri}, "position": {"line": line, "character": 4}}),
+            "latency",
+        );
+        completion.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    println!(
+        "{} ({} bytes): diagnostics after a change {:.2} ms, completion {:.2} ms (medians of 100)",
+        path.file_name().unwrap().to_string_lossy(),
+        text.len(),
+        median(diag),
+        median(completion)
+    );
+}

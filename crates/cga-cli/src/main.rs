@@ -76,6 +76,16 @@ enum Command {
         #[arg(long = "workspace", value_name = "DIR")]
         workspaces: Vec<PathBuf>,
     },
+    /// Format rule files in place (indentation, trailing spaces, blank lines).
+    Fmt {
+        /// The rule files.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Change nothing: list the files that formatting would change,
+        /// and exit with status 1 if there are any.
+        #[arg(long)]
+        check: bool,
+    },
     /// Language server for editors, on standard input and output.
     Lsp {
         /// Accepted for editor clients that pass it; stdio is the only transport.
@@ -206,6 +216,7 @@ fn main() -> ExitCode {
                 style,
                 workspaces,
             } => check(&rules, format, style.as_deref(), &workspaces),
+            Command::Fmt { files, check } => fmt(&files, check),
             Command::Lsp { workspaces, .. } => {
                 cga_lsp::run_stdio(&workspaces).map_err(|e| Failure::Error(e.to_string()))
             }
@@ -229,6 +240,31 @@ fn main() -> ExitCode {
             ExitCode::from(2)
         }
     }
+}
+
+/// `cga fmt`: each file through the formatter of `cga_lsp::format`.
+fn fmt(files: &[PathBuf], check: bool) -> Result<(), Failure> {
+    let mut unformatted = false;
+    for path in files {
+        let bytes = std::fs::read(path)
+            .map_err(|e| Failure::Usage(format!("cannot read {}: {e}", path.display())))?;
+        let text = cga::decode_text(&bytes);
+        let formatted = cga_lsp::format::format(&text);
+        if formatted.as_bytes() == bytes.as_slice() {
+            continue;
+        }
+        if check {
+            eprintln!("{}: not formatted", path.display());
+            unformatted = true;
+        } else {
+            std::fs::write(path, formatted)
+                .map_err(|e| Failure::Error(format!("cannot write {}: {e}", path.display())))?;
+        }
+    }
+    if unformatted {
+        return Err(Failure::Reported);
+    }
+    Ok(())
 }
 
 fn report_diagnostics<'a>(diags: impl IntoIterator<Item = &'a Diagnostic>) {

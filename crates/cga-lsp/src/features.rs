@@ -50,6 +50,7 @@ pub fn capabilities() -> ServerCapabilities {
             },
         )),
         folding_range_provider: Some(FoldingRangeProviderCapability::Simple(true)),
+        document_formatting_provider: Some(OneOf::Left(true)),
         ..Default::default()
     }
 }
@@ -73,6 +74,7 @@ pub fn dispatch(s: &mut Server, method: &str, params: Value) -> Result<Value, Fa
         server::WORKSPACE_SYMBOL => json(workspace_symbols(s, p(params)?)),
         server::SEMANTIC_TOKENS => json(semantic_tokens(s, p(params)?)),
         server::FOLDING_RANGE => json(folding_ranges(s, p(params)?)),
+        server::FORMATTING => json(formatting(s, p(params)?)),
         _ => return Err(Failure::UnknownMethod),
     })
 }
@@ -1333,6 +1335,20 @@ fn folding_ranges(s: &Server, p: FoldingRangeParams) -> Option<Vec<FoldingRange>
     }
     out.sort_by_key(|f| (f.start_line, f.end_line));
     Some(out)
+}
+
+// ---------------------------------------------------------------- formatting
+
+/// The whole document replaced by its formatted text, when that differs.
+fn formatting(s: &Server, p: DocumentFormattingParams) -> Option<Vec<TextEdit>> {
+    let path = p.text_document.uri.to_file_path().ok()?;
+    let index = s.index(&path)?;
+    let formatted = crate::format::format(&index.text);
+    if formatted == index.text {
+        return Some(Vec::new());
+    }
+    let all = index.lines.range(&index.text, 0..index.text.len());
+    Some(vec![TextEdit::new(all, formatted)])
 }
 
 #[cfg(test)]

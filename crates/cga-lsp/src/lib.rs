@@ -23,6 +23,9 @@
 //!   document symbols grouped by `@Group`, workspace symbols, semantic
 //!   tokens and folding ranges.
 //!
+//! - formatting (`textDocument/formatting`) with [`format::format`], which
+//!   is also `cga fmt`.
+//!
 //! Modules: `text` (offsets and LSP positions), `scan` (a lexical pass for
 //! highlighting), `index` (what a file defines and uses), `builtins`
 //! (functions, selectors, keywords), `features` (the requests), `server`
@@ -30,6 +33,7 @@
 
 mod builtins;
 mod features;
+pub mod format;
 mod index;
 mod scan;
 mod server;

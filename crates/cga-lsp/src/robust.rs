@@ -26,7 +26,7 @@ impl Rng {
     }
 }
 
-fn cga_files(dir: &Path, out: &mut Vec<PathBuf>) {
+pub(crate) fn cga_files(dir: &Path, out: &mut Vec<PathBuf>) {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return;
     };

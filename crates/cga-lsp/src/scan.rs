@@ -58,14 +58,7 @@ pub fn scan(text: &str) -> Vec<Tok> {
                 TokKind::Comment
             }
             b'"' => {
-                i += 1;
-                while i < b.len() && b[i] != c && b[i] != b'\n' {
-                    if b[i] == b'\\' {
-                        i += 1;
-                    }
-                    i += 1;
-                }
-                i = (i + 1).min(b.len());
+                i = string_end(b, i).unwrap_or_else(|end| end);
                 TokKind::Str
             }
             b'@' => {
@@ -105,6 +98,51 @@ pub fn scan(text: &str) -> Vec<Tok> {
     out
 }
 
+/// Where the string opened at `open` ends (after its closing quote), as
+/// the engine's lexer reads strings: a string may go on over a line break
+/// when it closes on a later line and what follows its closing quote can
+/// follow a string; otherwise (`Err`) it ends at its first line break.
+fn string_end(b: &[u8], open: usize) -> Result<usize, usize> {
+    let mut i = open + 1;
+    let mut line_end = None;
+    loop {
+        match b.get(i) {
+            None => return Err(line_end.unwrap_or(i)),
+            Some(b'\n') | Some(b'\r') => {
+                line_end.get_or_insert(i);
+                i += 1;
+            }
+            Some(b'"') => {
+                i += 1;
+                let Some(first_break) = line_end else {
+                    return Ok(i);
+                };
+                let mut j = i;
+                while matches!(b.get(j), Some(b' ' | b'\t')) {
+                    j += 1;
+                }
+                let follows_well = match b.get(j) {
+                    None | Some(b'\n' | b'\r') => true,
+                    Some(&c) => {
+                        !(c.is_ascii_alphanumeric()
+                            || c == b'_'
+                            || c == b'"'
+                            || c == b'.'
+                            || c >= 0x80)
+                    }
+                };
+                return if follows_well {
+                    Ok(i)
+                } else {
+                    Err(first_break)
+                };
+            }
+            Some(b'\\') if matches!(b.get(i + 1), Some(c) if *c != b'\n' && *c != b'\r') => i += 2,
+            Some(_) => i += 1,
+        }
+    }
+}
+
 fn line_end(b: &[u8], i: usize) -> usize {
     b[i..]
         .iter()
@@ -120,6 +158,13 @@ mod tests {
     fn comments_strings_numbers_words() {
         let text =
             "@Range(0, 1.5e2) attr a = \"x // y\" # c\nLot --> s('0.5) /* m\nn */ scope.sx Leaf.";
+        let text2 = "@Enum(\"a\",\"\n b\",\"c\") print(\"abc)\nLot";
+        let strs: Vec<&str> = scan(text2)
+            .iter()
+            .filter(|t| t.kind == TokKind::Str)
+            .map(|t| &text2[t.span.clone()])
+            .collect();
+        assert_eq!(strs, ["\"a\"", "\"\n b\"", "\"c\"", "\"abc)"]);
         let toks: Vec<(TokKind, &str)> = scan(text)
             .iter()
             .map(|t| (t.kind, &text[t.span.clone()]))

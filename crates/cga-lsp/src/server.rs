@@ -483,3 +483,4 @@ pub(crate) const DOCUMENT_SYMBOL: &str = r::DocumentSymbolRequest::METHOD;
 pub(crate) const WORKSPACE_SYMBOL: &str = r::WorkspaceSymbolRequest::METHOD;
 pub(crate) const SEMANTIC_TOKENS: &str = r::SemanticTokensFullRequest::METHOD;
 pub(crate) const FOLDING_RANGE: &str = r::FoldingRangeRequest::METHOD;
+pub(crate) const FORMATTING: &str = r::Formatting::METHOD;

@@ -5,11 +5,13 @@
 //! [`parse`] is the engine's own error-tolerant parser: it never panics,
 //! always gives a tree (with placeholders where text was missing) and the
 //! syntax errors found. Spans are byte offsets into the text parsed.
+//! [`sexpr`] writes a tree in a compact text form without spans: two
+//! texts with the same form mean the same (a formatter's test).
 
 use std::path::{Path, PathBuf};
 
 pub use cga_syntax::ast;
-pub use cga_syntax::{parse, FileId, Span};
+pub use cga_syntax::{parse, sexpr, FileId, Span};
 
 use crate::{Workspaces, World};
 

@@ -547,6 +547,22 @@ fn an_editor_session_over_stdio() {
     let items = c.request("textDocument/completion", at(&scratch, text, "/Lib/", 0, 5));
     assert_eq!(labels(&items), ["rules/"]);
 
+    // Formatting: one edit replacing the document.
+    let messy = "Lot -->\n extrude(1)   \n";
+    let fmt_uri = uri(&root.join("Main/rules/messy.cga"));
+    c.notify(
+        "textDocument/didOpen",
+        json!({"textDocument": {"uri": fmt_uri, "languageId": "cga", "version": 1, "text": messy}}),
+    );
+    let edits = c.request(
+        "textDocument/formatting",
+        json!({"textDocument": {"uri": fmt_uri}, "options": {"tabSize": 4, "insertSpaces": true}}),
+    );
+    assert_eq!(
+        edits,
+        json!([{"range": range((0, 0), (2, 0)), "newText": "Lot -->\n    extrude(1)\n"}])
+    );
+
     // Unknown methods are answered with an error, not a crash.
     let r = c.request_raw("textDocument/unknownThing", json!({}));
     assert_eq!(r["error"]["code"], -32601);
@@ -555,4 +571,28 @@ fn an_editor_session_over_stdio() {
     c.notify("exit", Value::Null);
     let status = c.child.wait().unwrap();
     assert!(status.success(), "{status}");
+}
+
+#[test]
+fn fmt_formats_in_place_and_check_reports() {
+    let dir = temp_dir("fmt");
+    let file = dir.join("a.cga");
+    let messy = "Lot -->  \n\textrude(10)\n  comp(f) {\ntop : Roof.\n}\n\n\n\nRoof --> X.";
+    std::fs::write(&file, messy).unwrap();
+    let out = cga().args(["fmt", "--check"]).arg(&file).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("a.cga: not formatted"));
+    assert_eq!(
+        std::fs::read_to_string(&file).unwrap(),
+        messy,
+        "--check changes nothing"
+    );
+    let out = cga().arg("fmt").arg(&file).output().unwrap();
+    assert!(out.status.success());
+    assert_eq!(
+        std::fs::read_to_string(&file).unwrap(),
+        "Lot -->\n    extrude(10)\n    comp(f) {\n        top : Roof.\n    }\n\nRoof --> X.\n"
+    );
+    let out = cga().args(["fmt", "--check"]).arg(&file).output().unwrap();
+    assert_eq!(out.status.code(), Some(0));
 }

@@ -118,8 +118,8 @@ pub fn format(text: &str) -> String {
             let last_code = line
                 .bytes()
                 .enumerate()
-                .filter(|(i, c)| !comment[line_start + i] && !c.is_ascii_whitespace())
-                .last();
+                .rev()
+                .find(|(i, c)| !comment[line_start + i] && !c.is_ascii_whitespace());
             if let Some((_, c)) = last_code {
                 after_colon = c == b':';
             }

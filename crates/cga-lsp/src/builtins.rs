@@ -656,3 +656,38 @@ pub const KEYWORDS: &[&str] = &[
     "bool[]",
     "string[]",
 ];
+
+#[cfg(test)]
+mod tests {
+    /// The VS Code grammar (`editors/vscode/syntaxes/cga.tmLanguage.json`)
+    /// names every operation of the engine's table and every built-in
+    /// function here, so that highlighting follows the table.
+    #[test]
+    fn the_vscode_grammar_names_every_operation_and_function() {
+        let path = cga_testkit::repo_root().join("editors/vscode/syntaxes/cga.tmLanguage.json");
+        let grammar: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        let words = |key: &str| -> Vec<String> {
+            let m = grammar["repository"][key]["match"].as_str().unwrap();
+            let inner = m.split_once("(?:").unwrap().1;
+            let inner = inner.split_once(')').unwrap().0;
+            inner.split('|').map(|w| w.replace("\\\\.", ".").replace("\\.", ".")).collect()
+        };
+        let ops = words("operations");
+        let mut names: Vec<&str> = cga::operations::all()
+            .iter()
+            .flat_map(|o| std::iter::once(o.name).chain(o.aliases.iter().copied()))
+            .collect();
+        names.sort();
+        names.dedup();
+        let missing: Vec<&&str> = names.iter().filter(|n| !ops.iter().any(|o| o == *n)).collect();
+        assert!(missing.is_empty(), "operations missing from the grammar: {missing:?}\nall: {}", names.join("|"));
+        let functions = words("functions");
+        let missing: Vec<&str> = super::FUNCTIONS
+            .iter()
+            .map(|f| f.name)
+            .filter(|n| !n.contains('.') && !functions.iter().any(|o| o == n))
+            .collect();
+        assert!(missing.is_empty(), "functions missing from the grammar: {missing:?}");
+    }
+}

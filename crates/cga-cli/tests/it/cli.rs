@@ -1199,3 +1199,60 @@ fn an_import_of_an_unknown_style_is_an_error() {
     assert!(err.contains("unknown style `mystyl`"), "{err}");
     assert!(err.contains("defines the styles Default, mystyle"), "{err}");
 }
+
+/// An OBJ model can be taken apart: a group (`g`) per lot, named by its
+/// feature id, and materials named by their colour or colour map.
+#[test]
+fn obj_groups_per_lot_and_material_names_say_what_they_are() {
+    let dir = temp_dir("obj-groups");
+    let gj = dir.join("two.geojson");
+    std::fs::write(
+        &gj,
+        r#"{"type":"FeatureCollection","features":[
+          {"type":"Feature","id":"north house","properties":{},"geometry":{"type":"Polygon",
+           "coordinates":[[[0,0],[10,0],[10,10],[0,10],[0,0]]]}},
+          {"type":"Feature","id":"b","properties":{},"geometry":{"type":"Polygon",
+           "coordinates":[[[20,0],[30,0],[30,10],[20,10],[20,0]]]}}]}"#,
+    )
+    .unwrap();
+    let rules = rule_file(
+        &dir,
+        "g.cga",
+        "Lot --> extrude(3) comp(f) { top : color(\"#ff8000\") Roof. | all : Wall. }\n",
+    );
+    let obj = dir.join("m.obj");
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--lot",
+        gj.to_str().unwrap(),
+        "--crs",
+        "local",
+        "-o",
+        obj.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = std::fs::read_to_string(&obj).unwrap();
+    let groups: Vec<&str> = text.lines().filter(|l| l.starts_with("g ")).collect();
+    assert_eq!(groups, ["g north_house", "g b"]);
+    // Each group's faces: the 5 walls and the roof of one building.
+    let faces_after = |g: &str| {
+        text.split(g)
+            .nth(1)
+            .unwrap()
+            .split("\ng ")
+            .next()
+            .unwrap()
+            .lines()
+            .filter(|l| l.starts_with("f "))
+            .count()
+    };
+    assert_eq!(faces_after("g north_house\n"), 6);
+    assert_eq!(faces_after("g b\n"), 6);
+    let mtl = std::fs::read_to_string(dir.join("m.mtl")).unwrap();
+    let names: Vec<&str> = mtl
+        .lines()
+        .filter_map(|l| l.strip_prefix("newmtl "))
+        .collect();
+    assert_eq!(names, ["color_ff8000", "color_ffffff"]);
+}

@@ -102,7 +102,7 @@ struct GenerateArgs {
     /// The rule file (.cga).
     rules: PathBuf,
     /// A lot: `rect:W,D`, `grid:COLSxROWS`, an .obj file (each face one
-    /// lot) or a .geojson, .fgb, .gpkg or .shp file (each polygon one lot).
+    /// lot) or a .geojson, .fgb, .gpkg or .shp file (each feature one lot).
     /// Repeatable. Default: `rect:20,30`.
     #[arg(long = "lot", value_name = "SPEC")]
     lots: Vec<String>,
@@ -114,6 +114,11 @@ struct GenerateArgs {
     /// `skip` them or stop with an `error`; each is named in a warning.
     #[arg(long, value_name = "WHAT", default_value = "repair")]
     invalid: cga::InvalidPolicy,
+    /// Each polygon of a GIS feature (a MultiPolygon's parts) is a lot of
+    /// its own, named ID, ID.1, ...; by default a feature is one lot whose
+    /// polygons are the faces of one initial shape.
+    #[arg(long)]
+    split_multipolygons: bool,
     /// The start rule (default: the rule marked @StartRule, else `Lot`).
     #[arg(long, value_name = "NAME")]
     start_rule: Option<String>,
@@ -363,6 +368,7 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
     let lot_options = cga::LotOptions {
         crs: args.crs.clone(),
         invalid: args.invalid,
+        split_multipolygons: args.split_multipolygons,
     };
     let lots = cga::lots::read_with(&args.lots, &lot_options)?;
     for note in &lots.notes {

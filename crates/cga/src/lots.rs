@@ -47,7 +47,7 @@ pub fn polygon(name: impl Into<String>, points: &[DVec3]) -> Lot {
 /// Lots from specifications as the `cga` command takes them (`--lot`):
 /// `rect:W,D`, `grid:COLSxROWS[:LOTS.obj]` (a synthetic city of lots in a
 /// grid), an `.obj` file (each face one lot), or a GIS file: `.geojson`,
-/// `.json`, `.fgb`, `.gpkg` or `.shp` (each polygon one lot, feature
+/// `.json`, `.fgb`, `.gpkg` or `.shp` (each feature one lot, feature
 /// properties as attributes, projected into one local metric frame when
 /// georeferenced; see `docs/geographic.md`). No specification:
 /// `rect:20,30`. Each file's own CRS, invalid lots repaired: see

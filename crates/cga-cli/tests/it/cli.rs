@@ -458,7 +458,7 @@ fn reports_are_aggregated_per_key() {
 }
 
 #[test]
-fn obj_and_geojson_lots_give_one_initial_shape_per_polygon() {
+fn obj_faces_and_geojson_features_give_one_initial_shape_each() {
     let dir = temp_dir("lots");
     let rules = rule_file(
         &dir,
@@ -506,7 +506,54 @@ fn obj_and_geojson_lots_give_one_initial_shape_per_polygon() {
         "local",
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
+    // The MultiPolygon is one shape of two faces (4 + 0.5 m²).
+    assert_eq!(stdout(&out), "a 96 12\nb 4.5 3\n");
+    // Or a lot per polygon.
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--lot",
+        gj.to_str().unwrap(),
+        "--crs",
+        "local",
+        "--split-multipolygons",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
     assert_eq!(stdout(&out), "a 96 12\nb 4 3\nb.1 0.5 3\n");
+}
+
+/// A MultiPolygon is one initial shape with a face per polygon, as
+/// CityEngine imports it: an extrusion extrudes every face, comp(f) sees
+/// them all, and a setback works on each face.
+#[test]
+fn a_multipolygon_is_one_shape_of_several_faces() {
+    let dir = temp_dir("multipolygon");
+    let gj = dir.join("two.geojson");
+    std::fs::write(
+        &gj,
+        r#"{"type":"FeatureCollection","features":[
+          {"type":"Feature","id":"twin","properties":{},"geometry":{"type":"MultiPolygon",
+           "coordinates":[[[[0,0],[10,0],[10,10],[0,10],[0,0]]],[[[20,0],[30,0],[30,10],[20,10],[20,0]]]]}}]}"#,
+    )
+    .unwrap();
+    let rules = rule_file(
+        &dir,
+        "m.cga",
+        r#"Lot --> print(geometry.nFaces) print(geometry.area) Mass
+Mass --> extrude(5) print(geometry.nFaces) print(geometry.volume) comp(f) { top : Top }
+Top --> print("top " + geometry.area)
+"#,
+    );
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--lot",
+        gj.to_str().unwrap(),
+        "--crs",
+        "local",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(stdout(&out), "2\n200\n12\n1000\ntop 100\ntop 100\n");
 }
 
 #[test]
@@ -881,8 +928,18 @@ fn crs_and_invalid_options() {
         a.extend_from_slice(extra);
         run(&a)
     };
-    // Repaired by default: two triangles of 25 m², with a warning.
+    // Repaired by default: two triangles of 25 m², the faces of one lot,
+    // with a warning.
     let out = args(&["--crs", "local"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(stdout(&out), "eight 50\nok 100\n");
+    assert!(
+        stderr(&out).contains("warning: ") && stderr(&out).contains("crosses itself at (5, 5)"),
+        "{}",
+        stderr(&out)
+    );
+    // Lots of their own with --split-multipolygons.
+    let out = args(&["--crs", "local", "--split-multipolygons"]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert_eq!(stdout(&out), "eight 25\neight-1 25\nok 100\n");
     assert!(
@@ -1141,4 +1198,61 @@ fn an_import_of_an_unknown_style_is_an_error() {
     assert!(err.contains("main.cga:1:14"), "{err}");
     assert!(err.contains("unknown style `mystyl`"), "{err}");
     assert!(err.contains("defines the styles Default, mystyle"), "{err}");
+}
+
+/// An OBJ model can be taken apart: a group (`g`) per lot, named by its
+/// feature id, and materials named by their colour or colour map.
+#[test]
+fn obj_groups_per_lot_and_material_names_say_what_they_are() {
+    let dir = temp_dir("obj-groups");
+    let gj = dir.join("two.geojson");
+    std::fs::write(
+        &gj,
+        r#"{"type":"FeatureCollection","features":[
+          {"type":"Feature","id":"north house","properties":{},"geometry":{"type":"Polygon",
+           "coordinates":[[[0,0],[10,0],[10,10],[0,10],[0,0]]]}},
+          {"type":"Feature","id":"b","properties":{},"geometry":{"type":"Polygon",
+           "coordinates":[[[20,0],[30,0],[30,10],[20,10],[20,0]]]}}]}"#,
+    )
+    .unwrap();
+    let rules = rule_file(
+        &dir,
+        "g.cga",
+        "Lot --> extrude(3) comp(f) { top : color(\"#ff8000\") Roof. | all : Wall. }\n",
+    );
+    let obj = dir.join("m.obj");
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--lot",
+        gj.to_str().unwrap(),
+        "--crs",
+        "local",
+        "-o",
+        obj.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = std::fs::read_to_string(&obj).unwrap();
+    let groups: Vec<&str> = text.lines().filter(|l| l.starts_with("g ")).collect();
+    assert_eq!(groups, ["g north_house", "g b"]);
+    // Each group's faces: the 5 walls and the roof of one building.
+    let faces_after = |g: &str| {
+        text.split(g)
+            .nth(1)
+            .unwrap()
+            .split("\ng ")
+            .next()
+            .unwrap()
+            .lines()
+            .filter(|l| l.starts_with("f "))
+            .count()
+    };
+    assert_eq!(faces_after("g north_house\n"), 6);
+    assert_eq!(faces_after("g b\n"), 6);
+    let mtl = std::fs::read_to_string(dir.join("m.mtl")).unwrap();
+    let names: Vec<&str> = mtl
+        .lines()
+        .filter_map(|l| l.strip_prefix("newmtl "))
+        .collect();
+    assert_eq!(names, ["color_ff8000", "color_ffffff"]);
 }

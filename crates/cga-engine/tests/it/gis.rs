@@ -285,8 +285,20 @@ fn every_feature_is_accounted_for() {
     .unwrap();
     let set = read(&path, &LotOptions::default());
     let names: Vec<&str> = set.lots.iter().map(|l| l.name.as_str()).collect();
+    // The collection's two polygons: one lot of two faces.
+    assert_eq!(names, ["gc"]);
+    assert_eq!(set.lots[0].mesh.faces.len(), 2);
+    assert_eq!(set.lots[0].attrs, vec![("h".into(), Value::Float(5.0))]);
+    let split = LotOptions {
+        split_multipolygons: true,
+        ..LotOptions::default()
+    };
+    let names: Vec<String> = read(&path, &split)
+        .lots
+        .into_iter()
+        .map(|l| l.name)
+        .collect();
     assert_eq!(names, ["gc", "gc.1"]);
-    assert_eq!(set.lots[1].attrs, vec![("h".into(), Value::Float(5.0))]);
     let warnings: Vec<&String> = set
         .messages
         .iter()
@@ -376,12 +388,14 @@ fn invalid_lots_are_repaired_by_default() {
     };
     let set = read(&path, &options);
     let names: Vec<&str> = set.lots.iter().map(|l| l.name.as_str()).collect();
-    assert_eq!(names, ["eight", "eight-1", "stray", "fine"]);
-    assert!((area(&set.lots[0]) - 25.0).abs() < 1e-9);
-    assert!((area(&set.lots[1]) - 25.0).abs() < 1e-9);
+    // The figure eight is repaired into two triangles of 25 m²: the faces
+    // of one lot.
+    assert_eq!(names, ["eight", "stray", "fine"]);
+    assert_eq!(set.lots[0].mesh.faces.len(), 2);
+    assert!((area(&set.lots[0]) - 50.0).abs() < 1e-9);
     // The stray hole is dropped: the lot keeps its 100 m² and one ring.
-    assert!((area(&set.lots[2]) - 100.0).abs() < 1e-9);
-    assert_eq!(set.lots[2].mesh.loops.len(), 1);
+    assert!((area(&set.lots[1]) - 100.0).abs() < 1e-9);
+    assert_eq!(set.lots[1].mesh.loops.len(), 1);
     let warnings: Vec<&String> = set
         .messages
         .iter()
@@ -391,7 +405,7 @@ fn invalid_lots_are_repaired_by_default() {
         })
         .collect();
     assert_eq!(warnings.len(), 3, "{warnings:?}");
-    assert!(warnings[0].contains("feature 0 (id \"eight\", line 2): lot `eight` is invalid (the outer ring crosses itself at (5, 5)): repaired into 2 lots"), "{}", warnings[0]);
+    assert!(warnings[0].contains("feature 0 (id \"eight\", line 2): lot `eight` is invalid (the outer ring crosses itself at (5, 5)): repaired into 2 polygons"), "{}", warnings[0]);
     assert!(
         warnings[1].contains("hole 1 lies outside the outer ring at (40, 0)"),
         "{}",
@@ -402,6 +416,20 @@ fn invalid_lots_are_repaired_by_default() {
         "{}",
         warnings[2]
     );
+
+    // A lot per polygon: the two pieces are lots of their own.
+    let split = LotOptions {
+        split_multipolygons: true,
+        ..options.clone()
+    };
+    let set = read(&path, &split);
+    let names: Vec<&str> = set.lots.iter().map(|l| l.name.as_str()).collect();
+    assert_eq!(names, ["eight", "eight-1", "stray", "fine"]);
+    assert!((area(&set.lots[1]) - 25.0).abs() < 1e-9);
+    assert!(set
+        .messages
+        .iter()
+        .any(|m| matches!(m, Message::Warning(w) if w.ends_with("repaired into 2 lots"))));
 
     let skip = LotOptions {
         invalid: InvalidPolicy::Skip,
@@ -647,4 +675,40 @@ fn shapefile_with_its_prj_holes_and_attributes() {
             assert!((g - w).abs() < 1e-4 * w, "{g} vs {w}");
         }
     }
+}
+
+/// An OBJ lot wound clockwise (normal down) is kept as CityEngine keeps it,
+/// with a warning naming it; counter-clockwise lots are not named.
+#[test]
+fn clockwise_obj_lots_are_named_in_a_warning() {
+    let dir = temp_dir("clockwise");
+    let obj = dir.join("lots.obj");
+    std::fs::write(
+        &obj,
+        "v 0 0 0\nv 10 0 0\nv 10 0 -10\nv 0 0 -10\n\
+         v 20 0 0\nv 20 0 -10\nv 30 0 -10\nv 30 0 0\n\
+         f 1 2 3 4\nf 5 6 7 8\n",
+    )
+    .unwrap();
+    let set = read_lots(&[obj.display().to_string()], &LotOptions::default()).unwrap();
+    assert_eq!(set.lots.len(), 2);
+    let warnings: Vec<&String> = set
+        .messages
+        .iter()
+        .filter_map(|m| match m {
+            Message::Warning(w) => Some(w),
+            Message::Note(_) => None,
+        })
+        .collect();
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(
+        warnings[0].ends_with(
+            "1 of 2 lots are wound clockwise (their normal points down, so extrusions go down, as in CityEngine): face 1; reverse their vertex order to build upwards"
+        ),
+        "{}",
+        warnings[0]
+    );
+    // Kept as they are: the clockwise lot still faces down.
+    let n = cga_geometry::measure::face_normal(&set.lots[1].mesh, 0);
+    assert!(n.y < -0.99, "{n:?}");
 }

@@ -265,8 +265,11 @@ fn face_with_hole() {
         assert!(p.normals.iter().all(|n| *n == [0.0, 1.0, 0.0]));
         assert_eq!(p.min, vec![0.0, 0.0, -4.0]);
         assert_eq!(p.max, vec![4.0, 0.0, 0.0]);
-        // The default material's name.
-        assert_eq!(g.doc.materials().next().unwrap().name(), Some("material"));
+        // The default material (white, unnamed) is named by its colour.
+        assert_eq!(
+            g.doc.materials().next().unwrap().name(),
+            Some("color_ffffff")
+        );
     }
 }
 

@@ -214,11 +214,12 @@ fn textures_with_the_same_file_name_get_distinct_copies() {
         },
     );
     let obj = read_obj(&path);
-    assert_eq!(obj.mtl["material"]["map_Kd"], "wall.png");
-    assert_eq!(obj.mtl["material_2"]["map_Kd"], "wall_2.png");
+    // Unnamed materials are named by their colour map.
+    assert_eq!(obj.mtl["wall"]["map_Kd"], "wall.png");
+    assert_eq!(obj.mtl["wall_2"]["map_Kd"], "wall_2.png");
     assert_eq!(std::fs::read(out.join("wall.png")).unwrap(), b"a");
     assert_eq!(std::fs::read(out.join("wall_2.png")).unwrap(), b"b");
-    assert_eq!(obj.mtl["material_3"]["map_Kd"], "1.png");
+    assert_eq!(obj.mtl["1"]["map_Kd"], "1.png");
     assert_eq!(std::fs::read(out.join("1.png")).unwrap(), b"c");
 }
 

@@ -671,7 +671,10 @@ mod tests {
             let m = grammar["repository"][key]["match"].as_str().unwrap();
             let inner = m.split_once("(?:").unwrap().1;
             let inner = inner.split_once(')').unwrap().0;
-            inner.split('|').map(|w| w.replace("\\\\.", ".").replace("\\.", ".")).collect()
+            inner
+                .split('|')
+                .map(|w| w.replace("\\\\.", ".").replace("\\.", "."))
+                .collect()
         };
         let ops = words("operations");
         let mut names: Vec<&str> = cga::operations::all()
@@ -680,14 +683,24 @@ mod tests {
             .collect();
         names.sort();
         names.dedup();
-        let missing: Vec<&&str> = names.iter().filter(|n| !ops.iter().any(|o| o == *n)).collect();
-        assert!(missing.is_empty(), "operations missing from the grammar: {missing:?}\nall: {}", names.join("|"));
+        let missing: Vec<&&str> = names
+            .iter()
+            .filter(|n| !ops.iter().any(|o| o == *n))
+            .collect();
+        assert!(
+            missing.is_empty(),
+            "operations missing from the grammar: {missing:?}\nall: {}",
+            names.join("|")
+        );
         let functions = words("functions");
         let missing: Vec<&str> = super::FUNCTIONS
             .iter()
             .map(|f| f.name)
             .filter(|n| !n.contains('.') && !functions.iter().any(|o| o == n))
             .collect();
-        assert!(missing.is_empty(), "functions missing from the grammar: {missing:?}");
+        assert!(
+            missing.is_empty(),
+            "functions missing from the grammar: {missing:?}"
+        );
     }
 }

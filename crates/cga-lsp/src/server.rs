@@ -133,6 +133,10 @@ pub struct Server {
     pending: HashMap<PathBuf, Instant>,
     /// Indexes of files read from disk, with the metadata they were read at.
     disk: Mutex<HashMap<PathBuf, DiskEntry>>,
+    /// Paths written in rule files as found, for the request being
+    /// answered (files may come and go between requests): highlighting a
+    /// file with a thousand `imp.X` looks for `imp`'s file once.
+    located: Mutex<HashMap<(PathBuf, String), Option<PathBuf>>>,
 }
 
 impl Server {
@@ -172,6 +176,7 @@ impl Server {
             roots,
             pending: HashMap::new(),
             disk: Mutex::new(HashMap::new()),
+            located: Mutex::new(HashMap::new()),
         }
     }
 
@@ -180,6 +185,7 @@ impl Server {
     }
 
     pub(crate) fn notification(&mut self, note: Notification) {
+        self.forget_located();
         match note.method.as_str() {
             m if m == n::DidOpenTextDocument::METHOD => {
                 let Ok(p) =
@@ -249,6 +255,7 @@ impl Server {
 
     /// Diagnostics of the documents whose time has come.
     fn due_diagnostics(&mut self) -> Vec<(Url, Vec<lsp_types::Diagnostic>, Option<i32>)> {
+        self.forget_located();
         let now = Instant::now();
         let due: Vec<PathBuf> = self
             .pending
@@ -386,7 +393,14 @@ impl Server {
 
     /// The file a path written in `from` names.
     pub fn locate(&self, from: &Path, target: &str) -> Option<PathBuf> {
-        cga::syntax::locate(&*self.world, from, target, &self.workspaces).ok()
+        let key = (from.to_path_buf(), target.to_string());
+        let mut located = self.located.lock().unwrap_or_else(|e| e.into_inner());
+        located
+            .entry(key)
+            .or_insert_with(|| {
+                cga::syntax::locate(&*self.world, from, target, &self.workspaces).ok()
+            })
+            .clone()
     }
 
     /// Every rule file of the workspace: open documents, the `.cga` files
@@ -408,8 +422,17 @@ impl Server {
         files
     }
 
+    /// Forgets where paths led: files may have come or gone since.
+    fn forget_located(&self) {
+        self.located
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clear();
+    }
+
     pub(crate) fn request(&mut self, req: Request) -> Response {
         self.ensure_indexed();
+        self.forget_located();
         let id = req.id.clone();
         let method = req.method.clone();
         match catch_unwind(AssertUnwindSafe(|| {

@@ -112,6 +112,9 @@ pub struct FileIndex {
     pub imports: Vec<Import>,
     /// Spans worth folding: declarations, blocks.
     pub folds: Vec<Range<usize>>,
+    /// Top-level definitions by name (indices into `defs`), so that
+    /// resolving every name of a large file stays linear.
+    by_name: std::collections::HashMap<String, Vec<usize>>,
 }
 
 impl FileIndex {
@@ -124,10 +127,16 @@ impl FileIndex {
             refs: Vec::new(),
             imports: Vec::new(),
             folds: Vec::new(),
+            by_name: Default::default(),
             text,
         };
         for item in &module.items {
             index.item(item);
+        }
+        for (i, d) in index.defs.iter().enumerate() {
+            if d.owner.is_none() {
+                index.by_name.entry(d.name.clone()).or_default().push(i);
+            }
         }
         index
     }
@@ -135,10 +144,11 @@ impl FileIndex {
     /// The top-level definitions called `name` (parameters and locals
     /// excluded).
     pub fn top_level<'a>(&'a self, name: &'a str) -> impl Iterator<Item = (usize, &'a Def)> + 'a {
-        self.defs
-            .iter()
-            .enumerate()
-            .filter(move |(_, d)| d.owner.is_none() && d.name == name)
+        self.by_name
+            .get(name)
+            .into_iter()
+            .flatten()
+            .map(|&i| (i, &self.defs[i]))
     }
 
     /// The definition a reference made in this file names, if it is in
@@ -149,12 +159,13 @@ impl FileIndex {
             return None;
         }
         if let Some(owner) = r.owner {
-            if let Some(i) = self
-                .defs
+            // A declaration's parameters and locals follow it in `defs`.
+            let found = self.defs[owner + 1..]
                 .iter()
-                .position(|d| d.owner == Some(owner) && d.name == r.name)
-            {
-                return Some(i);
+                .take_while(|d| d.owner == Some(owner))
+                .position(|d| d.name == r.name);
+            if let Some(i) = found {
+                return Some(owner + 1 + i);
             }
         }
         let fits = |d: &Def| match r.kind {

@@ -21,6 +21,10 @@ impl LineIndex {
         let offset = offset.min(text.len());
         let line = self.starts.partition_point(|&s| s <= offset) - 1;
         let start = self.starts[line];
+        if let Some(prefix) = text.get(start..offset).filter(|p| p.is_ascii()) {
+            // One UTF-16 unit per byte.
+            return Position::new(line as u32, prefix.len() as u32);
+        }
         let column: usize = text[start..]
             .char_indices()
             .take_while(|(i, _)| start + i < offset)

@@ -206,8 +206,9 @@ impl Server {
                         index: None,
                     },
                 );
-                // A newly opened file is checked at once.
-                self.pending.insert(path, Instant::now());
+                // A newly opened file is checked at once (its text may
+                // differ from the disk's, which importers saw).
+                self.check_soon(path, Instant::now());
             }
             m if m == n::DidChangeTextDocument::METHOD => {
                 let Ok(p) =
@@ -227,15 +228,7 @@ impl Server {
                 doc.version = p.text_document.version;
                 doc.index = None;
                 self.world.set(&path, doc.text.clone());
-                self.pending.insert(path.clone(), Instant::now() + DEBOUNCE);
-                // Files importing this one may change too.
-                let others: Vec<PathBuf> =
-                    self.docs.keys().filter(|k| **k != path).cloned().collect();
-                for other in others {
-                    if self.imports_of(&other).contains(&path) {
-                        self.pending.insert(other, Instant::now() + DEBOUNCE);
-                    }
-                }
+                self.check_soon(path, Instant::now() + DEBOUNCE);
             }
             m if m == n::DidCloseTextDocument::METHOD => {
                 let Ok(p) =
@@ -251,6 +244,18 @@ impl Server {
             }
             _ => {}
         }
+    }
+
+    /// Diagnostics of `path` due at `when`, and of the open documents
+    /// that import it (their problems may change with it).
+    fn check_soon(&mut self, path: PathBuf, when: Instant) {
+        let others: Vec<PathBuf> = self.docs.keys().filter(|k| **k != path).cloned().collect();
+        for other in others {
+            if self.imports_of(&other).contains(&path) {
+                self.pending.insert(other, when);
+            }
+        }
+        self.pending.insert(path, when);
     }
 
     /// Diagnostics of the documents whose time has come.

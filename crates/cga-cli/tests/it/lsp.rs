@@ -563,6 +563,33 @@ fn an_editor_session_over_stdio() {
         json!([{"range": range((0, 0), (2, 0)), "newText": "Lot -->\n    extrude(1)\n"}])
     );
 
+    // A problem in an imported file shows on the import that leads there.
+    let broken_facade = FACADE.replace("color(\"#ffffff\")", "colr(1)");
+    c.notify(
+        "textDocument/didOpen",
+        json!({"textDocument": {"uri": facade, "languageId": "cga", "version": 1, "text": broken_facade}}),
+    );
+    let own = c.diagnostics(&facade);
+    assert_eq!(own.len(), 1, "{own:?}");
+    assert_eq!(own[0]["range"], range((4, 10), (4, 14)));
+    let message = own[0]["message"].as_str().unwrap().to_string();
+    let importer = c.diagnostics(&main);
+    let shown: Vec<&Value> = importer
+        .iter()
+        .filter(|d| {
+            d["message"]
+                .as_str()
+                .unwrap()
+                .starts_with("in facade.cga:5:11: ")
+        })
+        .collect();
+    assert_eq!(shown.len(), 1, "{importer:?}");
+    assert_eq!(
+        shown[0]["message"],
+        format!("in facade.cga:5:11: {message}")
+    );
+    assert_eq!(shown[0]["range"], range((0, 0), (0, 36)));
+
     // Unknown methods are answered with an error, not a crash.
     let r = c.request_raw("textDocument/unknownThing", json!({}));
     assert_eq!(r["error"]["code"], -32601);

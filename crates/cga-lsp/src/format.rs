@@ -211,6 +211,63 @@ mod tests {
         );
     }
 
+    /// Over every rule file of `../shared/corpus` that loads without
+    /// errors: the formatted file, loaded in its place (its imports and
+    /// assets found as before), generates the same model on the default
+    /// lot: the same meshes (positions, normals, UVs, indices, materials),
+    /// prints, reports and error. Lots are capped (shapes, time) to keep
+    /// the test short; both runs stop at the same cap.
+    #[test]
+    fn formatted_corpus_files_generate_the_same_models() {
+        use std::sync::Arc;
+        let Some(corpus) = cga_testkit::shared("corpus/workspace") else {
+            return;
+        };
+        let mut files = Vec::new();
+        crate::robust::cga_files(&corpus, &mut files);
+        let options = cga::Options::default().jobs(1).limits(cga::Limits {
+            max_shapes: 20_000,
+            max_seconds: 20.0,
+            ..Default::default()
+        });
+        let lot = cga::lots::rect(20.0, 30.0);
+        let (mut compared, mut with_geometry) = (0, 0);
+        for path in &files {
+            let disk = cga::Engine::on_disk();
+            let original = disk.load(path);
+            if original.has_errors() {
+                continue;
+            }
+            let text = cga::decode_text(&std::fs::read(path).unwrap());
+            let formatted = format(&text);
+            let world = Arc::new(cga::MemoryWorld::over(Arc::new(cga::DiskWorld)));
+            world.set(path, formatted.clone());
+            let ours = cga::Engine::with_world(world).load(path);
+            let name = path.display();
+            assert!(!ours.has_errors(), "{name}: {}", ours.render_diagnostics());
+            let a = original.generate(&lot, &options).map_err(|e| e.to_string());
+            let b = ours.generate(&lot, &options).map_err(|e| e.to_string());
+            match (a, b) {
+                (Ok(a), Ok(b)) => {
+                    with_geometry += usize::from(!a.model.meshes.is_empty());
+                    assert!(a.model == b.model, "{name}: another model");
+                    assert_eq!(a.prints, b.prints, "{name}");
+                    assert_eq!(a.reports, b.reports, "{name}");
+                    assert_eq!(
+                        a.error.map(|e| e.message),
+                        b.error.map(|e| e.message),
+                        "{name}"
+                    );
+                }
+                (a, b) => assert_eq!(a.err(), b.err(), "{name}"),
+            }
+            compared += 1;
+        }
+        println!("{compared} files compared, {with_geometry} with geometry");
+        assert!(compared >= 20, "{compared} files loaded without errors");
+        assert!(with_geometry >= 10, "{with_geometry} files made geometry");
+    }
+
     #[test]
     fn indents_by_brackets_and_declarations() {
         let text = "\n\n// A rule.\n@StartRule\nLot -->   \n  extrude(10)\n\t comp(f) {\n top : Roof\n| side :\n split(y) { 3 : Floor }*\n      }\n\n\n\nRoof --> X.";

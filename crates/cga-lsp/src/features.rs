@@ -551,6 +551,16 @@ fn completion(s: &Server, p: CompletionParams) -> Option<CompletionResponse> {
             for d in index.defs.iter().filter(|d| d.kind == DefKind::Attr) {
                 items.push(def_item(d, &d.name));
             }
+            // The attributes of imports, by their prefix (`set(fac.height, 3)`).
+            for import in &index.imports {
+                let Some(alias) = &import.alias else { continue };
+                let Some(imported) = s.locate(&path, &import.path).and_then(|t| s.index(&t)) else {
+                    continue;
+                };
+                for d in imported.defs.iter().filter(|d| d.kind == DefKind::Attr) {
+                    items.push(def_item(d, &format!("{alias}.{}", d.name)));
+                }
+            }
             for (name, what) in builtins::SHAPE_ATTRIBUTES {
                 if !name.starts_with("split.") && !name.starts_with("comp.") {
                     items.push(simple(name, CompletionItemKind::PROPERTY, what));

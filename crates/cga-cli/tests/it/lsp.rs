@@ -361,7 +361,11 @@ fn an_editor_session_over_stdio() {
     );
     let l = labels(&items);
     assert!(
-        l.starts_with(&["height".to_string(), "depth".to_string()]),
+        l.starts_with(&[
+            "height".to_string(),
+            "depth".to_string(),
+            "fac.floorHeight".to_string()
+        ]),
         "{l:?}"
     );
     assert!(l.contains(&"material.color.rgb".to_string()));

@@ -261,6 +261,8 @@ impl Server {
     /// Diagnostics of the documents whose time has come.
     fn due_diagnostics(&mut self) -> Vec<(Url, Vec<lsp_types::Diagnostic>, Option<i32>)> {
         self.forget_located();
+        // Index the changed documents once, here, for the requests to come.
+        self.ensure_indexed();
         let now = Instant::now();
         let due: Vec<PathBuf> = self
             .pending
@@ -376,7 +378,7 @@ impl Server {
     }
 
     /// Indexes open documents whose index is stale.
-    fn ensure_indexed(&mut self) {
+    pub(crate) fn ensure_indexed(&mut self) {
         for doc in self.docs.values_mut() {
             if doc.index.is_none() {
                 doc.index = Some(Arc::new(FileIndex::new(doc.text.clone())));

@@ -393,6 +393,11 @@ pub(crate) struct GltfWriter {
     /// lot's data is written out when the next begins.
     per_lot: bool,
     lots: Vec<LotNode>,
+    /// How many lots the model will have, if known (see
+    /// `estimated_json_room`).
+    lots_hint: Option<usize>,
+    /// GLB: where the binary data written early starts.
+    json_room: u64,
 }
 
 /// A lot's node: its name and `extras`, and the first of its primitives in
@@ -464,7 +469,14 @@ impl GltfWriter {
             bin_out: None,
             per_lot,
             lots: Vec::new(),
+            lots_hint: None,
+            json_room: GLB_JSON_ROOM,
         }
+    }
+
+    /// Says how many lots the model will have.
+    pub(crate) fn expect_lots(&mut self, lots: usize) {
+        self.lots_hint = Some(lots);
     }
 
     /// Starts a lot's node (see [`LotNode`]): what is held of the lot
@@ -555,13 +567,43 @@ impl GltfWriter {
         self.held += bytes;
     }
 
+    /// The room to leave for a GLB's header and JSON when data is first
+    /// written early. With a node per lot and the number of lots known,
+    /// the JSON grows with the lots: room for as many lots as the first,
+    /// with a quarter more, so that the binary data seldom has to be moved
+    /// up at the end (spaces pad what is left).
+    fn estimated_json_room(&self) -> u64 {
+        // Compact JSON of a primitive with its accessors and buffer views,
+        // and of a lot's node and mesh, in bytes (measured on the example
+        // city: about 2,500 bytes for a lot of four primitives).
+        const PER_PRIMITIVE: u64 = 700;
+        const PER_LOT: u64 = 200;
+        let (Some(lots), true) = (self.lots_hint, self.per_lot) else {
+            return GLB_JSON_ROOM;
+        };
+        let primitives = self
+            .buckets
+            .iter()
+            .filter(|b| !b.indices.is_empty())
+            .count() as u64;
+        let extras = self
+            .lots
+            .last()
+            .and_then(|l| l.extras.as_ref())
+            .map_or(0, |e| e.to_string().len() as u64);
+        let per_lot = primitives * PER_PRIMITIVE + PER_LOT + extras;
+        let room = (lots as u64).saturating_mul(per_lot) / 4 * 5;
+        room.clamp(GLB_JSON_ROOM, 256 << 20) / 4 * 4
+    }
+
     /// Writes every bucket's data as a primitive and empties the buckets.
     fn flush(&mut self) -> Result<(), ExportError> {
         let path = self.path.clone();
         let io = |e| ExportError::io(&path, e);
         let out: &mut dyn Write = if self.binary {
             if self.written_bytes == 0 {
-                self.out.seek(SeekFrom::Start(GLB_JSON_ROOM)).map_err(io)?;
+                self.json_room = self.estimated_json_room();
+                self.out.seek(SeekFrom::Start(self.json_room)).map_err(io)?;
             }
             &mut self.out
         } else {
@@ -816,7 +858,7 @@ impl GltfWriter {
         out.flush().map_err(io)
     }
 
-    /// GLB whose binary data was partly written early, from `GLB_JSON_ROOM` on:
+    /// GLB whose binary data was partly written early, from `json_room` on:
     /// the rest of it follows, then the header and the JSON (padded with
     /// spaces to the room, or, if it does not fit, with the binary data
     /// moved up to make room) go before it.
@@ -833,11 +875,12 @@ impl GltfWriter {
         self.out.flush().map_err(io)?;
         // Header (12), JSON chunk header (8), JSON, BIN chunk header (8).
         let head = 12 + 8 + json.len() as u64 + 8;
-        let start = if head <= GLB_JSON_ROOM {
-            GLB_JSON_ROOM
+        let room = self.json_room;
+        let start = if head <= room {
+            room
         } else {
             let file = self.out.get_mut();
-            move_up(&mut **file, GLB_JSON_ROOM, bin_len, head - GLB_JSON_ROOM).map_err(io)?;
+            move_up(&mut **file, room, bin_len, head - room).map_err(io)?;
             head
         };
         json.resize((start - 28) as usize, b' ');

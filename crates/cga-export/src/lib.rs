@@ -466,6 +466,15 @@ impl ModelWriter {
         }
     }
 
+    /// Says how many lots will be begun ([`begin_lot`](Self::begin_lot)):
+    /// a GLB with a node per lot then leaves room for their JSON at the
+    /// start, instead of moving its binary data up at the end.
+    pub fn expect_lots(&mut self, lots: usize) {
+        if let Sink::Gltf(w, _) = &mut self.sink {
+            w.expect_lots(lots);
+        }
+    }
+
     /// Starts the output of a lot: what is added from now on belongs to it.
     /// With [`Granularity::Lot`] it is a glTF node named `name` with
     /// `extras` (for instance its index and attributes), or an OBJ group;

@@ -115,8 +115,11 @@ impl Rules {
             lots: lots.len(),
             ..Summary::default()
         };
-        // The lot whose output was begun last (OBJ groups per lot).
+        // The lot whose output was begun last (a node or group per lot).
         let mut begun: Option<usize> = None;
+        if let Some(w) = writer.as_deref_mut() {
+            w.expect_lots(lots.len());
+        }
         let mut take = |i: usize, taken: Taken<Piece, Done>| -> Result<(), Error> {
             if begun != Some(i) {
                 begun = Some(i);

@@ -494,6 +494,7 @@ fn a_node_per_lot_or_a_mesh_per_material() {
             ..ExportOptions::default()
         };
         let mut w = ModelWriter::create(&path, Format::from_path(&path).unwrap(), options).unwrap();
+        w.expect_lots(3);
         w.begin_lot("a", Some(json!({"lot": 0, "attributes": {"height": 12.5}})))
             .unwrap();
         for m in &lot_a {

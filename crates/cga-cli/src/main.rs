@@ -168,6 +168,13 @@ struct GenerateArgs {
     /// memory; more is fewer primitives per material).
     #[arg(long, value_name = "MIB", default_value_t = cga::DEFAULT_FLUSH_MIB)]
     held_mib: usize,
+    /// How lots are kept apart in the model: `lot` (a glTF node per lot,
+    /// named by it, its index and attributes in `extras`; an OBJ group per
+    /// lot) or `material` (everything merged by material). Default: `lot`
+    /// up to 10,000 lots, `material` above, where a node per lot makes the
+    /// glTF JSON large.
+    #[arg(long, value_name = "lot|material")]
+    granularity: Option<cga::Granularity>,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -207,6 +214,9 @@ impl From<Error> for Failure {
 /// stack where it needs to, but the first frames of a deep parse are
 /// cheaper on a thread that starts with room.
 const MAIN_STACK: usize = 64 << 20;
+
+/// Lots up to which a model gets a node (group) per lot by default.
+const NODES_PER_LOT_UP_TO: usize = 10_000;
 
 fn main() -> ExitCode {
     keep_freed_memory();
@@ -305,12 +315,14 @@ fn check(
             return Err(Failure::Reported);
         }
         let size = rules.size();
+        let count =
+            |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
         eprintln!(
-            "{}: ok ({} rules, {} attributes, {} functions)",
+            "{}: ok ({}, {}, {})",
             path.display(),
-            size.rules,
-            size.attributes,
-            size.functions
+            count(size.rules, "rule", "rules"),
+            count(size.attributes, "attribute", "attributes"),
+            count(size.functions, "function or const", "functions and consts")
         );
         eprintln!("styles: {}", rules.styles().join(", "));
         eprintln!("start rules: {}", rules.start_rules().join(", "));
@@ -417,6 +429,17 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
                     projection: o.proj_string(),
                 }),
                 flush_mib: args.held_mib,
+                granularity: args.granularity.unwrap_or_else(|| {
+                    if lots.lots.len() > NODES_PER_LOT_UP_TO {
+                        eprintln!(
+                            "note: {} lots: the model is merged by material (--granularity lot for a node per lot)",
+                            lots.lots.len()
+                        );
+                        cga::Granularity::Material
+                    } else {
+                        cga::Granularity::Lot
+                    }
+                }),
                 ..rules.export_options()
             };
             Some(

@@ -1032,6 +1032,29 @@ fn rename(s: &Server, p: RenameParams) -> Result<Option<WorkspaceEdit>, Failure>
                 .into(),
         ));
     };
+    // A name the declaration's file already defines (a rule for a rule,
+    // a value for a value) would merge two definitions.
+    let d = found.def();
+    let clash = match d.kind {
+        DefKind::Param | DefKind::Local => found
+            .index
+            .defs
+            .iter()
+            .any(|o| o.owner == d.owner && o.name == new),
+        DefKind::Import => found.index.import_named(new).is_some(),
+        kind => found.index.top_level(new).any(|(_, o)| {
+            (o.kind == DefKind::Rule) == (kind == DefKind::Rule) && o.kind != DefKind::Import
+        }),
+    };
+    if clash && new != d.name {
+        let file = found
+            .path
+            .file_name()
+            .map_or(String::new(), |n| n.to_string_lossy().into_owned());
+        return Err(Failure::Refused(format!(
+            "`{new}` is already defined in {file}"
+        )));
+    }
     let mut changes: HashMap<Url, Vec<TextEdit>> = HashMap::new();
     for (file, index, span) in uses(s, &found, true) {
         let Some(u) = url(&file) else { continue };

@@ -332,6 +332,14 @@ fn an_editor_session_over_stdio() {
             .contains("not a CGA name"),
         "{r}"
     );
+    let r = c.request_raw(
+        "textDocument/rename",
+        json!({"textDocument": {"uri": main}, "position": pos(MAIN, "attr depth", 0, 6), "newName": "height"}),
+    );
+    assert_eq!(
+        r["error"]["message"], "`height` is already defined in main.cga",
+        "{r}"
+    );
 
     // Completion: selectors in a comp block, names of an import, attributes
     // in set(), operations with snippets, file paths.

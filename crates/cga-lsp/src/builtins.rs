@@ -633,6 +633,19 @@ pub const OTHER_SELECTORS: &[&str] = &[
     "edges",
 ];
 
+/// Whether `word` is a selector keyword of some operation.
+pub fn is_selector(word: &str) -> bool {
+    [
+        COMP_SELECTORS,
+        COMP_TYPES,
+        SPLIT_AXES,
+        SETBACK_SELECTORS,
+        OTHER_SELECTORS,
+    ]
+    .iter()
+    .any(|list| list.contains(&word))
+}
+
 /// Keywords of the language.
 pub const KEYWORDS: &[&str] = &[
     "attr",

@@ -167,6 +167,8 @@ enum Target {
     ShapeAttr(&'static str, &'static str),
     /// A file named by an import's path.
     File(PathBuf),
+    /// A selector keyword (`front`, `y`, `world.up`, `f`).
+    Selector(String),
 }
 
 /// The target at `offset` and the span of what names it.
@@ -218,7 +220,10 @@ fn target_at(
                     .iter()
                     .find(|(n, _)| *n == r.name)
                     .map(|(n, d)| Target::ShapeAttr(n, d))
-                    .or_else(|| builtins::function(&r.name).map(Target::Function)),
+                    .or_else(|| builtins::function(&r.name).map(Target::Function))
+                    .or_else(|| {
+                        builtins::is_selector(&r.name).then(|| Target::Selector(r.name.clone()))
+                    }),
                 RefKind::Leaf => None,
             };
             builtin.map(|t| (t, r.span.clone()))
@@ -237,6 +242,7 @@ fn hover(s: &Server, p: HoverParams) -> Option<Hover> {
         Target::Function(f) => describe_function(f),
         Target::ShapeAttr(name, what) => format!("```cga\n{name}\n```\nShape attribute. {what}"),
         Target::File(file) => format!("`{}`", file.display()),
+        Target::Selector(word) => format!("```cga\n{word}\n```\nselector keyword"),
     };
     Some(Hover {
         contents: HoverContents::Markup(MarkupContent {

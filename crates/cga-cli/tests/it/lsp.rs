@@ -239,6 +239,13 @@ fn an_editor_session_over_stdio() {
         .unwrap()
         .contains("twice(x) = x * k"));
 
+    // A selector keyword.
+    let h = c.request("textDocument/hover", at(&main, MAIN, "side :", 0, 1));
+    assert_eq!(
+        h["contents"]["value"],
+        "```cga\nside\n```\nselector keyword"
+    );
+
     // Definition: across the import, and of a parameter.
     let d = c.request(
         "textDocument/definition",

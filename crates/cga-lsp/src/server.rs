@@ -52,7 +52,8 @@ pub fn run(connection: Connection, workspaces: &[PathBuf]) -> Result<(), Error> 
 
 fn serve(connection: &Connection, workspaces: &[PathBuf]) -> Result<(), Error> {
     let (id, params) = connection.initialize_start()?;
-    let init: lsp_types::InitializeParams = serde_json::from_value(params)?;
+    // A client that leaves out required fields still gets a server.
+    let init: lsp_types::InitializeParams = serde_json::from_value(params).unwrap_or_default();
     let mut server = Server::new(&init, workspaces);
     let result = lsp_types::InitializeResult {
         capabilities: crate::features::capabilities(),

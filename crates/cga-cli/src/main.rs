@@ -4,6 +4,7 @@
 //! cga generate RULES.cga [--lot SPEC]... [--start-rule NAME] [--attr NAME=VALUE]...
 //!                        [--seed N] [-o OUT.glb|OUT.gltf|OUT.obj] [--report OUT.json]
 //! cga check RULES.cga
+//! cga serve RULES.cga [--lot SPEC]... [--port N] [--host H]
 //! ```
 //!
 //! Standard output carries only the lines of `print()`, in derivation order.
@@ -85,6 +86,29 @@ enum Command {
         /// and exit with status 1 if there are any.
         #[arg(long)]
         check: bool,
+    },
+    /// Live preview in the browser: serves a page that shows the model,
+    /// regenerates when a file of the workspace changes or an attribute
+    /// is moved.
+    Serve {
+        /// The rule file.
+        rules: PathBuf,
+        /// A lot, as for `generate`; repeatable. Default: `rect:20,30`.
+        #[arg(long = "lot", value_name = "SPEC")]
+        lots: Vec<String>,
+        /// The port to listen on (0: any free port).
+        #[arg(long, default_value_t = cga_serve::DEFAULT_PORT)]
+        port: u16,
+        /// The address to listen on; only this machine by default.
+        #[arg(long, default_value = "127.0.0.1")]
+        host: String,
+        /// Further folders the rules may read (as for `generate`).
+        #[arg(long = "workspace", value_name = "DIR")]
+        workspaces: Vec<PathBuf>,
+        /// Maximum time per lot, in seconds: a runaway rule is stopped and
+        /// reported, and the preview goes on.
+        #[arg(long, default_value_t = cga_serve::DEFAULT_MAX_SECONDS)]
+        max_seconds: f64,
     },
     /// Language server for editors, on standard input and output.
     Lsp {
@@ -232,6 +256,22 @@ fn main() -> ExitCode {
                 workspaces,
             } => check(&rules, format, style.as_deref(), &workspaces),
             Command::Fmt { files, check } => fmt(&files, check),
+            Command::Serve {
+                rules,
+                lots,
+                port,
+                host,
+                workspaces,
+                max_seconds,
+            } => {
+                let mut config = cga_serve::Config::new(rules);
+                config.lots = lots;
+                config.port = port;
+                config.host = host;
+                config.workspaces = workspaces;
+                config.limits.max_seconds = max_seconds;
+                cga_serve::run(config).map_err(Failure::Error)
+            }
             Command::Lsp { workspaces, .. } => {
                 cga_lsp::run_stdio(&workspaces).map_err(|e| Failure::Error(e.to_string()))
             }

@@ -1,0 +1,526 @@
+//! Loading and generating on a thread of its own, with the newest request
+//! winning: a change cancels the generation it makes obsolete.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Condvar, Mutex, RwLock};
+use std::time::Instant;
+
+use cga::{Cancel, ConfinedWorld, DiskWorld, Engine, Error, Lot, LotResult, Options, Rules};
+use serde_json::{json, Value as Json};
+
+use crate::encode;
+
+/// What the page asked for.
+#[derive(Clone, Debug, Default)]
+pub struct Params {
+    pub seed: u64,
+    /// Attribute values by name, as the page sent them.
+    pub attrs: BTreeMap<String, Json>,
+}
+
+/// What the page shows, as of one generation.
+pub struct Snapshot {
+    /// Grows with every published change.
+    pub version: u64,
+    /// The state as JSON (`/api/state`, the `state` event).
+    pub state: Arc<String>,
+    /// The last good model (binary, see [`encode`]) and its number.
+    pub model: Arc<Vec<u8>>,
+    pub model_version: u64,
+    /// What made the model: for provenance and the GLB download.
+    pub made_by: Option<Made>,
+}
+
+#[derive(Clone)]
+pub struct Made {
+    pub rules: Rules,
+    pub results: Arc<Vec<LotResult>>,
+    pub options: Options,
+}
+
+pub(crate) struct Request {
+    params: Params,
+    /// Something needs doing.
+    dirty: bool,
+    /// Reload the rules (a file changed).
+    reload: bool,
+    stop: bool,
+}
+
+/// The preview's engine, rules and lots, and the thread that generates.
+pub struct Preview {
+    pub engine: Engine,
+    pub rules_path: PathBuf,
+    /// The folders the rules (and requests) may read.
+    pub roots: Vec<PathBuf>,
+    pub lots: Vec<Lot>,
+    /// The lots' own outlines as meshes (binary, see [`encode`]).
+    pub lots_model: Arc<Vec<u8>>,
+    limits: cga::Limits,
+    request: Mutex<Request>,
+    wake: Condvar,
+    running: Mutex<Option<Cancel>>,
+    published: RwLock<Arc<Snapshot>>,
+    events: tokio::sync::watch::Sender<u64>,
+    watcher: Mutex<Option<notify::RecommendedWatcher>>,
+    lot_notes: Vec<String>,
+}
+
+/// The folder a rule file's project is: the parent of a `rules` folder
+/// (a CityEngine project holds `rules/` and `assets/` side by side), else
+/// the rule file's own folder.
+pub fn workspace_of(rules: &Path) -> PathBuf {
+    let dir = rules.parent().unwrap_or(Path::new(".")).to_path_buf();
+    if dir.file_name().is_some_and(|n| n == "rules") {
+        if let Some(project) = dir.parent() {
+            return project.to_path_buf();
+        }
+    }
+    dir
+}
+
+impl Preview {
+    pub fn start(config: &crate::Config) -> Result<Arc<Preview>, String> {
+        let rules_path = config
+            .rules
+            .canonicalize()
+            .map_err(|e| format!("{}: {e}", config.rules.display()))?;
+        let mut roots = vec![workspace_of(&rules_path)];
+        for w in &config.workspaces {
+            roots.push(
+                w.canonicalize()
+                    .map_err(|e| format!("{}: {e}", w.display()))?,
+            );
+        }
+        let world = ConfinedWorld::new(Arc::new(DiskWorld), roots.clone());
+        let engine = Engine::new(world);
+        // Lot files are read from disk: the user named them.
+        let lot_set = cga::lots::read(&config.lots).map_err(|e| e.to_string())?;
+        let lots = lot_set.lots;
+        let lots_model = Arc::new(lot_outlines(&engine, &roots[0], &lots));
+        let (events, _) = tokio::sync::watch::channel(0);
+        let empty = Snapshot {
+            version: 0,
+            state: Arc::new("{}".to_string()),
+            model: Arc::new(encode::model(&[])),
+            model_version: 0,
+            made_by: None,
+        };
+        let preview = Arc::new(Preview {
+            engine,
+            rules_path,
+            roots,
+            lots,
+            lots_model,
+            limits: config.limits,
+            request: Mutex::new(Request {
+                params: Params::default(),
+                dirty: true,
+                reload: true,
+                stop: false,
+            }),
+            wake: Condvar::new(),
+            running: Mutex::new(None),
+            published: RwLock::new(Arc::new(empty)),
+            events,
+            watcher: Mutex::new(None),
+            lot_notes: lot_set.warnings,
+        });
+        let worker = preview.clone();
+        std::thread::Builder::new()
+            .name("cga-serve-generate".into())
+            .spawn(move || worker.work())
+            .map_err(|e| format!("cannot start generating: {e}"))?;
+        preview.watch();
+        // The first state before anyone asks.
+        preview.wait_for_version(1, std::time::Duration::from_secs(600));
+        Ok(preview)
+    }
+
+    /// Watches the workspace folders: any change reloads.
+    fn watch(self: &Arc<Self>) {
+        use notify::{EventKind, RecursiveMode, Watcher};
+        let weak = Arc::downgrade(self);
+        let handler = move |event: notify::Result<notify::Event>| {
+            let Ok(event) = event else { return };
+            if matches!(event.kind, EventKind::Access(_) | EventKind::Other) {
+                return;
+            }
+            if let Some(p) = weak.upgrade() {
+                p.request(|r| r.reload = true);
+            }
+        };
+        match notify::recommended_watcher(handler) {
+            Ok(mut watcher) => {
+                for root in &self.roots {
+                    if let Err(e) = watcher.watch(root, RecursiveMode::Recursive) {
+                        eprintln!("warning: cannot watch {}: {e}", root.display());
+                    }
+                }
+                *self.watcher.lock().unwrap() = Some(watcher);
+            }
+            Err(e) => eprintln!("warning: cannot watch files for changes: {e}"),
+        }
+    }
+
+    /// Asks for a new generation (after `change`), cancelling the running
+    /// one, which the change makes obsolete.
+    pub(crate) fn request(&self, change: impl FnOnce(&mut Request)) {
+        {
+            let mut r = self.request.lock().unwrap();
+            change(&mut r);
+            r.dirty = true;
+        }
+        self.wake.notify_all();
+        if let Some(cancel) = self.running.lock().unwrap().take() {
+            cancel.cancel();
+        }
+    }
+
+    /// New values from the page.
+    pub fn set_params(&self, params: Params) {
+        self.request(|r| r.params = params);
+    }
+
+    pub fn params(&self) -> Params {
+        self.request.lock().unwrap().params.clone()
+    }
+
+    pub fn stop(&self) {
+        self.request(|r| r.stop = true);
+        *self.watcher.lock().unwrap() = None;
+    }
+
+    pub fn snapshot(&self) -> Arc<Snapshot> {
+        self.published.read().unwrap().clone()
+    }
+
+    pub fn subscribe(&self) -> tokio::sync::watch::Receiver<u64> {
+        self.events.subscribe()
+    }
+
+    /// Blocks until a state of at least `version` is published (tests,
+    /// start-up).
+    pub fn wait_for_version(&self, version: u64, timeout: std::time::Duration) -> bool {
+        let end = Instant::now() + timeout;
+        while Instant::now() < end {
+            if self.snapshot().version >= version {
+                return true;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        false
+    }
+
+    fn work(self: Arc<Self>) {
+        let mut rules: Option<Rules> = None;
+        let mut load_ms = 0.0;
+        loop {
+            let (params, reload) = {
+                let mut r = self.request.lock().unwrap();
+                while !r.dirty && !r.stop {
+                    r = self.wake.wait(r).unwrap();
+                }
+                if r.stop {
+                    return;
+                }
+                r.dirty = false;
+                (r.params.clone(), std::mem::take(&mut r.reload))
+            };
+            if reload || rules.is_none() {
+                let t = Instant::now();
+                rules = Some(self.engine.load(&self.rules_path));
+                load_ms = t.elapsed().as_secs_f64() * 1e3;
+            }
+            let rules = rules.clone().expect("loaded above");
+            self.generate(&rules, &params, load_ms);
+        }
+    }
+
+    /// One generation, published unless a newer request cancelled it.
+    fn generate(&self, rules: &Rules, params: &Params, load_ms: f64) {
+        let mut problems: Vec<Json> = rules
+            .diagnostics()
+            .iter()
+            .map(|d| self.diagnostic(d, None))
+            .collect();
+        for w in &self.lot_notes {
+            problems.push(json!({"severity": "warning", "message": w}));
+        }
+        let previous = self.snapshot();
+        if rules.has_errors() {
+            self.publish(rules, params, problems, None, load_ms, 0.0, &previous);
+            return;
+        }
+        let cancel = Cancel::new();
+        *self.running.lock().unwrap() = Some(cancel.clone());
+        let mut options = Options::default()
+            .seed(params.seed)
+            .limits(self.limits)
+            .cancel(cancel);
+        for (name, v) in &params.attrs {
+            // Values of attributes an edit removed, or that do not fit
+            // the attribute's type, are left out.
+            if let Some(attr) = rules.attribute(name) {
+                if let Some(value) = encode::attr_value(attr.ty, v) {
+                    options = options.attr(name.clone(), value);
+                }
+            }
+        }
+        let t = Instant::now();
+        let outcome = rules.generate_all(&self.lots, &options);
+        let gen_ms = t.elapsed().as_secs_f64() * 1e3;
+        self.running.lock().unwrap().take();
+        match outcome {
+            Ok(results) => {
+                for lot in &results {
+                    for w in &lot.warnings {
+                        problems.push(self.diagnostic(w, Some(&lot.name)));
+                    }
+                    if let Some(e) = &lot.error {
+                        problems.push(self.diagnostic(e, Some(&lot.name)));
+                    }
+                }
+                // A later download regenerates with these values; it must
+                // not be stopped by this generation's switch.
+                options.cancel = None;
+                let made = Made {
+                    rules: rules.clone(),
+                    results: Arc::new(results),
+                    options,
+                };
+                self.publish(
+                    rules,
+                    params,
+                    problems,
+                    Some(made),
+                    load_ms,
+                    gen_ms,
+                    &previous,
+                );
+            }
+            // A newer request is waiting: it will publish.
+            Err(Error::Cancelled) => {}
+            Err(e) => {
+                problems.push(json!({"severity": "error", "message": e.to_string()}));
+                self.publish(rules, params, problems, None, load_ms, gen_ms, &previous);
+            }
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn publish(
+        &self,
+        rules: &Rules,
+        params: &Params,
+        problems: Vec<Json>,
+        made: Option<Made>,
+        load_ms: f64,
+        gen_ms: f64,
+        previous: &Snapshot,
+    ) {
+        let version = previous.version + 1;
+        let fresh = made.is_some();
+        let (model, model_version, made_by) = match made {
+            Some(m) => (Arc::new(encode::model(&m.results)), version, Some(m)),
+            None => (
+                previous.model.clone(),
+                previous.model_version,
+                previous.made_by.clone(),
+            ),
+        };
+        let results: &[LotResult] = made_by.as_ref().map(|m| &m.results[..]).unwrap_or(&[]);
+        let mut prints = Vec::new();
+        let mut reports = Vec::new();
+        for lot in results {
+            for p in &lot.prints {
+                prints.push(json!({"lot": lot.name, "text": p}));
+            }
+            for (k, v) in &lot.reports {
+                reports.push(json!({"lot": lot.name, "key": k, "value": encode::value(v)}));
+            }
+        }
+        let stats = json!({
+            "lots": results.len(),
+            "failed": results.iter().filter(|l| l.error.is_some()).count(),
+            "shapes": results.iter().map(|l| l.shapes).sum::<usize>(),
+            "leaves": results.iter().map(|l| l.leaf_count).sum::<usize>(),
+            "faces": results.iter().map(|l| l.model.faces).sum::<u64>(),
+            "triangles": results.iter().map(|l| l.model.triangles()).sum::<usize>(),
+            "load_ms": load_ms,
+            "generate_ms": gen_ms,
+        });
+        let state = json!({
+            "version": version,
+            "rules": self.display_path(rules.path()),
+            "model_version": model_version,
+            // The model shown is not of the current text (it has errors).
+            "stale": !fresh,
+            "has_errors": rules.has_errors(),
+            "seed": params.seed,
+            "values": params.attrs,
+            "attributes": self.attributes(rules),
+            "problems": problems,
+            "prints": prints,
+            "reports": reports,
+            "stats": stats,
+            "lots": results.iter().map(|l| json!({"name": l.name, "error": l.error.is_some()})).collect::<Vec<_>>(),
+        });
+        let snapshot = Snapshot {
+            version,
+            state: Arc::new(state.to_string()),
+            model,
+            model_version,
+            made_by,
+        };
+        *self.published.write().unwrap() = Arc::new(snapshot);
+        self.events.send_replace(version);
+    }
+
+    fn attributes(&self, rules: &Rules) -> Vec<Json> {
+        rules
+            .attributes()
+            .iter()
+            .map(|a| {
+                let range = a.range().map(|r| json!({"min": r.min, "max": r.max, "step": r.step}));
+                let files = a.file_extensions().map(|ext| self.files_with(&ext));
+                json!({
+                    "name": a.name,
+                    "type": a.ty.map(|t| format!("{t:?}").to_lowercase()),
+                    "default": a.default.as_ref().map(encode::value),
+                    "range": range,
+                    "enum": a.enum_values().map(|vs| vs.iter().map(encode::value).collect::<Vec<_>>()),
+                    "color": a.is_color(),
+                    "group": a.group().map(|(g, o)| json!({"name": g, "order": o})),
+                    "order": a.order(),
+                    "hidden": a.is_hidden(),
+                    "description": a.description().or_else(|| a.doc.clone()),
+                    "files": files,
+                    "line": a.location.as_ref().map(|l| l.line),
+                })
+            })
+            .collect()
+    }
+
+    /// Workspace files with one of the extensions (for `@File`), as paths
+    /// relative to the rule file's folder, at most a few thousand.
+    fn files_with(&self, extensions: &[String]) -> Vec<String> {
+        let base = self.rules_path.parent().unwrap_or(Path::new("/"));
+        let mut out = Vec::new();
+        let mut stack = vec![self.roots[0].clone()];
+        let mut seen = 0;
+        while let Some(dir) = stack.pop() {
+            let Ok(entries) = std::fs::read_dir(&dir) else {
+                continue;
+            };
+            for e in entries.flatten() {
+                seen += 1;
+                if seen > 20_000 || out.len() >= 2_000 {
+                    return out;
+                }
+                let path = e.path();
+                let Ok(ft) = e.file_type() else { continue };
+                if ft.is_dir() {
+                    if !e.file_name().to_string_lossy().starts_with('.') {
+                        stack.push(path);
+                    }
+                    continue;
+                }
+                let ext = path
+                    .extension()
+                    .map(|x| x.to_string_lossy().to_lowercase())
+                    .unwrap_or_default();
+                let wanted = extensions.is_empty()
+                    || extensions
+                        .iter()
+                        .any(|x| x.trim_start_matches('.').eq_ignore_ascii_case(&ext));
+                if wanted {
+                    out.push(relative_to(&path, base));
+                }
+            }
+        }
+        out.sort();
+        out
+    }
+
+    fn diagnostic(&self, d: &cga::Diagnostic, lot: Option<&str>) -> Json {
+        let severity = if d.is_error() { "error" } else { "warning" };
+        let mut j = json!({
+            "severity": severity,
+            "message": d.message,
+            "lot": lot,
+            "text": d.render(),
+        });
+        if let Some(at) = &d.location {
+            j["file"] = json!(self.display_path(&at.file));
+            j["line"] = json!(at.line);
+            j["column"] = json!(at.column);
+            j["line_text"] = json!(at.line_text);
+        }
+        j
+    }
+
+    /// A path as the user reads it: relative to the workspace it is in.
+    fn display_path(&self, path: &Path) -> String {
+        for root in &self.roots {
+            if let Ok(rel) = path.strip_prefix(root) {
+                return rel.to_string_lossy().into_owned();
+            }
+        }
+        path.to_string_lossy().into_owned()
+    }
+}
+
+/// `path` relative to `base` (`../assets/a.obj` where it is not below).
+fn relative_to(path: &Path, base: &Path) -> String {
+    let p: Vec<_> = path.components().collect();
+    let b: Vec<_> = base.components().collect();
+    let common = p.iter().zip(&b).take_while(|(x, y)| x == y).count();
+    let mut out = PathBuf::new();
+    for _ in common..b.len() {
+        out.push("..");
+    }
+    for c in &p[common..] {
+        out.push(c);
+    }
+    out.to_string_lossy().replace('\\', "/")
+}
+
+/// The lots themselves as meshes, by a rule that leaves them as they are
+/// (loaded from text: nothing is read).
+fn lot_outlines(engine: &Engine, root: &Path, lots: &[Lot]) -> Vec<u8> {
+    let rules = engine.load_text(
+        root.join("cga-serve-lots.cga"),
+        "Lot --> color(\"#9a9a92\") Ground.\n",
+    );
+    match rules.generate_all(lots, &Options::default()) {
+        Ok(results) => encode::model(&results),
+        Err(_) => encode::model(&[]),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn workspaces_and_relative_paths() {
+        assert_eq!(
+            workspace_of(Path::new("/w/proj/rules/a.cga")),
+            PathBuf::from("/w/proj")
+        );
+        assert_eq!(workspace_of(Path::new("/w/x/a.cga")), PathBuf::from("/w/x"));
+        assert_eq!(
+            relative_to(
+                Path::new("/w/proj/assets/a.obj"),
+                Path::new("/w/proj/rules")
+            ),
+            "../assets/a.obj"
+        );
+        assert_eq!(
+            relative_to(Path::new("/w/a/b.png"), Path::new("/w/a")),
+            "b.png"
+        );
+    }
+}

@@ -1,0 +1,252 @@
+//! The HTTP routes (see the table in the crate's documentation).
+
+use std::collections::BTreeMap;
+use std::convert::Infallible;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use axum::extract::{DefaultBodyLimit, Query, State};
+use axum::http::{header, Method, StatusCode, Uri};
+use axum::response::sse::{Event, KeepAlive, Sse};
+use axum::response::{IntoResponse, Response};
+use axum::routing::{get, post};
+use axum::{Json, Router};
+use cga::{ModelWriter, Target};
+use serde::Deserialize;
+use serde_json::json;
+use tokio_stream::StreamExt;
+
+use crate::generator::{Params, Preview};
+use crate::paths;
+
+/// Largest request body: the page sends a few attribute values.
+const MAX_BODY: usize = 64 * 1024;
+/// Most attribute values in one request.
+const MAX_ATTRS: usize = 4096;
+/// Largest workspace file served.
+const MAX_FILE: u64 = 256 << 20;
+
+#[derive(Clone)]
+struct App {
+    preview: Arc<Preview>,
+    web_dir: Arc<PathBuf>,
+}
+
+pub fn router(preview: Arc<Preview>, web_dir: PathBuf) -> Router {
+    let app = App {
+        preview,
+        web_dir: Arc::new(web_dir),
+    };
+    Router::new()
+        .route("/api/state", get(state))
+        .route("/api/events", get(events))
+        .route("/api/model.bin", get(model))
+        .route("/api/lots.bin", get(lots))
+        .route("/api/model.glb", get(glb))
+        .route("/api/provenance", get(provenance))
+        .route("/api/params", post(set_params))
+        .fallback(files)
+        .layer(DefaultBodyLimit::max(MAX_BODY))
+        .with_state(app)
+}
+
+fn no_store(content_type: &'static str, body: impl IntoResponse) -> Response {
+    (
+        [
+            (header::CONTENT_TYPE, content_type),
+            (header::CACHE_CONTROL, "no-store"),
+        ],
+        body,
+    )
+        .into_response()
+}
+
+fn not_found() -> Response {
+    (StatusCode::NOT_FOUND, "not found\n").into_response()
+}
+
+async fn state(State(app): State<App>) -> Response {
+    let s = app.preview.snapshot();
+    no_store("application/json", s.state.as_str().to_string())
+}
+
+async fn events(
+    State(app): State<App>,
+) -> Sse<impl tokio_stream::Stream<Item = Result<Event, Infallible>>> {
+    let preview = app.preview.clone();
+    // The current state at once, then each newer one; states published
+    // while a client was busy are skipped, only the latest counts.
+    let stream = tokio_stream::wrappers::WatchStream::new(app.preview.subscribe()).map(move |_| {
+        let s = preview.snapshot();
+        Ok(Event::default().event("state").data(s.state.as_str()))
+    });
+    Sse::new(stream).keep_alive(KeepAlive::default())
+}
+
+async fn model(State(app): State<App>) -> Response {
+    let s = app.preview.snapshot();
+    no_store("application/octet-stream", s.model.as_ref().clone())
+}
+
+async fn lots(State(app): State<App>) -> Response {
+    no_store(
+        "application/octet-stream",
+        app.preview.lots_model.as_ref().clone(),
+    )
+}
+
+/// The last good model as a GLB, generated again into a writer with the
+/// values that made it.
+async fn glb(State(app): State<App>) -> Response {
+    let preview = app.preview.clone();
+    let made = match app.preview.snapshot().made_by.clone() {
+        Some(m) => m,
+        None => return (StatusCode::CONFLICT, "no model yet\n").into_response(),
+    };
+    let job = tokio::task::spawn_blocking(move || -> Result<Vec<u8>, cga::Error> {
+        let mut writer = ModelWriter::glb_in_memory(made.rules.export_options())?;
+        made.rules.generate_lots(
+            &preview.lots,
+            &made.options,
+            Target::Writer(&mut writer),
+            |_| {},
+        )?;
+        Ok(writer.finish_bytes()?.0)
+    });
+    match job.await {
+        Ok(Ok(bytes)) => (
+            [
+                (header::CONTENT_TYPE, "model/gltf-binary"),
+                (
+                    header::CONTENT_DISPOSITION,
+                    "attachment; filename=\"model.glb\"",
+                ),
+            ],
+            bytes,
+        )
+            .into_response(),
+        Ok(Err(e)) => (StatusCode::INTERNAL_SERVER_ERROR, format!("{e}\n")).into_response(),
+        Err(_) => (StatusCode::INTERNAL_SERVER_ERROR, "export failed\n").into_response(),
+    }
+}
+
+#[derive(Deserialize)]
+struct Triangle {
+    lot: usize,
+    mesh: usize,
+    tri: usize,
+}
+
+async fn provenance(State(app): State<App>, Query(t): Query<Triangle>) -> Response {
+    let s = app.preview.snapshot();
+    let Some(made) = &s.made_by else {
+        return not_found();
+    };
+    let Some(lot) = made.results.get(t.lot) else {
+        return not_found();
+    };
+    let Some(p) = lot.provenance(&made.rules, t.mesh, t.tri) else {
+        return not_found();
+    };
+    let mut j = json!({
+        "lot": lot.name,
+        "rule": p.rule,
+        "shape": p.shape.as_ref(),
+        "model_version": s.model_version,
+    });
+    if let Some(at) = &p.location {
+        let root = &app.preview.roots;
+        let file = root
+            .iter()
+            .find_map(|r| at.file.strip_prefix(r).ok())
+            .unwrap_or(&at.file);
+        j["file"] = json!(file.to_string_lossy());
+        j["line"] = json!(at.line);
+        j["column"] = json!(at.column);
+        j["line_text"] = json!(at.line_text);
+    }
+    no_store("application/json", j.to_string())
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ParamsBody {
+    #[serde(default)]
+    seed: u64,
+    #[serde(default)]
+    attrs: BTreeMap<String, serde_json::Value>,
+}
+
+async fn set_params(State(app): State<App>, Json(body): Json<ParamsBody>) -> Response {
+    if body.attrs.len() > MAX_ATTRS {
+        return (StatusCode::PAYLOAD_TOO_LARGE, "too many attributes\n").into_response();
+    }
+    app.preview.set_params(Params {
+        seed: body.seed,
+        attrs: body.attrs,
+    });
+    (StatusCode::ACCEPTED, Json(json!({"accepted": true}))).into_response()
+}
+
+/// The page's files (`/`, `/main.js`) and the workspace's (`/files/...`),
+/// by the raw request path: nothing here decodes before checking.
+async fn files(State(app): State<App>, method: Method, uri: Uri) -> Response {
+    if method != Method::GET && method != Method::HEAD {
+        return (StatusCode::METHOD_NOT_ALLOWED, "method not allowed\n").into_response();
+    }
+    let path = uri.path();
+    if let Some(rest) = path.strip_prefix("/files/") {
+        return workspace_file(&app, rest).await;
+    }
+    let name = match path {
+        "/" | "/index.html" => "index.html",
+        _ => match path.strip_prefix('/').and_then(paths::page_file) {
+            Some(n) => n,
+            None => return not_found(),
+        },
+    };
+    let file = app.web_dir.join(name);
+    match tokio::fs::read(&file).await {
+        Ok(bytes) => no_store(paths::content_type(&file), bytes),
+        Err(_) if name == "index.html" => (
+            StatusCode::SERVICE_UNAVAILABLE,
+            [(header::CONTENT_TYPE, "text/html; charset=utf-8")],
+            format!(
+                "<!doctype html><title>cga serve</title><h1>The preview page is not built</h1>\
+                 <p>Run once, in the repository:</p><pre>{}</pre><p>then reload.</p>",
+                crate::WEB_BUILD_HINT
+            ),
+        )
+            .into_response(),
+        Err(_) => not_found(),
+    }
+}
+
+async fn workspace_file(app: &App, raw: &str) -> Response {
+    let Some(rel) = paths::relative_path(raw) else {
+        return not_found();
+    };
+    let preview = app.preview.clone();
+    let read = tokio::task::spawn_blocking(move || {
+        let world = preview.engine.world();
+        for root in &preview.roots {
+            let path = root.join(&rel);
+            // The confined world refuses what leads out of the roots
+            // (symbolic links included).
+            match world.metadata(&path) {
+                Some(m) if !m.is_dir && m.len <= MAX_FILE => {
+                    if let Ok(bytes) = world.read(&path) {
+                        return Some((path, bytes));
+                    }
+                }
+                _ => {}
+            }
+        }
+        None
+    })
+    .await;
+    match read {
+        Ok(Some((path, bytes))) => no_store(paths::content_type(&path), bytes),
+        _ => not_found(),
+    }
+}

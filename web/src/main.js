@@ -1,0 +1,538 @@
+// The page of `cga serve`: a 3D view of the model the server generates, an
+// attribute panel built from the rule file's annotations, and panels for
+// problems, prints, reports and statistics. The server pushes a `state`
+// event after every change (server-sent events); the model comes as plain
+// arrays (`/api/model.bin`, see crates/cga-serve/src/encode.rs).
+
+import * as THREE from 'three';
+import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+
+const $ = (id) => document.getElementById(id);
+const BACKGROUND = 0xdde3ea;
+
+// What tests (and curious users) can read: `window.cgaPreview`.
+const page = {
+  stateVersion: 0,
+  modelVersion: 0, // of the model drawn
+  drawnAt: 0,
+  bounds: null, // {min: [x,y,z], max: [x,y,z]} of the model drawn
+  problems: [],
+  stale: false,
+  values: {},
+  picked: null,
+};
+window.cgaPreview = page;
+
+// ---------------------------------------------------------------- viewport
+
+const canvas = $('canvas');
+// The drawing buffer is kept so that tests can read the pixels drawn.
+const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
+renderer.shadowMap.enabled = true;
+renderer.shadowMap.type = THREE.PCFSoftShadowMap;
+const scene = new THREE.Scene();
+scene.background = new THREE.Color(BACKGROUND);
+const camera = new THREE.PerspectiveCamera(45, 1, 0.1, 100000);
+camera.position.set(40, 35, 40);
+const controls = new OrbitControls(camera, canvas);
+controls.enableDamping = false;
+
+scene.add(new THREE.HemisphereLight(0xffffff, 0x8d8a80, 1.6));
+const sun = new THREE.DirectionalLight(0xffffff, 1.8);
+sun.position.set(60, 100, 40);
+sun.castShadow = true;
+sun.shadow.mapSize.set(2048, 2048);
+// Without a bias, walls shadow themselves in stripes (shadow acne).
+sun.shadow.bias = -0.0005;
+sun.shadow.normalBias = 0.05;
+scene.add(sun, sun.target);
+
+const grids = new THREE.Group();
+scene.add(grids);
+const lotsGroup = new THREE.Group();
+const modelGroup = new THREE.Group();
+scene.add(lotsGroup, modelGroup);
+
+function resize() {
+  const w = canvas.clientWidth;
+  const h = canvas.clientHeight;
+  if (canvas.width !== Math.floor(w * renderer.getPixelRatio()) || canvas.height !== Math.floor(h * renderer.getPixelRatio())) {
+    renderer.setSize(w, h, false);
+    camera.aspect = w / Math.max(h, 1);
+    camera.updateProjectionMatrix();
+  }
+}
+
+function render() {
+  resize();
+  renderer.render(scene, camera);
+}
+controls.addEventListener('change', render);
+window.addEventListener('resize', render);
+
+// A grid of 1 m cells and one of 10 m cells under the model, sized to it.
+function makeGrids(box) {
+  grids.clear();
+  const size = box.isEmpty() ? new THREE.Vector3(40, 0, 40) : box.getSize(new THREE.Vector3());
+  const centre = box.isEmpty() ? new THREE.Vector3() : box.getCenter(new THREE.Vector3());
+  const extent = Math.ceil((Math.max(size.x, size.z) * 1.6 + 20) / 10) * 10;
+  const fine = new THREE.GridHelper(extent, extent, 0xc4cad2, 0xc4cad2);
+  const coarse = new THREE.GridHelper(extent, extent / 10, 0x98a0aa, 0x98a0aa);
+  for (const g of [fine, coarse]) {
+    g.position.set(Math.round(centre.x / 10) * 10, -0.02, Math.round(centre.z / 10) * 10);
+    grids.add(g);
+  }
+  const shadow = new THREE.Mesh(new THREE.PlaneGeometry(extent, extent), new THREE.ShadowMaterial({ opacity: 0.18 }));
+  shadow.rotation.x = -Math.PI / 2;
+  shadow.position.copy(fine.position).setY(-0.03);
+  shadow.receiveShadow = true;
+  grids.add(shadow);
+  const r = Math.max(size.x, size.y, size.z, 10);
+  sun.position.set(centre.x + r, centre.y + 2 * r, centre.z + 0.7 * r);
+  sun.target.position.copy(centre);
+  const cam = sun.shadow.camera;
+  cam.left = cam.bottom = -1.5 * r;
+  cam.right = cam.top = 1.5 * r;
+  cam.near = 0.1;
+  cam.far = 6 * r;
+  cam.updateProjectionMatrix();
+}
+
+function fit() {
+  const box = new THREE.Box3().setFromObject(modelGroup);
+  if (box.isEmpty()) box.setFromObject(lotsGroup);
+  if (box.isEmpty()) return;
+  const centre = box.getCenter(new THREE.Vector3());
+  const radius = box.getBoundingSphere(new THREE.Sphere()).radius;
+  const distance = radius / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2)) * 1.1;
+  const direction = new THREE.Vector3(1, 0.8, 1.2).normalize();
+  camera.position.copy(centre).addScaledVector(direction, distance);
+  controls.target.copy(centre);
+  controls.update();
+  render();
+}
+$('fit').addEventListener('click', fit);
+
+// ------------------------------------------------------------------ models
+
+// Reads the binary model: "CGAM", header length, JSON header, arrays.
+function decodeModel(buffer) {
+  const view = new DataView(buffer);
+  const magic = String.fromCharCode(...new Uint8Array(buffer, 0, 4));
+  if (magic !== 'CGAM') throw new Error('not a model');
+  const headerLength = view.getUint32(4, true);
+  const header = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, 8, headerLength)));
+  return { header, data: 8 + headerLength };
+}
+
+function srgb(c) {
+  return new THREE.Color().setRGB(c[0], c[1], c[2], THREE.SRGBColorSpace);
+}
+
+function buildMeshes(buffer, group, { lots = false } = {}) {
+  const { header, data } = decodeModel(buffer);
+  for (const child of group.children) {
+    child.geometry.dispose();
+    child.material.dispose();
+  }
+  group.clear();
+  for (const lot of header.lots) {
+    for (const m of lot.meshes) {
+      const geometry = new THREE.BufferGeometry();
+      geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(buffer, data + m.positions, m.vertices * 3), 3));
+      if (m.normals !== null) {
+        geometry.setAttribute('normal', new THREE.BufferAttribute(new Float32Array(buffer, data + m.normals, m.vertices * 3), 3));
+      } else {
+        geometry.computeVertexNormals();
+      }
+      geometry.setIndex(new THREE.BufferAttribute(new Uint32Array(buffer, data + m.indices, m.triangles * 3), 1));
+      const material = new THREE.MeshStandardMaterial({
+        color: lots ? 0xa8a89e : srgb(m.color),
+        roughness: 0.85,
+        metalness: 0,
+        transparent: m.opacity < 1,
+        opacity: m.opacity,
+        side: m.double_sided || lots ? THREE.DoubleSide : THREE.FrontSide,
+        // Lots lie where the buildings stand: drawn behind them.
+        polygonOffset: lots,
+        polygonOffsetFactor: lots ? 2 : 0,
+        polygonOffsetUnits: lots ? 2 : 0,
+      });
+      const mesh = new THREE.Mesh(geometry, material);
+      mesh.castShadow = !lots;
+      mesh.receiveShadow = true;
+      mesh.userData = { lot: lot.index, lotName: lot.name, mesh: m.mesh, material: m.material };
+      group.add(mesh);
+    }
+  }
+}
+
+let lotsLoaded = false;
+let fitted = false;
+let loadingModel = 0;
+
+async function loadLots() {
+  const response = await fetch('api/lots.bin');
+  buildMeshes(await response.arrayBuffer(), lotsGroup, { lots: true });
+  lotsLoaded = true;
+}
+
+async function loadModel(version) {
+  loadingModel = version;
+  const t = performance.now();
+  const response = await fetch(`api/model.bin?v=${version}`);
+  const buffer = await response.arrayBuffer();
+  // A newer model was asked for meanwhile: that one is drawn.
+  if (loadingModel !== version) return;
+  if (!lotsLoaded) await loadLots();
+  buildMeshes(buffer, modelGroup);
+  const box = new THREE.Box3().setFromObject(modelGroup);
+  const both = box.clone().union(new THREE.Box3().setFromObject(lotsGroup));
+  makeGrids(both);
+  if (!fitted) {
+    fitted = true;
+    fit();
+  }
+  render();
+  page.modelVersion = version;
+  page.drawnAt = performance.now();
+  page.drawMs = page.drawnAt - t;
+  page.bounds = box.isEmpty() ? null : { min: box.min.toArray(), max: box.max.toArray() };
+  $('stat-draw').textContent = `${page.drawMs.toFixed(1)} ms`;
+}
+
+// The model's pixels: the share of the model's screen box that changes
+// when the model is hidden (tests read it).
+page.modelPixels = () => {
+  const box = new THREE.Box3().setFromObject(modelGroup);
+  if (box.isEmpty()) return { box: null, changed: 0, total: 0 };
+  const corners = [];
+  for (const x of [box.min.x, box.max.x]) for (const y of [box.min.y, box.max.y]) for (const z of [box.min.z, box.max.z]) {
+    corners.push(new THREE.Vector3(x, y, z).project(camera));
+  }
+  const w = renderer.domElement.width;
+  const h = renderer.domElement.height;
+  const xs = corners.map((c) => Math.round((c.x + 1) / 2 * w));
+  const ys = corners.map((c) => Math.round((1 - c.y) / 2 * h));
+  const x0 = Math.max(0, Math.min(...xs)); const x1 = Math.min(w, Math.max(...xs));
+  const y0 = Math.max(0, Math.min(...ys)); const y1 = Math.min(h, Math.max(...ys));
+  const read = () => {
+    render();
+    const c = document.createElement('canvas');
+    c.width = w; c.height = h;
+    const g = c.getContext('2d');
+    g.drawImage(renderer.domElement, 0, 0);
+    return g.getImageData(x0, y0, Math.max(1, x1 - x0), Math.max(1, y1 - y0)).data;
+  };
+  const withModel = read();
+  modelGroup.visible = false;
+  const without = read();
+  modelGroup.visible = true;
+  render();
+  let changed = 0;
+  for (let i = 0; i < withModel.length; i += 4) {
+    const d = Math.abs(withModel[i] - without[i]) + Math.abs(withModel[i + 1] - without[i + 1]) + Math.abs(withModel[i + 2] - without[i + 2]);
+    if (d > 24) changed++;
+  }
+  return { box: [x0, y0, x1, y1], changed, total: withModel.length / 4 };
+};
+
+// ------------------------------------------------------------- attributes
+
+let attributeSignature = '';
+const values = {}; // name -> value set on the page
+let seed = 0;
+let sendTimer = null;
+
+function sendParams() {
+  // One request per frame at most; the server cancels what it obsoletes.
+  if (sendTimer) return;
+  sendTimer = requestAnimationFrame(async () => {
+    sendTimer = null;
+    page.sentAt = performance.now();
+    setStatus('generating…', 'busy');
+    await fetch('api/params', {
+      method: 'POST',
+      headers: { 'content-type': 'application/json' },
+      body: JSON.stringify({ seed, attrs: values }),
+    });
+  });
+}
+
+$('seed').addEventListener('input', (e) => {
+  const n = Math.max(0, Math.floor(Number(e.target.value) || 0));
+  seed = n;
+  sendParams();
+});
+
+function sortAttributes(attributes) {
+  const groupOrder = new Map();
+  for (const a of attributes) {
+    const g = a.group ? a.group.name : '';
+    const o = a.group && a.group.order !== null ? a.group.order : Infinity;
+    if (!groupOrder.has(g) || o < groupOrder.get(g)) groupOrder.set(g, o);
+  }
+  const firstLine = new Map();
+  for (const a of attributes) {
+    const g = a.group ? a.group.name : '';
+    firstLine.set(g, Math.min(firstLine.get(g) ?? Infinity, a.line ?? Infinity));
+  }
+  const key = (a) => {
+    const g = a.group ? a.group.name : '';
+    return [g === '' ? -Infinity : groupOrder.get(g), firstLine.get(g), g, a.order ?? Infinity, a.line ?? Infinity, a.name];
+  };
+  return [...attributes].sort((a, b) => {
+    const ka = key(a); const kb = key(b);
+    for (let i = 0; i < ka.length; i++) {
+      if (ka[i] < kb[i]) return -1;
+      if (ka[i] > kb[i]) return 1;
+    }
+    return 0;
+  });
+}
+
+function text(v) {
+  return typeof v === 'number' ? String(Math.round(v * 1000) / 1000) : String(v);
+}
+
+function control(a, value) {
+  const set = (v) => { values[a.name] = v; sendParams(); };
+  if (a.enum) {
+    const select = document.createElement('select');
+    for (const option of a.enum) {
+      const o = document.createElement('option');
+      o.value = JSON.stringify(option);
+      o.textContent = text(option);
+      select.append(o);
+    }
+    select.value = JSON.stringify(value);
+    select.addEventListener('change', () => set(JSON.parse(select.value)));
+    return select;
+  }
+  if (a.type === 'bool') {
+    const box = document.createElement('input');
+    box.type = 'checkbox';
+    box.checked = value === true;
+    box.addEventListener('change', () => set(box.checked));
+    return box;
+  }
+  if (a.type === 'float' && a.range) {
+    const wrap = document.createElement('span');
+    wrap.className = 'with-value';
+    const slider = document.createElement('input');
+    slider.type = 'range';
+    slider.min = a.range.min;
+    slider.max = a.range.max;
+    // Without a step: whole numbers where the range and default are
+    // (counts such as floors), else 200 steps over the range.
+    const whole = [a.range.min, a.range.max, a.default].every(Number.isInteger);
+    slider.step = a.range.step ?? (whole ? 1 : ((a.range.max - a.range.min) / 200 || 'any'));
+    slider.value = value;
+    const out = document.createElement('output');
+    out.textContent = text(value);
+    slider.addEventListener('input', () => {
+      out.textContent = text(Number(slider.value));
+      set(Number(slider.value));
+    });
+    wrap.append(slider, out);
+    return wrap;
+  }
+  if (a.type === 'float') {
+    const input = document.createElement('input');
+    input.type = 'number';
+    input.step = 'any';
+    input.value = value;
+    input.addEventListener('change', () => { if (input.value !== '') set(Number(input.value)); });
+    return input;
+  }
+  if (a.type === 'str' && a.color) {
+    const input = document.createElement('input');
+    input.type = 'color';
+    input.value = /^#[0-9a-fA-F]{6}$/.test(value) ? value : '#000000';
+    input.addEventListener('input', () => set(input.value));
+    return input;
+  }
+  if (a.type === 'str' && a.files) {
+    const select = document.createElement('select');
+    const options = a.files.includes(value) ? a.files : [value, ...a.files];
+    for (const f of options) {
+      const o = document.createElement('option');
+      o.value = f; o.textContent = f;
+      select.append(o);
+    }
+    select.value = value;
+    select.addEventListener('change', () => set(select.value));
+    return select;
+  }
+  const input = document.createElement('input');
+  input.type = 'text';
+  input.value = Array.isArray(value) ? JSON.stringify(value) : value ?? '';
+  input.readOnly = a.type !== 'str';
+  input.addEventListener('change', () => set(input.value));
+  return input;
+}
+
+function renderAttributes(state) {
+  const signature = JSON.stringify(state.attributes.map((a) => [a.name, a.type, a.range, a.enum, a.color, a.group, a.order, a.hidden, a.description, a.files, a.default]));
+  if (signature === attributeSignature) return;
+  attributeSignature = signature;
+  const form = $('attributes');
+  form.replaceChildren();
+  let group = null;
+  for (const a of sortAttributes(state.attributes)) {
+    if (a.hidden) continue;
+    const g = a.group ? a.group.name : '';
+    if (g !== group) {
+      group = g;
+      if (g) {
+        const h = document.createElement('h3');
+        h.textContent = g;
+        form.append(h);
+      }
+    }
+    const label = document.createElement('label');
+    label.className = 'attr';
+    label.dataset.attr = a.name;
+    if (a.description) label.title = a.description;
+    const name = document.createElement('span');
+    name.className = 'name';
+    name.textContent = a.name;
+    const value = a.name in state.values ? state.values[a.name] : a.default;
+    label.append(name, control(a, value));
+    form.append(label);
+  }
+}
+
+// ------------------------------------------------------------------ panels
+
+function setStatus(message, kind = '') {
+  const s = $('status');
+  s.textContent = message;
+  s.className = `status ${kind}`;
+}
+
+function renderProblems(problems) {
+  const list = $('problems');
+  list.replaceChildren();
+  for (const p of problems) {
+    const li = document.createElement('li');
+    li.className = `problem ${p.severity}`;
+    const where = document.createElement('div');
+    where.className = 'where';
+    where.textContent = p.file ? `${p.file}:${p.line}:${p.column}` : (p.lot ?? '');
+    const message = document.createElement('div');
+    message.textContent = `${p.severity}: ${p.message}${p.lot && p.file ? ` (lot ${p.lot})` : ''}`;
+    li.append(where, message);
+    if (p.line_text) {
+      const pre = document.createElement('pre');
+      pre.textContent = p.line_text;
+      li.append(pre);
+    }
+    list.append(li);
+  }
+  $('problem-count').textContent = String(problems.length);
+}
+
+function row(table, cells) {
+  const tr = document.createElement('tr');
+  for (const [c, numeric] of cells) {
+    const td = document.createElement('td');
+    td.textContent = c;
+    if (numeric) td.className = 'n';
+    tr.append(td);
+  }
+  table.append(tr);
+}
+
+function renderStats(state) {
+  const t = $('stats');
+  t.replaceChildren();
+  const s = state.stats;
+  const n = (x) => Number(x).toLocaleString('en');
+  row(t, [['lots'], [`${n(s.lots)}${s.failed ? ` (${s.failed} stopped)` : ''}`, true]]);
+  row(t, [['shapes'], [n(s.shapes), true]]);
+  row(t, [['leaves'], [n(s.leaves), true]]);
+  row(t, [['faces'], [n(s.faces), true]]);
+  row(t, [['triangles'], [n(s.triangles), true]]);
+  row(t, [['load'], [`${s.load_ms.toFixed(1)} ms`, true]]);
+  row(t, [['generate'], [`${s.generate_ms.toFixed(1)} ms`, true]]);
+  const tr = document.createElement('tr');
+  tr.innerHTML = '<td>draw</td><td class="n" id="stat-draw"></td>';
+  t.append(tr);
+  if (page.drawMs !== undefined) $('stat-draw').textContent = `${page.drawMs.toFixed(1)} ms`;
+}
+
+function renderOutputs(state) {
+  const multi = state.lots.length > 1;
+  $('prints').textContent = state.prints.map((p) => (multi ? `[${p.lot}] ${p.text}` : p.text)).join('\n');
+  $('print-count').textContent = String(state.prints.length);
+  const t = $('reports');
+  t.replaceChildren();
+  for (const r of state.reports) row(t, multi ? [[r.lot], [r.key], [text(r.value), true]] : [[r.key], [text(r.value), true]]);
+  $('report-count').textContent = String(state.reports.length);
+}
+
+function onState(state) {
+  page.stateVersion = state.version;
+  page.problems = state.problems;
+  page.stale = state.stale;
+  page.values = state.values;
+  page.stats = state.stats;
+  $('rules-name').textContent = state.rules;
+  document.title = `${state.rules} · cga serve`;
+  seed = state.seed;
+  if (document.activeElement !== $('seed')) $('seed').value = String(state.seed);
+  Object.assign(values, state.values);
+  renderAttributes(state);
+  renderProblems(state.problems);
+  renderStats(state);
+  renderOutputs(state);
+  $('stale').hidden = !state.stale;
+  const errors = state.problems.filter((p) => p.severity === 'error').length;
+  if (errors) setStatus(`${errors} error${errors > 1 ? 's' : ''}`, 'error');
+  else setStatus('up to date');
+  if (state.model_version !== page.modelVersion && state.model_version > 0) loadModel(state.model_version);
+}
+
+// ------------------------------------------------------------- provenance
+
+const raycaster = new THREE.Raycaster();
+let down = null;
+canvas.addEventListener('pointerdown', (e) => { down = [e.clientX, e.clientY]; });
+canvas.addEventListener('pointerup', async (e) => {
+  if (!down || Math.hypot(e.clientX - down[0], e.clientY - down[1]) > 4) return;
+  const r = canvas.getBoundingClientRect();
+  const pointer = new THREE.Vector2((e.clientX - r.left) / r.width * 2 - 1, -((e.clientY - r.top) / r.height) * 2 + 1);
+  raycaster.setFromCamera(pointer, camera);
+  const hit = raycaster.intersectObjects(modelGroup.children, false)[0];
+  const box = $('picked');
+  if (!hit) { box.hidden = true; page.picked = null; return; }
+  const { lot, mesh } = hit.object.userData;
+  const response = await fetch(`api/provenance?lot=${lot}&mesh=${mesh}&tri=${hit.faceIndex}`);
+  if (!response.ok) { box.hidden = true; return; }
+  const p = await response.json();
+  page.picked = p;
+  box.replaceChildren();
+  const head = document.createElement('div');
+  head.textContent = `${p.rule ?? '(no rule)'} → ${p.shape}${p.file ? ` at ${p.file}:${p.line}:${p.column}` : ''} · lot ${p.lot}`;
+  box.append(head);
+  if (p.line_text) {
+    const pre = document.createElement('pre');
+    pre.textContent = p.line_text;
+    box.append(pre);
+  }
+  box.hidden = false;
+});
+
+// ------------------------------------------------------------------ events
+
+function connect() {
+  const events = new EventSource('api/events');
+  events.addEventListener('state', (e) => onState(JSON.parse(e.data)));
+  events.onerror = () => setStatus('disconnected: is cga serve running?', 'error');
+  events.onopen = () => setStatus('connected');
+}
+
+render();
+connect();

@@ -64,7 +64,7 @@ pub fn model(results: &[LotResult]) -> Vec<u8> {
         lots.push(json!({"index": lot.index, "name": lot.name, "meshes": meshes}));
     }
     let mut header = serde_json::to_vec(&json!({ "lots": lots })).expect("JSON of plain data");
-    while header.len() % 4 != 0 {
+    while !header.len().is_multiple_of(4) {
         header.push(b' ');
     }
     let mut out = Vec::with_capacity(8 + header.len() + data.len());

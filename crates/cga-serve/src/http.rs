@@ -177,7 +177,16 @@ struct ParamsBody {
     attrs: BTreeMap<String, serde_json::Value>,
 }
 
-async fn set_params(State(app): State<App>, Json(body): Json<ParamsBody>) -> Response {
+async fn set_params(State(app): State<App>, Json(body): Json<serde_json::Value>) -> Response {
+    // Only an object: serde would also take `[]` for a struct whose
+    // fields all have defaults.
+    if !body.is_object() {
+        return (StatusCode::UNPROCESSABLE_ENTITY, "expected a JSON object\n").into_response();
+    }
+    let body: ParamsBody = match serde_json::from_value(body) {
+        Ok(b) => b,
+        Err(e) => return (StatusCode::UNPROCESSABLE_ENTITY, format!("{e}\n")).into_response(),
+    };
     if body.attrs.len() > MAX_ATTRS {
         return (StatusCode::PAYLOAD_TOO_LARGE, "too many attributes\n").into_response();
     }

@@ -114,6 +114,8 @@ test('a syntax error is shown with file:line:col and the last model stays', asyn
   assert.equal(after.modelVersion, before.modelVersion);
   assert.equal(after.stale, true);
   assert.ok(await page.locator('#stale').isVisible());
+  // The attribute panel keeps the last good file's controls.
+  assert.equal(await page.locator('label[data-attr=floors] input[type=range]').count(), 1);
   assert.equal(await height(), before.bounds.max[1]);
   const pixels = await modelPixels();
   assert.ok(pixels.changed / pixels.total > 0.3, JSON.stringify(pixels));

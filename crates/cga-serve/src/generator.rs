@@ -35,6 +35,8 @@ pub struct Snapshot {
 #[derive(Clone)]
 pub struct Made {
     pub rules: Rules,
+    /// How long the generation took, in milliseconds.
+    pub generate_ms: f64,
     pub results: Arc<Vec<LotResult>>,
     pub options: Options,
 }
@@ -287,6 +289,7 @@ impl Preview {
                 options.cancel = None;
                 let made = Made {
                     rules: rules.clone(),
+                    generate_ms: gen_ms,
                     results: Arc::new(results),
                     options,
                 };
@@ -349,7 +352,7 @@ impl Preview {
             "faces": results.iter().map(|l| l.model.faces).sum::<u64>(),
             "triangles": results.iter().map(|l| l.model.triangles()).sum::<usize>(),
             "load_ms": load_ms,
-            "generate_ms": gen_ms,
+            "generate_ms": made_by.as_ref().map(|m| m.generate_ms).unwrap_or(gen_ms),
         });
         let state = json!({
             "version": version,
@@ -360,7 +363,12 @@ impl Preview {
             "has_errors": rules.has_errors(),
             "seed": params.seed,
             "values": params.attrs,
-            "attributes": self.attributes(rules),
+            // Rules with errors may not know their attributes' types: the
+            // panel keeps those of the rules that made the model shown.
+            "attributes": match (&made_by, rules.has_errors()) {
+                (Some(m), true) => self.attributes(&m.rules),
+                _ => self.attributes(rules),
+            },
             "problems": problems,
             "prints": prints,
             "reports": reports,

@@ -47,8 +47,10 @@ pub use cga_world::{decode_text, ConfinedWorld, DiskWorld, MemoryWorld, Metadata
 pub use diagnostics::{Diagnostic, Location, Severity};
 pub use error::{Error, ExportError};
 pub use generate::Target;
-pub use lots::{CrsOption, GeoOrigin, InvalidPolicy, Lot, LotOptions, LotSet};
-pub use model::{LeafOrigin, LotResult, Material, PlainMesh, PlainModel, Provenance, Summary};
+pub use lots::{Axes, CrsOption, GeoOrigin, InvalidPolicy, Lot, LotOptions, LotSet};
+pub use model::{
+    write_plain, LeafOrigin, LotResult, Material, PlainMesh, PlainModel, Provenance, Summary,
+};
 pub use options::{Cancel, Limits, Options};
 pub use rules::{Engine, ProgramSize, RuleInfo, RuleRef, Rules};
 

@@ -69,57 +69,79 @@ pub fn from_rings(
     rings: &[Vec<[f64; 3]>],
     axes: Axes,
 ) -> Result<Lot, String> {
-    if rings.is_empty() {
-        return Err("a lot needs an outer ring".into());
+    from_polygons(name, std::slice::from_ref(&rings.to_vec()), axes)
+}
+
+/// A lot of several polygons (a GIS MultiPolygon), each one face of the
+/// lot's initial shape (as CityEngine makes shapes of several faces), each
+/// given and checked as [`from_rings`] says; the first polygon's first
+/// edge is the street front.
+pub fn from_polygons(
+    name: impl Into<String>,
+    polygons: &[Vec<Vec<[f64; 3]>>],
+    axes: Axes,
+) -> Result<Lot, String> {
+    if polygons.is_empty() {
+        return Err("a lot needs at least one polygon".into());
     }
     let mut mesh = cga_geometry::Mesh::new();
-    let mut loops: Vec<Vec<u32>> = Vec::with_capacity(rings.len());
-    for (r, ring) in rings.iter().enumerate() {
-        let what = if r == 0 {
-            "the outer ring".to_string()
+    for (k, rings) in polygons.iter().enumerate() {
+        let polygon = if polygons.len() > 1 {
+            format!("polygon {k}: ")
         } else {
-            format!("hole {r}")
+            String::new()
         };
-        if let Some(p) = ring.iter().find(|p| p.iter().any(|c| !c.is_finite())) {
-            return Err(format!(
-                "{what} has a coordinate that is not a finite number: ({}, {}, {})",
-                p[0], p[1], p[2]
-            ));
+        if rings.is_empty() {
+            return Err(format!("{polygon}a lot needs an outer ring"));
         }
-        let mut points = ring.as_slice();
-        if points.len() > 1 && points.first() == points.last() {
-            points = &points[..points.len() - 1];
+        let mut loops: Vec<Vec<u32>> = Vec::with_capacity(rings.len());
+        for (r, ring) in rings.iter().enumerate() {
+            let what = if r == 0 {
+                format!("{polygon}the outer ring")
+            } else {
+                format!("{polygon}hole {r}")
+            };
+            if let Some(p) = ring.iter().find(|p| p.iter().any(|c| !c.is_finite())) {
+                return Err(format!(
+                    "{what} has a coordinate that is not a finite number: ({}, {}, {})",
+                    p[0], p[1], p[2]
+                ));
+            }
+            let mut points = ring.as_slice();
+            if points.len() > 1 && points.first() == points.last() {
+                points = &points[..points.len() - 1];
+            }
+            if points.len() < 3 {
+                return Err(format!(
+                    "{what} has {} distinct point{}; a lot needs at least 3",
+                    points.len(),
+                    if points.len() == 1 { "" } else { "s" }
+                ));
+            }
+            let start = mesh.positions.len() as u32;
+            mesh.positions.extend(points.iter().map(|p| match axes {
+                Axes::Gis => DVec3::new(p[0], p[2], -p[1]),
+                Axes::Engine => DVec3::new(p[0], p[1], p[2]),
+            }));
+            loops.push((start..mesh.positions.len() as u32).collect());
         }
-        if points.len() < 3 {
-            return Err(format!(
-                "{what} has {} distinct point{}; a lot needs at least 3",
-                points.len(),
-                if points.len() == 1 { "" } else { "s" }
-            ));
+        for (i, l) in loops.iter_mut().enumerate() {
+            // Twice the signed area in the x-z plane seen from +y: positive
+            // is counter-clockwise. Vertical rings (zero area) stay as given.
+            let mut a = 0.0;
+            for k in 0..l.len() {
+                let p = mesh.positions[l[k] as usize];
+                let q = mesh.positions[l[(k + 1) % l.len()] as usize];
+                a += p.z * q.x - p.x * q.z;
+            }
+            if a != 0.0 && (i == 0) != (a > 0.0) {
+                // Reversed after the first point, so the first edge is kept.
+                l[1..].reverse();
+            }
         }
-        let start = mesh.positions.len() as u32;
-        mesh.positions.extend(points.iter().map(|p| match axes {
-            Axes::Gis => DVec3::new(p[0], p[2], -p[1]),
-            Axes::Engine => DVec3::new(p[0], p[1], p[2]),
-        }));
-        loops.push((start..mesh.positions.len() as u32).collect());
+        let refs: Vec<&[u32]> = loops.iter().map(|l| l.as_slice()).collect();
+        mesh.add_face(&refs, 0);
     }
-    for (i, l) in loops.iter_mut().enumerate() {
-        // Twice the signed area in the x-z plane seen from +y: positive
-        // is counter-clockwise. Vertical rings (zero area) stay as given.
-        let mut a = 0.0;
-        for k in 0..l.len() {
-            let p = mesh.positions[l[k] as usize];
-            let q = mesh.positions[l[(k + 1) % l.len()] as usize];
-            a += p.z * q.x - p.x * q.z;
-        }
-        if a != 0.0 && (i == 0) != (a > 0.0) {
-            // Reversed after the first point, so the first edge is kept.
-            l[1..].reverse();
-        }
-    }
-    let refs: Vec<&[u32]> = loops.iter().map(|l| l.as_slice()).collect();
-    mesh.add_face(&refs, 0);
     Ok(Lot {
         name: name.into(),
         mesh,
@@ -255,5 +277,17 @@ mod tests {
             "hole 1 has 0 distinct points; a lot needs at least 3"
         );
         assert!(from_rings("a", &[], Axes::Gis).is_err());
+        let square = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]];
+        let e = from_polygons(
+            "m",
+            &[vec![square.clone()], vec![square[..2].to_vec()]],
+            Axes::Gis,
+        );
+        assert_eq!(
+            e.unwrap_err(),
+            "polygon 1: the outer ring has 2 distinct points; a lot needs at least 3"
+        );
+        let two = from_polygons("m", &[vec![square.clone()], vec![square]], Axes::Gis).unwrap();
+        assert_eq!(two.mesh.faces.len(), 2);
     }
 }

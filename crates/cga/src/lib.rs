@@ -42,7 +42,7 @@ mod values;
 pub use attributes::{Annotation, Attribute, Range};
 pub use cga_engine::Workspaces;
 pub use cga_export::{ExportOptions, ExportStats, Format, Georeference, ModelWriter};
-pub use cga_value::{Value, ValueType};
+pub use cga_value::{Array, Value, ValueType};
 pub use cga_world::{decode_text, ConfinedWorld, DiskWorld, MemoryWorld, Metadata, World};
 pub use diagnostics::{Diagnostic, Location, Severity};
 pub use error::{Error, ExportError};
@@ -59,6 +59,9 @@ pub use cga_engine::assets::DEFAULT_MAX_ASSET_MIB;
 /// Default vertex data a glTF/GLB writer holds before writing it out, in MiB.
 pub use cga_export::DEFAULT_FLUSH_MIB;
 pub use values::parse_value;
+/// The names of a material's ten texture channels, in the order of
+/// [`Material::maps`] (and of CGA's UV sets).
+pub use cga_geometry::material::TEXTURE_CHANNELS;
 
 /// A value's text form, as `print()` and `str()` write it.
 pub fn value_text(value: &Value) -> String {

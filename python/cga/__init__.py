@@ -60,6 +60,12 @@ class Diagnostic:
         return self.rendered or self.message
 
 
+def _str_file(d):
+    if d.get("file") is not None:
+        d["file"] = os.fspath(d["file"])
+    return d
+
+
 class RuleError(Exception):
     """A rule file with errors. ``file``, ``line``, ``column`` and
     ``message`` are those of the first error; ``diagnostics`` has all."""
@@ -300,12 +306,13 @@ class Rules:
 
     @property
     def path(self):
-        return self._native.path
+        """The rule file's path (inside a rule package: ``city.rpk/rules/x.cga``)."""
+        return os.fspath(self._native.path)
 
     @property
     def diagnostics(self):
         """Every error and warning of the rule file and its imports."""
-        return [Diagnostic(**d) for d in self._native.diagnostics()]
+        return [Diagnostic(**_str_file(d)) for d in self._native.diagnostics()]
 
     @property
     def has_errors(self):
@@ -320,7 +327,7 @@ class Rules:
                 annotations = {}
                 for name, args in d.pop("annotations"):
                     annotations.setdefault(name, args)
-                out.append(Attribute(annotations=annotations, **d))
+                out.append(Attribute(annotations=annotations, **_str_file(d)))
             self._attributes = out
         return self._attributes
 

@@ -15,6 +15,7 @@ See ``docs/python.md`` for the whole API.
 """
 
 import os
+import threading
 from dataclasses import dataclass, field
 from typing import Any, List, Optional
 
@@ -208,6 +209,15 @@ class Model:
         self.leaves = d["leaves"]
         self._rules = rules
 
+    @classmethod
+    def failed(cls, index, name, why, rules):
+        """The model of a lot that could not be made."""
+        return cls({
+            "index": index, "name": name, "materials": _NO_MATERIALS, "meshes": [],
+            "reports": [], "prints": [], "warnings": [], "error": {"message": why},
+            "shapes": 0, "leaves": 0,
+        }, rules)
+
     @property
     def triangles(self):
         """Triangles over all meshes."""
@@ -240,9 +250,28 @@ class Model:
         return f"<cga.Model {self.index} ({self.name}): {self.triangles} triangles{state}>"
 
 
+class _NoMaterials:
+    def __len__(self):
+        return 0
+
+
+_NO_MATERIALS = _NoMaterials()
+
+
+def _stderr_is_terminal():
+    import sys
+
+    try:
+        return sys.stderr.isatty()
+    except (AttributeError, ValueError):
+        return False
+
+
 def _progress_bar(progress, total):
     """A callable(done, total) for the native loop, or None."""
-    if progress is False or progress is None and total < 1000:
+    if progress is False:
+        return None, None
+    if progress is None and (total < 1000 or not _stderr_is_terminal()):
         return None, None
     if callable(progress) and progress is not True:
         return progress, None
@@ -262,9 +291,17 @@ class Rules:
     """Rules loaded from a ``.cga`` file or ``.rpk`` rule package: their
     ``attributes``, ``diagnostics``, ``start_rules``, and generation."""
 
-    def __init__(self, native):
+    def __init__(self, native, spec=None):
         self._native = native
+        self._spec = spec
         self._attributes = None
+
+    def __reduce__(self):
+        # Rules travel (to Dask workers, other processes) as what they were
+        # loaded from, and are loaded once per process there.
+        if self._spec is None:
+            raise TypeError("these rules cannot be pickled")
+        return (_load, (self._spec,))
 
     @classmethod
     def open(cls, path, *, workspaces=(), check=True):
@@ -275,7 +312,8 @@ class Rules:
         path = os.fspath(path)
         if not os.path.exists(path):
             raise FileNotFoundError(path)
-        rules = cls(_cga.load(os.path.abspath(path), [os.fspath(w) for w in workspaces]))
+        spec = ("open", os.path.abspath(path), tuple(os.fspath(w) for w in workspaces))
+        rules = _load(spec, fresh=True)
         if check:
             rules._raise_errors()
         return rules
@@ -295,7 +333,8 @@ class Rules:
             if isinstance(content, str):
                 content = content.encode("utf-8")
             served.append((full, bytes(content)))
-        rules = cls(_cga.load_text(path, text, served, disk, [os.fspath(w) for w in workspaces]))
+        spec = ("text", path, text, tuple(served), bool(disk), tuple(os.fspath(w) for w in workspaces))
+        rules = _load(spec, fresh=True)
         if check:
             rules._raise_errors()
         return rules
@@ -346,7 +385,8 @@ class Rules:
         return self._native.styles()
 
     def generate(self, lots, attrs=None, seed=0, start_rule=None, jobs=None, *,
-                 geometry=True, output=None, progress=None, limits=None):
+                 geometry=True, output=None, progress=None, limits=None, invalid="raise",
+                 first_index=0):
         """Generates models on ``lots``: shapely polygons or multipolygons
         (holes too), a GeoSeries, a GeoDataFrame (columns named like
         attributes set them per lot), GeoJSON mappings (a Feature's
@@ -360,12 +400,22 @@ class Rules:
         ``.gltf`` or ``.obj`` file as they are generated (memory stays
         flat however many lots); the returned models then have no meshes.
         ``progress``: a tqdm bar (True; by default from 1,000 lots when
-        tqdm is installed), False, or a callable ``(done, total)``.
+        tqdm is installed and standard error is a terminal), False, or a callable ``(done, total)``.
+
+        ``invalid``: a lot that cannot be made (NaN coordinates, fewer than
+        3 points, not a polygon, an unknown attribute) raises ValueError
+        naming it (``"raise"``), or is a model with that ``error`` and no
+        geometry (``"report"``). ``first_index``: the place of the first lot
+        in a larger run (a partition's): each lot gets the index and the
+        seed it has in that run.
 
         Returns one :class:`Model` per lot, in order. Lots run in parallel
         with the GIL released; Ctrl-C stops the generation.
         """
-        native_lots, common = _normalize(lots, attrs, self._native.attribute_names())
+        if invalid not in ("raise", "report"):
+            raise ValueError(f"invalid must be 'raise' or 'report', not {invalid!r}")
+        skip = invalid == "report"
+        native_lots, common = _normalize(lots, attrs, self._native.attribute_names(), skip=skip)
         if self.has_errors:
             raise RuleError(self.diagnostics)
         callback, bar = _progress_bar(progress, len(native_lots))
@@ -373,16 +423,46 @@ class Rules:
         if limits is not None:
             lim = (limits.max_depth, limits.max_shapes, float(limits.max_seconds), limits.max_faces)
         try:
-            models, stats = self._native.generate(
+            models, stats, bad = self._native.generate(
                 native_lots, common, int(seed), start_rule, jobs, bool(geometry),
                 None if output is None else os.path.abspath(os.fspath(output)),
-                callback, lim,
+                callback, lim, int(first_index), skip,
             )
         finally:
             if bar is not None:
                 bar.close()
         self.last_write = stats
-        return [Model(m, self) for m in models]
+        out = [Model(m, self) for m in models]
+        if bad:
+            out.extend(Model.failed(i, name, why, self) for i, name, why in bad)
+            out.sort(key=lambda m: m.index)
+        return out
+
+
+_loaded = {}
+_loaded_lock = threading.Lock()
+
+
+def _load(spec, fresh=False):
+    """Rules for a load specification. Unpickled rules are loaded once per
+    process (a Dask worker loads the rules of many partitions once);
+    ``fresh``: loaded anew (``Rules.open`` sees a file's changes)."""
+    rules = None
+    if not fresh:
+        with _loaded_lock:
+            rules = _loaded.get(spec)
+    if rules is None:
+        if spec[0] == "open":
+            native = _cga.load(spec[1], list(spec[2]))
+        else:
+            _, path, text, served, disk, workspaces = spec
+            native = _cga.load_text(path, text, list(served), disk, list(workspaces))
+        rules = Rules(native, spec)
+        with _loaded_lock:
+            # Files change: only rules without errors are kept.
+            if not native.has_errors:
+                _loaded[spec] = rules
+    return rules
 
 
 def write(models, path):

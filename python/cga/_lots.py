@@ -116,7 +116,7 @@ def _check_crs(crs):
         )
 
 
-def normalize(lots, attrs, attribute_names):
+def normalize(lots, attrs, attribute_names, skip=False):
     """The native lots for ``lots``, with per-lot attributes from frame
     columns named like attributes (and ``seed``) and from ``attrs`` when
     it is a list (one mapping per lot). Returns ``(native_lots, common)``
@@ -162,6 +162,11 @@ def normalize(lots, attrs, attribute_names):
                 raise ValueError("the lot has no geometry")
             polygons, gis, own = _one(geom)
         except (ValueError, TypeError) as e:
+            if skip:
+                # (name, why): the native side lists it as invalid in its
+                # place, so that the other lots keep their indices and seeds.
+                out.append((ids[i], str(e)))
+                continue
             raise type(e)(f"lot {i} ({ids[i]}): {e}") from None
         lot_attrs = {k: v for k, v in own.items() if k in names}
         for c in columns:

@@ -175,8 +175,13 @@ impl NativeRules {
     /// polygons as lists of `(n, 3)` float64 rings. `geometry`: keep plain
     /// meshes; `output`: write them into this file instead (streamed).
     /// `progress(done)` is called on this thread at most ten times a second.
-    /// Returns `(models, stats)`: a dict per lot, and what the writer wrote.
-    #[pyo3(signature = (lots, attrs, seed, start_rule, jobs, geometry, output, progress, limits))]
+    /// `first_index`: the index of the first lot in a larger run (a Dask
+    /// partition's place): lots then get the seeds they have in that run.
+    /// `skip_invalid`: lots that cannot be made are left out and listed,
+    /// instead of raising `ValueError`.
+    /// Returns `(models, stats, invalid)`: a dict per lot, what the writer
+    /// wrote, and `(index, name, why)` of each lot left out.
+    #[pyo3(signature = (lots, attrs, seed, start_rule, jobs, geometry, output, progress, limits, first_index, skip_invalid))]
     #[allow(clippy::too_many_arguments)]
     fn generate<'py>(
         &self,
@@ -190,7 +195,13 @@ impl NativeRules {
         output: Option<PathBuf>,
         progress: Option<Bound<'py, PyAny>>,
         limits: Option<(usize, usize, f64, usize)>,
-    ) -> PyResult<(Vec<Bound<'py, PyDict>>, Option<Bound<'py, PyDict>>)> {
+        first_index: usize,
+        skip_invalid: bool,
+    ) -> PyResult<(
+        Vec<Bound<'py, PyDict>>,
+        Option<Bound<'py, PyDict>>,
+        Vec<(usize, String, String)>,
+    )> {
         let rules = &self.rules;
         if rules.has_errors() {
             return Err(to_py_err(rules.check_attributes(&Options::default()).err().unwrap_or(
@@ -200,7 +211,19 @@ impl NativeRules {
                 },
             )));
         }
-        let lots = read_lots(rules, lots)?;
+        let (mut lots, places, invalid) = read_lots(rules, lots, skip_invalid)?;
+        // A lot's seed depends on its place in the run: lots of a part of
+        // a run, or after lots left out, are given the seed of their
+        // place as their own (unless they have one, or the rules declare
+        // an attribute `seed`, which then is no seed).
+        if (first_index > 0 || !invalid.is_empty()) && rules.attribute("seed").is_none() {
+            for (lot, &place) in lots.iter_mut().zip(&places) {
+                if !lot.attrs.iter().any(|(n, _)| &**n == "seed") {
+                    let s = cga::lot_seed(seed, first_index + place);
+                    lot.attrs.push((Arc::from("seed"), Value::Float(s as f64)));
+                }
+            }
+        }
         let mut options = Options::default().seed(seed);
         options.start_rule = start_rule;
         for (name, value) in attrs {
@@ -283,7 +306,8 @@ impl NativeRules {
                 match got {
                     Ok(result) => {
                         if failure.is_none() {
-                            match model_dict(py, result) {
+                            let place = first_index + places[result.index];
+                            match model_dict(py, result, place) {
                                 Ok(d) => models.push(d),
                                 Err(e) => {
                                     cancel.cancel();
@@ -331,22 +355,62 @@ impl NativeRules {
             }
             None => None,
         };
-        Ok((models, stats))
+        let invalid = invalid
+            .into_iter()
+            .map(|(i, name, why)| (first_index + i, name, why))
+            .collect();
+        Ok((models, stats, invalid))
     }
 }
 
 /// Engine lots from the Python side's tuples, checked: a bad lot is a
-/// `ValueError` naming its index.
-fn read_lots(rules: &Rules, lots: &Bound<'_, PyList>) -> PyResult<Vec<cga::Lot>> {
+/// `ValueError` naming its index, or, with `skip`, left out and listed as
+/// `(index, name, why)`. Also gives each lot's index among `lots`.
+#[allow(clippy::type_complexity)]
+fn read_lots(
+    rules: &Rules,
+    lots: &Bound<'_, PyList>,
+    skip: bool,
+) -> PyResult<(Vec<cga::Lot>, Vec<usize>, Vec<(usize, String, String)>)> {
     let mut out = Vec::with_capacity(lots.len());
+    let mut places = Vec::with_capacity(lots.len());
+    let mut invalid = Vec::new();
     for (i, item) in lots.iter().enumerate() {
-        let (name, polygons, gis, attrs): (
+        match read_lot(rules, i, &item) {
+            Ok(lot) => {
+                out.push(lot);
+                places.push(i);
+            }
+            Err((name, why)) if skip => invalid.push((i, name, why)),
+            Err((name, why)) => {
+                return Err(PyValueError::new_err(format!("lot {i} ({name}): {why}")))
+            }
+        }
+    }
+    Ok((out, places, invalid))
+}
+
+/// One lot, or its name and why it cannot be made.
+/// `(name, why)` is a lot the Python side found invalid.
+fn read_lot(
+    rules: &Rules,
+    i: usize,
+    item: &Bound<'_, PyAny>,
+) -> Result<cga::Lot, (String, String)> {
+    if let Ok((name, why)) = item.extract::<(String, String)>() {
+        return Err((name, why));
+    }
+    {
+        type Item<'py> = (
             String,
-            Vec<Vec<PyReadonlyArray2<'_, f64>>>,
+            Vec<Vec<PyReadonlyArray2<'py, f64>>>,
             bool,
-            Vec<(String, Bound<'_, PyAny>)>,
-        ) = item.extract()?;
-        let bad = |why: String| PyValueError::new_err(format!("lot {i} ({name}): {why}"));
+            Vec<(String, Bound<'py, PyAny>)>,
+        );
+        let (name, polygons, gis, attrs): Item<'_> = item
+            .extract()
+            .map_err(|e| (format!("{i}"), format!("not a lot the package made: {e}")))?;
+        let bad = |why: String| (name.clone(), why);
         let mut rings_of = Vec::with_capacity(polygons.len());
         for polygon in &polygons {
             let mut rings = Vec::with_capacity(polygon.len());
@@ -385,9 +449,8 @@ fn read_lots(rules: &Rules, lots: &Bound<'_, PyList>) -> PyResult<Vec<cga::Lot>>
                 lot.attrs.push((Arc::from(attr.as_str()), v));
             }
         }
-        out.push(lot);
+        Ok(lot)
     }
-    Ok(out)
 }
 
 /// A Python value as a CGA value: bool, number, string, or a sequence of
@@ -504,9 +567,10 @@ fn array<'py, T: numpy::Element, const N: usize>(
     PyArray2::from_owned_array(py, a)
 }
 
-fn model_dict(py: Python<'_>, r: LotResult) -> PyResult<Bound<'_, PyDict>> {
+/// A lot's result as a dict; `index`: its place in the whole run.
+fn model_dict(py: Python<'_>, r: LotResult, index: usize) -> PyResult<Bound<'_, PyDict>> {
     let d = PyDict::new(py);
-    d.set_item("index", r.index)?;
+    d.set_item("index", index)?;
     d.set_item("name", &r.name)?;
     d.set_item("prints", &r.prints)?;
     let reports = r

@@ -107,9 +107,16 @@ pub fn from_polygons(
                     p[0], p[1], p[2]
                 ));
             }
-            let mut points = ring.as_slice();
-            if points.len() > 1 && points.first() == points.last() {
-                points = &points[..points.len() - 1];
+            // Repeated points (the closing one GeoJSON and shapely write,
+            // doubled vertices) are one corner.
+            let mut points: Vec<[f64; 3]> = Vec::with_capacity(ring.len());
+            for p in ring {
+                if points.last() != Some(p) {
+                    points.push(*p);
+                }
+            }
+            while points.len() > 1 && points.first() == points.last() {
+                points.pop();
             }
             if points.len() < 3 {
                 return Err(format!(

@@ -12,7 +12,8 @@ root=$(cd "$(dirname "$0")/../.." && pwd)
 cga=${1:-${CARGO_TARGET_DIR:-$root/target}/release/cga}
 runs=${2:-5}
 cga=$(realpath "$cga")
-oracle=$root/crates/cga-cli/tests/oracle
+# CityEngine's runtime packages and lots, outside the repository.
+oracle=${CGA_SHARED:-$root/../shared}/prt-oracle
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 
@@ -34,7 +35,7 @@ timed() {
 }
 
 cd "$oracle"
-candler=(generate candler/rules/candler.cga --lot lots/candler_footprint.obj)
+candler=(generate rules/candler/rules/candler.cga --lot lots/candler_footprint.obj)
 
 if command -v valgrind >/dev/null; then
     for what in "GLB written|-o $out/c.glb" "derivation only|"; do
@@ -50,7 +51,7 @@ read -r w c m < <(timed "$cga" "${candler[@]}" -o "$out/c.glb")
 echo "Candler on its footprint (one building, GLB): wall $w s, CPU $c s, peak $((m / 1024)) MiB"
 
 for jobs in 1 2; do
-    read -r w c m < <(timed "$cga" generate candler/rules/candler.cga \
+    read -r w c m < <(timed "$cga" generate rules/candler/rules/candler.cga \
         --lot grid:5x5:lots/candler_footprint.obj --jobs "$jobs" -o "$out/g.glb")
     per=$(awk -v w="$w" 'BEGIN { printf "%.1f", w / 25 * 1000 }')
     echo "25 Candler buildings (grid:5x5), --jobs $jobs: wall $w s ($per ms per building), CPU $c s, peak $((m / 1024)) MiB"

@@ -14,7 +14,8 @@ root=$(cd "$(dirname "$0")/../.." && pwd)
 cga=$(realpath "$1")
 out=$(realpath -m "$2")
 mkdir -p "$out"
-oracle=$root/crates/cga-cli/tests/oracle
+# CityEngine's runtime packages and lots, outside the repository.
+oracle=${CGA_SHARED:-$root/../shared}/prt-oracle
 
 run() { # name dir args...
     local name=$1 dir=$2
@@ -28,16 +29,16 @@ run() { # name dir args...
     sed -i "s|$out|OUT|g" "$out/$name".*.stderr
 }
 
-run candler.rect "$oracle" candler/rules/candler.cga --lot rect:20,30
-run candler.footprint "$oracle" candler/rules/candler.cga --lot lots/candler_footprint.obj
-run candler.3dprint "$oracle" candler/rules/candler.cga --lot lots/candler_footprint.obj --attr Mode=3DPrint
-run candler.grid "$oracle" candler/rules/candler.cga --lot grid:2x2:lots/candler_footprint.obj
-run identity "$oracle/identity" rules/identity.cga
-run fhv "$oracle/FacesHolesVerticesrule" rules/FacesHolesVerticesrule.cga
-run arrayAttrs "$oracle/arrayAttrs" rules/arrayAttrs.cga
-run arrayAttrs2d "$oracle/arrayAttrs2d" rules/arrayAttrs2d.cga
-run dynamic_imports "$oracle/dynamic_imports" rules/prt3_dynamic_imports/ruleA.cga
-run extrusion "$oracle/extrusion_rule" rules/extrusion_rule.cga --attr minBuildingHeight=23 --attr maxBuildingHeight=23
-run extrusion.seed "$oracle/extrusion_rule" rules/extrusion_rule.cga --seed 7
-run envelope "$oracle/envelope2002" rules/typology/envelope2002.cga --lot "$oracle/lots/building_parcel.obj" --seed 666
+run candler.rect "$oracle" rules/candler/rules/candler.cga --lot rect:20,30
+run candler.footprint "$oracle" rules/candler/rules/candler.cga --lot lots/candler_footprint.obj
+run candler.3dprint "$oracle" rules/candler/rules/candler.cga --lot lots/candler_footprint.obj --attr Mode=3DPrint
+run candler.grid "$oracle" rules/candler/rules/candler.cga --lot grid:2x2:lots/candler_footprint.obj
+run identity "$oracle/rules/identity" rules/identity.cga
+run fhv "$oracle/rules/FacesHolesVerticesrule" rules/FacesHolesVerticesrule.cga
+run arrayAttrs "$oracle/rules/arrayAttrs" rules/arrayAttrs.cga
+run arrayAttrs2d "$oracle/rules/arrayAttrs2d" rules/arrayAttrs2d.cga
+run dynamic_imports "$oracle/rules/dynamic_imports" rules/prt3_dynamic_imports/ruleA.cga
+run extrusion "$oracle/rules/extrusion_rule" rules/extrusion_rule.cga --attr minBuildingHeight=23 --attr maxBuildingHeight=23
+run extrusion.seed "$oracle/rules/extrusion_rule" rules/extrusion_rule.cga --seed 7
+run envelope "$oracle/rules/envelope2002" rules/typology/envelope2002.cga --lot "$oracle/lots/building_parcel.obj" --seed 666
 run city "$root" examples/building.cga --lot grid:6x6

@@ -67,6 +67,9 @@ enum Command {
         /// `text` for people, `json` (one object with all diagnostics) for tools.
         #[arg(long, value_enum, default_value_t = CheckFormat::Text)]
         format: CheckFormat,
+        /// The style of the rule file to check (default: its default style).
+        #[arg(long, value_name = "NAME")]
+        style: Option<String>,
         /// A CityEngine workspace folder (projects side by side) where paths
         /// such as `/ESRI.lib/rules/x.cga` are looked for after the rule
         /// file's own workspace; repeatable, then `CGA_WORKSPACE`.
@@ -80,7 +83,7 @@ struct GenerateArgs {
     /// The rule file (.cga).
     rules: PathBuf,
     /// A lot: `rect:W,D`, `grid:COLSxROWS`, an .obj file (each face one
-    /// lot) or a .geojson, .fgb, .gpkg or .shp file (each polygon one lot).
+    /// lot) or a .geojson, .fgb, .gpkg or .shp file (each feature one lot).
     /// Repeatable. Default: `rect:20,30`.
     #[arg(long = "lot", value_name = "SPEC")]
     lots: Vec<String>,
@@ -92,9 +95,18 @@ struct GenerateArgs {
     /// `skip` them or stop with an `error`; each is named in a warning.
     #[arg(long, value_name = "WHAT", default_value = "repair")]
     invalid: cga::InvalidPolicy,
+    /// Each polygon of a GIS feature (a MultiPolygon's parts) is a lot of
+    /// its own, named ID, ID.1, ...; by default a feature is one lot whose
+    /// polygons are the faces of one initial shape.
+    #[arg(long)]
+    split_multipolygons: bool,
     /// The start rule (default: the rule marked @StartRule, else `Lot`).
     #[arg(long, value_name = "NAME")]
     start_rule: Option<String>,
+    /// The style of the rule file to generate with (`style NAME` in the
+    /// file; default: its default style).
+    #[arg(long, value_name = "NAME")]
+    style: Option<String>,
     /// Set a rule attribute: a number, `true`/`false`, or a string. Repeatable.
     #[arg(long = "attr", value_name = "NAME=VALUE")]
     attrs: Vec<String>,
@@ -187,8 +199,9 @@ fn main() -> ExitCode {
             Command::Check {
                 rules,
                 format,
+                style,
                 workspaces,
-            } => check(&rules, format, &workspaces),
+            } => check(&rules, format, style.as_deref(), &workspaces),
         });
     let result = match worker.map(|w| w.join()) {
         Ok(Ok(r)) => r,
@@ -228,8 +241,15 @@ fn load(engine: &Engine, path: &Path) -> Result<Rules, Failure> {
     Ok(engine.load(path))
 }
 
-fn check(path: &Path, format: CheckFormat, workspaces: &[PathBuf]) -> Result<(), Failure> {
-    let engine = Engine::on_disk().workspaces(Workspaces::with_env(workspaces));
+fn check(
+    path: &Path,
+    format: CheckFormat,
+    style: Option<&str>,
+    workspaces: &[PathBuf],
+) -> Result<(), Failure> {
+    let engine = Engine::on_disk()
+        .workspaces(Workspaces::with_env(workspaces))
+        .style(style);
     let rules = load(&engine, path)?;
     if format == CheckFormat::Text {
         report_diagnostics(rules.diagnostics());
@@ -244,12 +264,20 @@ fn check(path: &Path, format: CheckFormat, workspaces: &[PathBuf]) -> Result<(),
             size.attributes,
             size.functions
         );
+        eprintln!("styles: {}", rules.styles().join(", "));
+        eprintln!("start rules: {}", rules.start_rules().join(", "));
         return Ok(());
     }
     let diagnostics: Vec<serde_json::Value> =
         rules.diagnostics().iter().map(diagnostic_json).collect();
     let ok = !rules.has_errors();
-    let doc = serde_json::json!({ "file": path.display().to_string(), "ok": ok, "diagnostics": diagnostics });
+    let doc = serde_json::json!({
+        "file": path.display().to_string(),
+        "ok": ok,
+        "diagnostics": diagnostics,
+        "styles": rules.styles(),
+        "start_rules": rules.start_rules(),
+    });
     println!("{}", serde_json::to_string_pretty(&doc).unwrap_or_default());
     if ok {
         Ok(())
@@ -292,6 +320,7 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
     let lot_options = cga::LotOptions {
         crs: args.crs.clone(),
         invalid: args.invalid,
+        split_multipolygons: args.split_multipolygons,
     };
     let lots = cga::lots::read_with(&args.lots, &lot_options)?;
     for note in &lots.notes {
@@ -302,7 +331,8 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
     }
     let engine = Engine::on_disk()
         .max_asset_mib(args.max_asset_mib)
-        .workspaces(Workspaces::with_env(&args.workspaces));
+        .workspaces(Workspaces::with_env(&args.workspaces))
+        .style(args.style.as_deref());
     let rules = load(&engine, &args.rules)?;
     report_diagnostics(rules.diagnostics());
     let mut options = Options {

@@ -27,4 +27,4 @@ pub use derive::{InitialInfo, Interp, Limits, LotOutput, RtError};
 pub use generate::{generate_lot, GenerateOptions};
 pub use locate::Workspaces;
 pub use program::Program;
-pub use resolve::{load, load_text, load_text_with, load_with, Loaded};
+pub use resolve::{load, load_text, load_text_with, load_with, LoadOptions, Loaded};

@@ -50,10 +50,22 @@ impl Loaded {
     }
 }
 
+/// How rule files are loaded besides the file itself.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct LoadOptions {
+    /// Where workspace paths (`/Project/...`) are looked for after the
+    /// rule file's own workspace.
+    pub workspaces: Workspaces,
+    /// The style of the main rule file to load (`style Modern`); `None` or
+    /// `Default` loads the default style. A name the file does not define
+    /// is an error naming the styles it does.
+    pub style: Option<String>,
+}
+
 /// Loads `path` and everything it imports from `world` into `sources`,
 /// parses and resolves.
 pub fn load(world: &dyn World, path: &Path, sources: &mut SourceMap) -> Loaded {
-    load_with(world, path, sources, &Workspaces::default())
+    load_with(world, path, sources, &LoadOptions::default())
 }
 
 /// Like [`load`], with workspace roots for imports that name a project
@@ -62,10 +74,10 @@ pub fn load_with(
     world: &dyn World,
     path: &Path,
     sources: &mut SourceMap,
-    workspaces: &Workspaces,
+    options: &LoadOptions,
 ) -> Loaded {
     match world.read_text(path) {
-        Ok(text) => load_text_with(world, path, text, sources, workspaces),
+        Ok(text) => load_text_with(world, path, text, sources, options),
         Err(e) => Loaded {
             program: Program::default(),
             diagnostics: vec![plain_error(format!(
@@ -79,7 +91,7 @@ pub fn load_with(
 /// Like [`load`] for rule text already in memory; `path` names it in
 /// diagnostics and is where its imports are searched from.
 pub fn load_text(world: &dyn World, path: &Path, text: String, sources: &mut SourceMap) -> Loaded {
-    load_text_with(world, path, text, sources, &Workspaces::default())
+    load_text_with(world, path, text, sources, &LoadOptions::default())
 }
 
 /// [`load_text`] with workspace roots.
@@ -88,12 +100,12 @@ pub fn load_text_with(
     path: &Path,
     text: String,
     sources: &mut SourceMap,
-    workspaces: &Workspaces,
+    options: &LoadOptions,
 ) -> Loaded {
     let mut r = Resolver {
         world,
         sources,
-        workspaces: workspaces.clone(),
+        workspaces: options.workspaces.clone(),
         program: Program::default(),
         diags: Vec::new(),
         tables: Vec::new(),
@@ -105,19 +117,19 @@ pub fn load_text_with(
         type_checks: Vec::new(),
     };
     let main = r.parse_file(path, text);
-    r.program.styles = std::iter::once("Default".to_string())
-        .chain(
-            r.parsed_files[main]
-                .module
-                .items
-                .iter()
-                .filter_map(|i| match i {
-                    Item::Style { name, .. } if name.name != "Default" => Some(name.name.clone()),
-                    _ => None,
-                }),
-        )
-        .collect();
-    r.instantiate(main, String::new(), None);
+    r.program.styles = module_styles(&r.parsed_files[main].module);
+    let style = match options.style.as_deref() {
+        Some(s) if !r.program.styles.iter().any(|d| d == s) => {
+            r.diags.push(plain_error(format!(
+                "unknown style `{s}`: {} defines the styles {}",
+                path.display(),
+                r.program.styles.join(", ")
+            )));
+            None
+        }
+        other => other,
+    };
+    r.instantiate(main, String::new(), None, style);
     r.resolve_pending();
     r.check_types();
     if let Some(t) = r.tables.first() {
@@ -218,6 +230,16 @@ struct Resolver<'s> {
     /// Binary operations whose operand types may be known before deriving
     /// (constants, attributes): checked once every attribute is resolved.
     type_checks: Vec<(ast::BinaryOp, RExpr, RExpr, Span)>,
+}
+
+/// The styles a module defines: `Default`, then each `style NAME` in order.
+fn module_styles(module: &ast::Module) -> Vec<String> {
+    std::iter::once("Default".to_string())
+        .chain(module.items.iter().filter_map(|i| match i {
+            Item::Style { name, .. } if name.name != "Default" => Some(name.name.clone()),
+            _ => None,
+        }))
+        .collect()
 }
 
 /// The items of a module as one style sees them: the items of the Default
@@ -441,6 +463,7 @@ impl Resolver<'_> {
         file_idx: usize,
         prefix: String,
         importer: Option<(RuleSetId, ast::ImportDecl)>,
+        main_style: Option<&str>,
     ) -> RuleSetId {
         let module = self.parsed_files[file_idx].module.clone();
         let path = self.parsed_files[file_idx].path.clone();
@@ -454,12 +477,30 @@ impl Resolver<'_> {
             importer.as_ref().and_then(|(_, d)| d.overrides.clone());
 
         // An import that lists styles (`import imp (mystyle) : "f.cga"`)
-        // generates with the first of them; everything else with Default.
-        let style: Option<String> = importer
-            .as_ref()
-            .and_then(|(_, d)| d.styles.as_ref())
-            .and_then(|list| list.first())
-            .map(|s| s.name.clone());
+        // generates with the first of them; the main file with the style
+        // asked for; everything else with Default.
+        let style: Option<String> = match &importer {
+            Some((_, d)) => d
+                .styles
+                .as_ref()
+                .and_then(|list| list.first())
+                .and_then(|s| {
+                    let defined = module_styles(&module);
+                    if defined.contains(&s.name) {
+                        return Some(s.name.clone());
+                    }
+                    self.diags.push(
+                        Diagnostic::error(format!("unknown style `{}`", s.name), s.span)
+                            .with_label(format!(
+                                "{} defines the styles {}",
+                                path.display(),
+                                defined.join(", ")
+                            )),
+                    );
+                    None
+                }),
+            None => main_style.map(str::to_string),
+        };
         let version = module_version(&module);
         for item in style_items(&module, style.as_deref()) {
             match item {
@@ -537,7 +578,7 @@ impl Resolver<'_> {
                 (None, _) => prefix.clone(),
             };
             self.stack.push(path.clone());
-            let child = self.instantiate(child_file, child_prefix, Some((rs, decl.clone())));
+            let child = self.instantiate(child_file, child_prefix, Some((rs, decl.clone())), None);
             self.stack.pop();
             if let Some(a) = alias {
                 self.tables[rs as usize].imports.insert(a, child);

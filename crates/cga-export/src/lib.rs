@@ -429,6 +429,15 @@ impl ModelWriter {
         }
     }
 
+    /// Starts the output of a lot named `name`: in OBJ a group (`g`) of its
+    /// own; glTF and GLB merge lots by material.
+    pub fn begin_lot(&mut self, name: &str) -> Result<(), ExportError> {
+        match &mut self.sink {
+            Sink::Obj(w, ..) => w.begin_group(name),
+            Sink::Gltf(..) => Ok(()),
+        }
+    }
+
     /// An encoder for this writer's format, for another thread: it does the
     /// work of [`add_placed`](ModelWriter::add_placed) there, and
     /// [`append`](ModelWriter::append) adds its batches. `None` for OBJ,

@@ -120,7 +120,11 @@ impl MaterialTable {
                 let id = self.materials.len() as u32;
                 e.insert(id);
                 self.materials.push(m.clone());
-                let name = unique_name(&m.name, &mut self.taken);
+                let name = if m.name.trim().is_empty() {
+                    unique_name(&derived_name(m), &mut self.taken)
+                } else {
+                    unique_name(&m.name, &mut self.taken)
+                };
                 self.names.push(name);
                 (id, true)
             }
@@ -143,6 +147,24 @@ impl MaterialTable {
     pub(crate) fn name(&self, id: u32) -> &str {
         &self.names[id as usize]
     }
+}
+
+/// The name of a material whose `material.name` is empty, from what it
+/// looks like: its colour map's file name without extension (`bricks` for
+/// `facade/bricks.jpg`), else its colour (`color_cc8844`), so that a user
+/// picking materials in a modelling program sees what each is.
+fn derived_name(m: &Material) -> String {
+    let map = m.maps[0].path.as_ref();
+    let file = map.rsplit(['/', '\\', ':']).next().unwrap_or_default();
+    let stem = match file.rsplit_once('.') {
+        Some((stem, _)) if !stem.is_empty() => stem,
+        _ => file,
+    };
+    if !stem.trim().is_empty() {
+        return stem.to_string();
+    }
+    let [r, g, b] = m.color.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8);
+    format!("color_{r:02x}{g:02x}{b:02x}")
 }
 
 /// A name usable in an MTL file (one token, no whitespace or control
@@ -232,8 +254,32 @@ mod tests {
         t.intern(&named("red_brick_2", 0.4));
         assert_eq!(t.name(0), "red_brick");
         assert_eq!(t.name(1), "red_brick_2");
-        assert_eq!(t.name(2), "material");
+        // Unnamed: by its colour (0.3 * 255 = 76.5, rounded to 77 = 0x4d).
+        assert_eq!(t.name(2), "color_4dffff");
         assert_eq!(t.name(3), "red_brick_2_2");
+    }
+
+    #[test]
+    fn unnamed_materials_are_named_by_their_colour_map() {
+        let mut t = MaterialTable::default();
+        let mapped = |path: &str, r: f64| {
+            let mut m = Material {
+                color: [r, 1.0, 1.0],
+                ..Material::default()
+            };
+            m.maps[0].path = path.into();
+            m
+        };
+        t.intern(&mapped("facade/bricks.jpg", 1.0));
+        t.intern(&mapped("other/bricks.png", 1.0));
+        t.intern(&mapped("builtin:uvtest.png", 1.0));
+        t.intern(&mapped("C:\\tex\\roof tiles.jpg", 1.0));
+        t.intern(&mapped("", 0.0));
+        assert_eq!(t.name(0), "bricks");
+        assert_eq!(t.name(1), "bricks_2");
+        assert_eq!(t.name(2), "uvtest");
+        assert_eq!(t.name(3), "roof_tiles");
+        assert_eq!(t.name(4), "color_00ffff");
     }
 
     #[test]

@@ -146,6 +146,26 @@ impl ObjWriter {
         self.corner_refs.resize(mesh.corners.len(), [0; 3]);
     }
 
+    /// Starts the group of a lot: `g NAME` (whitespace in the name made
+    /// `_`), so that a modelling program can pick one building out of a
+    /// city. Each group names its material again.
+    pub(crate) fn begin_group(&mut self, name: &str) -> Result<(), ExportError> {
+        let name: String = name
+            .trim()
+            .chars()
+            .map(|c| {
+                if c.is_whitespace() || c.is_control() {
+                    '_'
+                } else {
+                    c
+                }
+            })
+            .collect();
+        let name = if name.is_empty() { "lot".into() } else { name };
+        self.current = None;
+        writeln!(self.out, "g {name}").map_err(|e| ExportError::io(&self.path, e))
+    }
+
     pub(crate) fn add_face(&mut self, f: &FaceData) -> Result<(), ExportError> {
         let mesh = f.mesh;
         let uvs = mesh.uvs[0].as_deref();

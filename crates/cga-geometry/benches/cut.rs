@@ -10,19 +10,8 @@
 //! CGA's `split` passes them; a facade quad with UVs into 10 tiles; a
 //! 16-sided cylinder into 20 slabs; the 64 x 64 sphere (4,096 faces) into 50.
 //!
-//! Instructions per call (callgrind, the repeatable measure) and time per
-//! call (`cut_timing`, both builds run back to back on the shared 2-core
-//! build machine; noisy), before and after the allocation-free rewrite of
-//! the cutter with its fast path for simple splits (same output, bit for
-//! bit):
-//!
-//! | case | instructions before | after | ratio | time before | after |
-//! | --- | ---: | ---: | ---: | ---: | ---: |
-//! | box_4 | 230,472 | 70,155 | 3.3x | 16.9 us | 5.3 us |
-//! | box_12 | 791,931 | 233,435 | 3.4x | 60.1 us | 17.2 us |
-//! | quad_10 | 194,119 | 63,471 | 3.1x | 14.9 us | 5.5 us |
-//! | cylinder16_20 | 4,535,749 | 1,522,265 | 3.0x | 350 us | 112 us |
-//! | sphere4096_50 | 87,549,662 | 44,487,177 | 2.0x | 8.1 ms | 4.6 ms |
+//! The numbers before and after the allocation-free rewrite of the cutter
+//! are in `docs/performance.md` ("The plane cut").
 //!
 //! What remains for the small cases is largely the output itself: each part
 //! is a `Mesh` of five to seven vectors and a clone of the material list

@@ -36,6 +36,7 @@ pub mod asset_mesh;
 pub mod boolean;
 pub mod cleanup;
 pub mod collada;
+pub mod components;
 pub mod convexify;
 pub mod cut;
 pub mod envelope;

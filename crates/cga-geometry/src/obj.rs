@@ -412,25 +412,14 @@ mod tests {
     use crate::measure::{bounds, face_area, mesh_area, volume};
     use crate::topology::Topology;
 
-    /// The Candler assets live outside the repository, in the shared oracle
-    /// folder (beside the repository, or at /work/shared).
+    /// The Candler assets live outside the repository, in the oracle's
+    /// package (`../shared/prt-oracle/rules/candler/assets`).
     fn candler(rel: &str) -> Option<PathBuf> {
-        let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
-        [
-            manifest.join("../../../shared"),
-            manifest.join("../../../../shared"),
-            PathBuf::from("/work/shared"),
-        ]
-        .into_iter()
-        .map(|s| s.join("prt-oracle/rules/candler/assets").join(rel))
-        .find(|p| p.exists())
+        cga_testkit::shared(&format!("prt-oracle/rules/candler/assets/{rel}"))
     }
 
     fn load_candler(rel: &str) -> Option<ObjAsset> {
-        let Some(p) = candler(rel) else {
-            eprintln!("skipped: shared/prt-oracle asset {rel} not found");
-            return None;
-        };
+        let p = candler(rel)?;
         Some(load_obj(&p).expect("asset loads"))
     }
 

@@ -114,7 +114,15 @@ impl Rules {
             lots: lots.len(),
             ..Summary::default()
         };
+        // The lot whose output was begun last (OBJ groups per lot).
+        let mut begun: Option<usize> = None;
         let mut take = |i: usize, taken: Taken<Piece, Done>| -> Result<(), Error> {
+            if begun != Some(i) {
+                begun = Some(i);
+                if let Some(w) = writer.as_deref_mut() {
+                    w.begin_lot(&lots[i].name).map_err(Error::Export)?;
+                }
+            }
             let mut result = Ok(());
             let mut write = |piece| {
                 if let (Some(w), Ok(())) = (writer.as_deref_mut(), &result) {

@@ -160,7 +160,7 @@ pub fn from_polygons(
 /// Lots from specifications as the `cga` command takes them (`--lot`):
 /// `rect:W,D`, `grid:COLSxROWS[:LOTS.obj]` (a synthetic city of lots in a
 /// grid), an `.obj` file (each face one lot), or a GIS file: `.geojson`,
-/// `.json`, `.fgb`, `.gpkg` or `.shp` (each polygon one lot, feature
+/// `.json`, `.fgb`, `.gpkg` or `.shp` (each feature one lot, feature
 /// properties as attributes, projected into one local metric frame when
 /// georeferenced; see `docs/geographic.md`). No specification:
 /// `rect:20,30`. Each file's own CRS, invalid lots repaired: see

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use cga_engine::assets::{AssetStore, Assets};
 use cga_engine::context::ContextUse;
 use cga_engine::program::Program;
-use cga_engine::Workspaces;
+use cga_engine::{LoadOptions, Workspaces};
 use cga_syntax::SourceMap;
 use cga_world::{DiskWorld, World};
 
@@ -22,9 +22,9 @@ use crate::Error;
 pub struct Engine {
     world: Arc<dyn World>,
     store: Arc<AssetStore>,
-    /// Where workspace paths (`/Project/...`) are looked for after the rule
-    /// file's own workspace.
-    workspaces: Workspaces,
+    /// Where workspace paths (`/Project/...`) are looked for, and the
+    /// style rule files are loaded with.
+    options: LoadOptions,
 }
 
 impl Engine {
@@ -39,7 +39,7 @@ impl Engine {
         Engine {
             store: Arc::new(AssetStore::new(world.clone())),
             world,
-            workspaces: Workspaces::default(),
+            options: LoadOptions::default(),
         }
     }
 
@@ -48,7 +48,16 @@ impl Engine {
     /// looked for after the rule file's own workspace (`--workspace`,
     /// `CGA_WORKSPACE`; see `cga_engine::locate`).
     pub fn workspaces(mut self, workspaces: Workspaces) -> Engine {
-        self.workspaces = workspaces;
+        self.options.workspaces = workspaces;
+        self
+    }
+
+    /// Sets the style the main rule file is loaded with (`style Modern`
+    /// in the file; `None` or `"Default"` for its default style). A style
+    /// the file does not define is an error of the loaded rules naming
+    /// the styles it does ([`Rules::styles`] lists them).
+    pub fn style(mut self, style: Option<&str>) -> Engine {
+        self.options.style = style.map(str::to_string);
         self
     }
 
@@ -63,7 +72,7 @@ impl Engine {
         Engine {
             store: Arc::new(AssetStore::new(self.world.clone()).with_max_file_mib(mib)),
             world: self.world,
-            workspaces: self.workspaces,
+            options: self.options,
         }
     }
 
@@ -81,7 +90,7 @@ impl Engine {
         }
         on_big_stack(|| {
             let mut sources = SourceMap::new();
-            let loaded = cga_engine::load_with(&*self.world, path, &mut sources, &self.workspaces);
+            let loaded = cga_engine::load_with(&*self.world, path, &mut sources, &self.options);
             self.rules(path, loaded, sources)
         })
     }
@@ -93,13 +102,8 @@ impl Engine {
         let text = text.into();
         on_big_stack(|| {
             let mut sources = SourceMap::new();
-            let loaded = cga_engine::load_text_with(
-                &*self.world,
-                path,
-                text,
-                &mut sources,
-                &self.workspaces,
-            );
+            let loaded =
+                cga_engine::load_text_with(&*self.world, path, text, &mut sources, &self.options);
             self.rules(path, loaded, sources)
         })
     }
@@ -147,7 +151,7 @@ impl Engine {
                 AssetStore::new(world.clone()).with_max_file_mib(self.store.max_file_mib()),
             ),
             world,
-            workspaces: self.workspaces.clone(),
+            options: self.options.clone(),
         };
         engine.load(root.join(main))
     }
@@ -159,8 +163,8 @@ impl Engine {
             .map(|d| Diagnostic::new(d, &sources))
             .collect();
         let program = loaded.program;
-        let assets =
-            Assets::new(self.store.clone(), &sources).with_workspaces(self.workspaces.clone());
+        let assets = Assets::new(self.store.clone(), &sources)
+            .with_workspaces(self.options.workspaces.clone());
         let context_use = ContextUse::of(&program);
         let mut rules = Rules {
             inner: Arc::new(Inner {

@@ -43,6 +43,11 @@ pub struct LotOptions {
     pub crs: Option<CrsOption>,
     /// `--invalid`: what to do with invalid lots.
     pub invalid: InvalidPolicy,
+    /// `--split-multipolygons`: each polygon of a feature is a lot of its
+    /// own (`ID`, `ID.1`, ...). Without it a feature is one lot, its
+    /// polygons the faces of one initial shape, as CityEngine imports a
+    /// MultiPolygon.
+    pub split_multipolygons: bool,
 }
 
 /// Something to tell the user about the lots.
@@ -67,6 +72,39 @@ const NAMED_INVALID: usize = 20;
 /// The lot file formats, by extension.
 fn is_gis_file(ext: &str) -> bool {
     matches!(ext, "geojson" | "json" | "fgb" | "gpkg" | "shp")
+}
+
+/// The warning for the lots of an OBJ file whose normal points down (wound
+/// clockwise seen from above): CityEngine keeps them as they are, so their
+/// extrusions go down, which is rarely what was meant.
+fn clockwise_warning(path: &Path, lots: &[Lot]) -> Option<String> {
+    let down: Vec<usize> = lots
+        .iter()
+        .enumerate()
+        .filter(|(_, lot)| {
+            lot.mesh.faces.len() == 1 && cga_geometry::measure::face_normal(&lot.mesh, 0).y < -1e-9
+        })
+        .map(|(i, _)| i)
+        .collect();
+    if down.is_empty() {
+        return None;
+    }
+    const SHOWN: usize = 10;
+    let mut names: Vec<String> = down
+        .iter()
+        .take(SHOWN)
+        .map(|i| format!("face {i}"))
+        .collect();
+    if down.len() > SHOWN {
+        names.push(format!("and {} more", down.len() - SHOWN));
+    }
+    Some(format!(
+        "{}: {} of {} lots are wound clockwise (their normal points down, so extrusions go down, as in CityEngine): {}; reverse their vertex order to build upwards",
+        path.display(),
+        down.len(),
+        lots.len(),
+        names.join(", ")
+    ))
 }
 
 /// Reads the lots of `--lot` options: `rect:W,D`, `grid:COLSxROWS[:LOTS.obj]`,
@@ -100,7 +138,11 @@ pub fn read_lots(specs: &[String], options: &LotOptions) -> Result<LotSet, Strin
             .map(|e| e.to_ascii_lowercase())
             .unwrap_or_default();
         if ext == "obj" {
-            parts.push(Ok(crate::lot::from_obj(path)?));
+            let lots = crate::lot::from_obj(path)?;
+            if let Some(w) = clockwise_warning(path, &lots) {
+                reader.messages.push(Message::Warning(w));
+            }
+            parts.push(Ok(lots));
         } else if is_gis_file(&ext) {
             let start = reader.pending.len();
             reader.read_file(path, &ext)?;
@@ -388,6 +430,8 @@ impl Reader {
         let mut lots = Vec::with_capacity(self.pending.len());
         let mut counts = Vec::with_capacity(self.pending.len());
         let mut invalid = 0usize;
+        // The feature (source, index) whose lot was made last.
+        let mut last_feature: Option<(u32, usize)> = None;
         for mut p in self.pending {
             let georeferenced = geo_sources[p.source as usize];
             if let (true, Some(tm)) = (georeferenced, &projection) {
@@ -427,7 +471,10 @@ impl Reader {
                     }
                     (InvalidPolicy::Skip, _) | (InvalidPolicy::Repair, 0) => "left out".to_string(),
                     (InvalidPolicy::Repair, 1) => "repaired".to_string(),
-                    (InvalidPolicy::Repair, n) => format!("repaired into {n} lots"),
+                    (InvalidPolicy::Repair, n) if self.options.split_multipolygons => {
+                        format!("repaired into {n} lots")
+                    }
+                    (InvalidPolicy::Repair, n) => format!("repaired into {n} polygons"),
                 };
                 invalid += 1;
                 if invalid <= NAMED_INVALID {
@@ -442,6 +489,36 @@ impl Reader {
                     counts.push(0);
                     continue;
                 }
+            }
+            if !self.options.split_multipolygons {
+                // One shape per feature: its polygons (and a repair's
+                // pieces) are the faces of one lot.
+                let feature = (p.source, p.place.index);
+                if checked.repaired.is_empty() {
+                    counts.push(0);
+                    continue;
+                }
+                let lot = match lots.last_mut() {
+                    Some(lot) if last_feature == Some(feature) => {
+                        counts.push(0);
+                        lot
+                    }
+                    _ => {
+                        counts.push(1);
+                        last_feature = Some(feature);
+                        lots.push(Lot {
+                            name: p.name.clone(),
+                            mesh: Mesh::new(),
+                            attrs: p.attrs,
+                            geo_origin: if georeferenced { frame } else { None },
+                        });
+                        lots.last_mut().expect("just pushed")
+                    }
+                };
+                for polygon in &checked.repaired {
+                    add_polygon(&mut lot.mesh, polygon);
+                }
+                continue;
             }
             counts.push(checked.repaired.len() as u32);
             for (k, polygon) in checked.repaired.into_iter().enumerate() {
@@ -531,6 +608,12 @@ fn add_feature(
 /// `(x, z, -y)`, outer ring counter-clockwise seen from above.
 fn polygon_mesh(polygon: &Polygon) -> Mesh {
     let mut mesh = Mesh::new();
+    add_polygon(&mut mesh, polygon);
+    mesh
+}
+
+/// Adds `polygon` to `mesh` as a face (x east, y up, z south).
+fn add_polygon(mesh: &mut Mesh, polygon: &Polygon) {
     let mut loops: Vec<Vec<u32>> = Vec::with_capacity(polygon.len());
     for ring in polygon {
         let start = mesh.positions.len() as u32;
@@ -541,5 +624,4 @@ fn polygon_mesh(polygon: &Polygon) -> Mesh {
     crate::lot::orient_rings(&mesh.positions, &mut loops);
     let refs: Vec<&[u32]> = loops.iter().map(|l| l.as_slice()).collect();
     mesh.add_face(&refs, 0);
-    mesh
 }

@@ -40,7 +40,12 @@
 
 use std::sync::Arc;
 
-use cga_geometry::mesh::{Face, Loop, SharedVec};
+use cga_geometry::components::{
+    face_frame, face_of_corner, frame_from_x_y, frame_from_x_z, frame_from_z, loop_of_corner,
+    next_corner, prev_corner, reverse_keep_first, stored_normal, to_frame, SubmeshBuilder,
+    UnionFind,
+};
+use cga_geometry::mesh::Face;
 use cga_geometry::{measure, DMat3, DVec3, Mesh, Topology};
 use cga_syntax::ast::{BinaryOp, BlockOp};
 use cga_syntax::Span;
@@ -148,7 +153,7 @@ pub(crate) struct Components {
     eave_use: Vec<Option<cga_geometry::topology::EdgeUse>>,
     frames: Frames,
     parent: ParentFrames,
-    builder: MeshBuilder,
+    builder: SubmeshBuilder,
     /// `isTagged` results per query (see `tag_match`).
     tag_cache: Vec<TagMatch>,
 }
@@ -185,7 +190,7 @@ impl Components {
             Kind::Faces | Kind::Groups | Kind::Materials | Kind::Holes
         );
         let mut c = Components {
-            builder: MeshBuilder::new(&mesh),
+            builder: SubmeshBuilder::new(&mesh),
             mesh,
             kind,
             items: Vec::new(),
@@ -777,7 +782,11 @@ impl Components {
             Align::ZUp => self.item_frame(first, upward),
             Align::NoAlign => (DVec3::ZERO, DMat3::IDENTITY),
         };
-        let mut mesh = self.builder.begin(&self.mesh, self.kind);
+        let points = matches!(
+            self.kind,
+            Kind::Edges | Kind::FaceEdges | Kind::Vertices | Kind::FaceVertices
+        );
+        let mut mesh = self.builder.begin(&self.mesh, points);
         // Room for the corners of the faces taken (edges and vertices are a
         // corner or two), so the component's arrays are allocated once.
         let corners: usize = set
@@ -901,7 +910,7 @@ impl Components {
         self.topology();
         let topo = self.topo.as_ref().expect("just computed");
         let mesh = &*self.mesh;
-        let mut dsu = Dsu::new(sel.len());
+        let mut dsu = UnionFind::new(sel.len());
         match self.kind {
             Kind::Faces | Kind::Groups | Kind::Materials | Kind::Holes => {
                 // The selected component each face belongs to.
@@ -1004,421 +1013,6 @@ impl Components {
             sets[set_of_root[r] as usize].push(k);
         }
         sets
-    }
-}
-
-/// Union-find over `0..n`.
-struct Dsu(Vec<usize>);
-
-impl Dsu {
-    fn new(n: usize) -> Dsu {
-        Dsu((0..n).collect())
-    }
-    fn find(&mut self, mut i: usize) -> usize {
-        while self.0[i] != i {
-            self.0[i] = self.0[self.0[i]];
-            i = self.0[i];
-        }
-        i
-    }
-    fn union(&mut self, a: usize, b: usize) {
-        let (a, b) = (self.find(a), self.find(b));
-        // The smaller root wins, so roots are first members.
-        if a < b {
-            self.0[b] = a;
-        } else if b < a {
-            self.0[a] = b;
-        }
-    }
-}
-
-fn loop_of_corner(mesh: &Mesh, face: usize, corner: usize) -> Loop {
-    mesh.face_loops(face)
-        .iter()
-        .copied()
-        .find(|l| mesh.loop_corners(*l).contains(&corner))
-        .unwrap_or(mesh.outer_loop(face))
-}
-
-/// The corner after `corner` in its loop.
-fn next_corner(mesh: &Mesh, corner: usize) -> usize {
-    let l = containing_loop(mesh, corner);
-    let r = mesh.loop_corners(l);
-    if corner + 1 == r.end {
-        r.start
-    } else {
-        corner + 1
-    }
-}
-
-fn prev_corner(mesh: &Mesh, corner: usize) -> usize {
-    let l = containing_loop(mesh, corner);
-    let r = mesh.loop_corners(l);
-    if corner == r.start {
-        r.end - 1
-    } else {
-        corner - 1
-    }
-}
-
-/// The loop a corner belongs to (loops are sorted by their first corner).
-fn containing_loop(mesh: &Mesh, corner: usize) -> Loop {
-    let i = mesh
-        .loops
-        .partition_point(|l| l.start as usize <= corner)
-        .saturating_sub(1);
-    mesh.loops[i]
-}
-
-fn face_of_corner(mesh: &Mesh, corner: usize) -> usize {
-    let lp = mesh
-        .loops
-        .partition_point(|l| l.start as usize <= corner)
-        .saturating_sub(1) as u32;
-    mesh.faces
-        .partition_point(|f| f.first_loop <= lp)
-        .saturating_sub(1)
-}
-
-/// The normal stored on a corner, if the mesh carries normals.
-fn stored_normal(mesh: &Mesh, corner: usize) -> Option<DVec3> {
-    mesh.normals
-        .as_ref()
-        .and_then(|n| n.get(corner).copied())
-        .and_then(|n| n.try_normalize())
-}
-
-/// Reverses a closed polygon keeping its first point first.
-fn reverse_keep_first<T>(pts: &mut [T]) {
-    if pts.len() > 2 {
-        pts[1..].reverse();
-    }
-}
-
-/// The unit part of `c` orthogonal to the unit vector `v`, unless `c` is
-/// (nearly) parallel to `v` or zero.
-fn orthogonal_part(c: DVec3, v: DVec3) -> Option<DVec3> {
-    let r = c - v * c.dot(v);
-    (r.length() > 1e-9 * c.length()).then(|| r.normalize())
-}
-
-/// A unit vector perpendicular to the unit vector `v`: the first candidate
-/// not parallel to it, made orthogonal.
-fn perpendicular(v: DVec3, candidates: &[DVec3]) -> DVec3 {
-    candidates
-        .iter()
-        .find_map(|&c| orthogonal_part(c, v))
-        .unwrap_or_else(|| v.any_orthonormal_vector())
-}
-
-/// The frame of a face: x along its first edge, z along `normal`.
-fn face_frame(pts: &[DVec3], normal: DVec3, stored: Option<DVec3>) -> (DVec3, DMat3) {
-    let origin = pts.first().copied().unwrap_or(DVec3::ZERO);
-    // "The first edge": from the first vertex to the next distinct one.
-    let x = pts
-        .iter()
-        .skip(1)
-        .map(|&p| p - origin)
-        .find(|d| d.length_squared() > 1e-24)
-        .unwrap_or(DVec3::X);
-    let z = if normal != DVec3::ZERO {
-        normal
-    } else {
-        stored.unwrap_or(DVec3::ZERO)
-    };
-    (origin, frame_from_x_z(x, z))
-}
-
-/// Right-handed axes with x along `x` and z as close to `z` as is
-/// orthogonal to x.
-fn frame_from_x_z(x: DVec3, z: DVec3) -> DMat3 {
-    let x = x.try_normalize().unwrap_or(DVec3::X);
-    let z =
-        orthogonal_part(z, x).unwrap_or_else(|| perpendicular(x, &[DVec3::Z, DVec3::Y, DVec3::X]));
-    DMat3::from_cols(x, z.cross(x), z)
-}
-
-/// Right-handed axes with x along `x` and y as close to `y` as is
-/// orthogonal to x (z = x × y).
-fn frame_from_x_y(x: DVec3, y: DVec3) -> DMat3 {
-    let x = x.try_normalize().unwrap_or(DVec3::X);
-    let y =
-        orthogonal_part(y, x).unwrap_or_else(|| perpendicular(x, &[DVec3::Y, DVec3::Z, DVec3::X]));
-    DMat3::from_cols(x, y, x.cross(y))
-}
-
-/// Right-handed axes with z along `z` and x as close to the current x axis
-/// as is orthogonal to z (a vertex frame).
-fn frame_from_z(z: DVec3) -> DMat3 {
-    let z = z.try_normalize().unwrap_or(DVec3::Z);
-    let x = perpendicular(z, &[DVec3::X, DVec3::Z, DVec3::Y]);
-    DMat3::from_cols(x, z.cross(x), z)
-}
-
-/// Maps `mesh` (parent scope-local) into the frame `(origin, axes)`, then
-/// moves it so that its bounding box starts at zero. Returns the bounding
-/// box in the frame. Coordinates within rounding noise of zero are set to
-/// zero so that flat components have exactly zero scope sizes.
-fn to_frame(mesh: &mut Mesh, origin: DVec3, axes: DMat3) -> (DVec3, DVec3) {
-    let inv = axes.transpose();
-    let extent = mesh
-        .positions
-        .iter()
-        .fold(0.0f64, |m, p| m.max((*p - origin).abs().max_element()));
-    let snap = 1e-11 * extent.max(1.0);
-    let clean = |v: f64| if v.abs() <= snap { 0.0 } else { v };
-    for p in &mut mesh.positions {
-        let q = inv * (*p - origin);
-        *p = DVec3::new(clean(q.x), clean(q.y), clean(q.z));
-    }
-    if let Some(normals) = &mut mesh.normals {
-        for n in normals {
-            *n = inv * *n;
-        }
-    }
-    let mut it = mesh.corners.iter().map(|&c| mesh.positions[c as usize]);
-    let Some(first) = it.next() else {
-        return (DVec3::ZERO, DVec3::ZERO);
-    };
-    let (lo, hi) = it.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p)));
-    if lo != DVec3::ZERO {
-        for p in &mut mesh.positions {
-            *p -= lo;
-        }
-    }
-    (lo, hi)
-}
-
-/// Copies parts of a mesh into new meshes, with their per-corner
-/// attributes, materials and groups. The position map is reused between
-/// components and reset after each, so that splitting a mesh of `n` faces
-/// costs O(size of the mesh), not O(n × positions).
-struct MeshBuilder {
-    remap: Vec<u32>,
-    touched: Vec<u32>,
-    mat_remap: Vec<u32>,
-    group_remap: Vec<u32>,
-    /// The source slots the component uses, in order of first use: its
-    /// material slots and groups (see `finish`).
-    used_mats: Vec<u32>,
-    used_groups: Vec<u32>,
-    /// Edge and vertex components carry their normal on their corners.
-    force_normals: bool,
-}
-
-impl MeshBuilder {
-    fn new(src: &Mesh) -> MeshBuilder {
-        MeshBuilder {
-            remap: vec![u32::MAX; src.positions.len()],
-            touched: Vec::new(),
-            mat_remap: vec![u32::MAX; src.materials.len()],
-            group_remap: vec![u32::MAX; src.groups.len()],
-            used_mats: Vec::new(),
-            used_groups: Vec::new(),
-            force_normals: false,
-        }
-    }
-
-    fn begin(&mut self, src: &Mesh, kind: Kind) -> Mesh {
-        // Material slots and groups are set by `finish`.
-        let mut m = Mesh::new();
-        for (dst, s) in m.uvs.iter_mut().zip(&src.uvs) {
-            if s.is_some() {
-                *dst = Some(Vec::new());
-            }
-        }
-        self.force_normals = matches!(
-            kind,
-            Kind::Edges | Kind::FaceEdges | Kind::Vertices | Kind::FaceVertices
-        );
-        if src.normals.is_some() || self.force_normals {
-            m.normals = Some(Vec::new());
-        }
-        // Components keep their tags: the source's tag table is shared.
-        m.tags = src.tags.clone();
-        if src.edge_tags.is_some() {
-            m.edge_tags = Some(Vec::new());
-        }
-        if src.vertex_tags.is_some() {
-            m.vertex_tags = Some(Vec::new());
-        }
-        m
-    }
-
-    fn position(&mut self, src: &Mesh, out: &mut Mesh, p: u32) -> u32 {
-        let slot = &mut self.remap[p as usize];
-        if *slot == u32::MAX {
-            *slot = out.positions.len() as u32;
-            out.positions.push(src.positions[p as usize]);
-            self.touched.push(p);
-        }
-        *slot
-    }
-
-    fn slots(&mut self, src: &Mesh, face: usize) -> (u32, u32) {
-        let f = src.faces[face];
-        let m = f.material as usize;
-        if self.mat_remap.get(m) == Some(&u32::MAX) {
-            self.mat_remap[m] = self.used_mats.len() as u32;
-            self.used_mats.push(m as u32);
-        }
-        let g = f.group as usize;
-        if self.group_remap.get(g) == Some(&u32::MAX) {
-            self.group_remap[g] = self.used_groups.len() as u32;
-            self.used_groups.push(g as u32);
-        }
-        (
-            self.mat_remap.get(m).copied().unwrap_or(0),
-            self.group_remap.get(g).copied().unwrap_or(0),
-        )
-    }
-
-    /// Appends corner `c` of `src` (position and attributes; `normal`
-    /// replaces the stored normal if given).
-    fn corner(&mut self, src: &Mesh, out: &mut Mesh, c: usize, normal: Option<DVec3>) {
-        let p = self.position(src, out, src.corners[c]);
-        out.corners.push(p);
-        for (dst, s) in out.uvs.iter_mut().zip(&src.uvs) {
-            if let (Some(dst), Some(s)) = (dst.as_mut(), s.as_ref()) {
-                dst.push(s.get(c).copied().unwrap_or_default());
-            }
-        }
-        if let Some(dst) = out.normals.as_mut() {
-            let n = normal
-                .or_else(|| src.normals.as_ref().and_then(|n| n.get(c).copied()))
-                .unwrap_or(DVec3::ZERO);
-            dst.push(n);
-        }
-        if let Some(dst) = out.edge_tags.as_mut() {
-            dst.push(src.edge_tag_index(c));
-        }
-        if let Some(dst) = out.vertex_tags.as_mut() {
-            dst.push(src.vertex_tag_index(c));
-        }
-    }
-
-    fn add_face(&mut self, src: &Mesh, out: &mut Mesh, face: usize) {
-        let (material, group) = self.slots(src, face);
-        let first_loop = out.loops.len() as u32;
-        let loops = src.face_loops(face);
-        for &l in loops {
-            let start = out.corners.len() as u32;
-            for c in src.loop_corners(l) {
-                self.corner(src, out, c, None);
-            }
-            out.loops.push(Loop { start, len: l.len });
-        }
-        out.faces.push(Face {
-            first_loop,
-            loop_count: loops.len() as u32,
-            material,
-            group,
-            tags: src.faces[face].tags,
-        });
-    }
-
-    /// A hole loop as a face of its own, facing like the face it is cut
-    /// from (the clockwise hole loop reversed, first corner kept).
-    fn add_hole(&mut self, src: &Mesh, out: &mut Mesh, face: usize, lp: usize) {
-        let (material, group) = self.slots(src, face);
-        let l = src.loops[lp];
-        let mut corners: Vec<usize> = src.loop_corners(l).collect();
-        reverse_keep_first(&mut corners);
-        let start = out.corners.len() as u32;
-        for c in corners {
-            self.corner(src, out, c, None);
-        }
-        // Reversed keeping the first corner: the edges run in reverse order.
-        let r = start as usize..out.corners.len();
-        if let Some(e) = out.edge_tags.as_mut() {
-            for (k, c) in src.loop_corners(l).enumerate() {
-                e[r.end - 1 - k] = src.edge_tag_index(c);
-            }
-        }
-        out.loops.push(Loop { start, len: l.len });
-        out.faces.push(Face {
-            first_loop: out.loops.len() as u32 - 1,
-            loop_count: 1,
-            material,
-            group,
-            tags: src.faces[face].tags,
-        });
-    }
-
-    /// An edge (two corners) or a vertex (one corner) as a face, with
-    /// `normal` stored on its corners.
-    fn add_points(
-        &mut self,
-        src: &Mesh,
-        out: &mut Mesh,
-        corners: &[usize],
-        face: usize,
-        normal: DVec3,
-    ) {
-        let (material, group) = self.slots(src, face);
-        let start = out.corners.len() as u32;
-        for &c in corners {
-            self.corner(src, out, c, Some(normal));
-        }
-        // Both corners of an edge shape stand for the one edge.
-        if let (Some(e), [c0, _]) = (out.edge_tags.as_mut(), corners) {
-            let t = src.edge_tag_index(*c0);
-            let n = e.len();
-            e[n - 2..].fill(t);
-        }
-        out.loops.push(Loop {
-            start,
-            len: corners.len() as u32,
-        });
-        out.faces.push(Face {
-            first_loop: out.loops.len() as u32 - 1,
-            loop_count: 1,
-            material,
-            group,
-            tags: src.faces[face].tags,
-        });
-    }
-
-    /// Resets the maps for the next component and completes `out`.
-    fn finish(&mut self, src: &Mesh, out: &mut Mesh) {
-        for p in self.touched.drain(..) {
-            self.remap[p as usize] = u32::MAX;
-        }
-        for &m in &self.used_mats {
-            self.mat_remap[m as usize] = u32::MAX;
-        }
-        for &g in &self.used_groups {
-            self.group_remap[g as usize] = u32::MAX;
-        }
-        // The slots used, in order of first use. When that is the source's
-        // whole list in order (a one-material mesh, the usual case), the
-        // component shares the source's list: no copy, and the exporter
-        // and the leaf material cache recognise it.
-        out.materials = if self.used_mats.is_empty() {
-            match src.materials.len() {
-                0 => vec![cga_geometry::Material::default()].into(),
-                1 => src.materials.clone(),
-                _ => vec![src.materials[0].clone()].into(),
-            }
-        } else {
-            pick(&src.materials, &self.used_mats)
-        };
-        if !self.used_groups.is_empty() {
-            out.groups = pick(&src.groups, &self.used_groups);
-        } // else: Mesh::new's one unnamed group
-        self.used_mats.clear();
-        self.used_groups.clear();
-    }
-}
-
-/// The elements `used` of `src`, in that order: `src` itself (shared) when
-/// that is all of it in order.
-fn pick<T: Clone>(src: &SharedVec<T>, used: &[u32]) -> SharedVec<T> {
-    let all = used.len() == src.len() && used.iter().enumerate().all(|(i, &k)| k as usize == i);
-    if all {
-        src.clone()
-    } else {
-        used.iter().map(|&k| src[k as usize].clone()).collect()
     }
 }
 

@@ -374,21 +374,10 @@ fn a_zip_rule_package_loads_with_its_imports_and_assets() {
         .starts_with("cannot read rule package"));
 }
 
-/// The shared rule packages of CityEngine's runtime (7z archives), when
-/// `../shared` is beside the repository.
+/// The rule packages of CityEngine's runtime (7z archives), in
+/// `../shared/prt-oracle/rpk` outside the repository.
 fn shared_package(name: &str) -> Option<std::path::PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/prt-oracle/rpk")
-        .join(name);
-    if p.is_file() {
-        return Some(p);
-    }
-    assert!(
-        std::env::var_os("CGA_REQUIRE_SHARED").is_none(),
-        "../shared/prt-oracle/rpk/{name} is required (CGA_REQUIRE_SHARED) but missing"
-    );
-    eprintln!("skipped: ../shared/prt-oracle/rpk/{name} not found");
-    None
+    cga_testkit::shared(&format!("prt-oracle/rpk/{name}"))
 }
 
 #[test]

@@ -1,0 +1,11 @@
+//! The integration tests of `cga-cli`, one binary (one link of the
+//! crate for all of them).
+
+mod common;
+
+mod bad_inputs;
+mod cli;
+mod context;
+mod oracle;
+mod texturing;
+mod workspace;

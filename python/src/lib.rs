@@ -25,6 +25,24 @@ use cga::{
     ModelWriter, Options, PlainMesh, PlainModel, Rules, Severity, Target, Value, World,
 };
 
+/// What `generate` gives: a dict per lot, the writer's counts, and the
+/// lots left out as `(index, name, why)`.
+type Generated<'py> = (
+    Vec<Bound<'py, PyDict>>,
+    Option<Bound<'py, PyDict>>,
+    Vec<(usize, String, String)>,
+);
+
+/// A kept mesh given back for writing: material, positions, normals,
+/// uvs, indices.
+type MeshIn<'py> = (
+    usize,
+    PyReadonlyArray2<'py, f64>,
+    PyReadonlyArray2<'py, f64>,
+    PyReadonlyArray2<'py, f64>,
+    PyReadonlyArray2<'py, u32>,
+);
+
 /// Loaded rules, shared by every generation that uses them.
 #[pyclass(frozen, module = "cga._cga")]
 struct NativeRules {
@@ -127,7 +145,10 @@ impl NativeRules {
                 let d = PyDict::new(py);
                 d.set_item("name", &a.name)?;
                 d.set_item("type", a.ty.map(|t| t.name()))?;
-                d.set_item("default", a.default.as_ref().map(|v| value_py(py, v)).transpose()?)?;
+                d.set_item(
+                    "default",
+                    a.default.as_ref().map(|v| value_py(py, v)).transpose()?,
+                )?;
                 let annotations = a
                     .annotations
                     .iter()
@@ -197,19 +218,18 @@ impl NativeRules {
         limits: Option<(usize, usize, f64, usize)>,
         first_index: usize,
         skip_invalid: bool,
-    ) -> PyResult<(
-        Vec<Bound<'py, PyDict>>,
-        Option<Bound<'py, PyDict>>,
-        Vec<(usize, String, String)>,
-    )> {
+    ) -> PyResult<Generated<'py>> {
         let rules = &self.rules;
         if rules.has_errors() {
-            return Err(to_py_err(rules.check_attributes(&Options::default()).err().unwrap_or(
-                Error::Rules {
-                    path: rules.path().to_path_buf(),
-                    errors: 1,
-                },
-            )));
+            return Err(to_py_err(
+                rules
+                    .check_attributes(&Options::default())
+                    .err()
+                    .unwrap_or(Error::Rules {
+                        path: rules.path().to_path_buf(),
+                        errors: 1,
+                    }),
+            ));
         }
         let (mut lots, places, invalid) = read_lots(rules, lots, skip_invalid)?;
         // A lot's seed depends on its place in the run: lots of a part of
@@ -240,12 +260,13 @@ impl NativeRules {
                 max_shapes: shapes,
                 max_seconds: seconds,
                 max_faces: faces,
-                ..Limits::default()
             });
         }
         // Refused options are refused before any thread starts.
         rules.check_attributes(&options).map_err(to_py_err)?;
-        rules.start_rule(options.start_rule.as_deref()).map_err(to_py_err)?;
+        rules
+            .start_rule(options.start_rule.as_deref())
+            .map_err(to_py_err)?;
         let format = match &output {
             Some(path) => Some(Format::from_path(path).ok_or_else(|| {
                 PyValueError::new_err(format!(
@@ -436,13 +457,11 @@ fn read_lot(
         let mut lot = cga::lots::from_polygons(name.clone(), &rings_of, axes).map_err(bad)?;
         for (attr, value) in attrs {
             if attr != "seed" && rules.attribute(&attr).is_none() {
-                return Err(bad(
-                    Error::UnknownAttribute {
-                        name: attr,
-                        known: rules.attributes().iter().map(|a| a.name.clone()).collect(),
-                    }
-                    .to_string(),
-                ));
+                return Err(bad(Error::UnknownAttribute {
+                    name: attr,
+                    known: rules.attributes().iter().map(|a| a.name.clone()).collect(),
+                }
+                .to_string()));
             }
             let value = py_value(&value).map_err(|e| bad(format!("attribute `{attr}`: {e}")))?;
             if let Some(v) = value {
@@ -583,7 +602,10 @@ fn model_dict(py: Python<'_>, r: LotResult, index: usize) -> PyResult<Bound<'_, 
     d.set_item("warnings", warnings)?;
     d.set_item(
         "error",
-        r.error.as_ref().map(|e| diagnostic_dict(py, e)).transpose()?,
+        r.error
+            .as_ref()
+            .map(|e| diagnostic_dict(py, e))
+            .transpose()?,
     )?;
     d.set_item("shapes", r.shapes)?;
     d.set_item("leaves", r.leaf_count)?;
@@ -639,22 +661,16 @@ fn write<'py>(
         Some(r) => r.rules.export_options(),
         None => cga::ExportOptions::default(),
     };
-    let mut writer = ModelWriter::create(&path, format, options).map_err(|e| to_py_err(e.into()))?;
+    let mut writer =
+        ModelWriter::create(&path, format, options).map_err(|e| to_py_err(e.into()))?;
     for item in models.iter() {
-        let (materials, meshes): (
-            Bound<'_, Materials>,
-            Vec<(
-                usize,
-                PyReadonlyArray2<'_, f64>,
-                PyReadonlyArray2<'_, f64>,
-                PyReadonlyArray2<'_, f64>,
-                PyReadonlyArray2<'_, u32>,
-            )>,
-        ) = item.extract()?;
+        let (materials, meshes): (Bound<'_, Materials>, Vec<MeshIn<'_>>) = item.extract()?;
         let rows3 = |a: &PyReadonlyArray2<'_, f64>| -> PyResult<Vec<[f64; 3]>> {
             let a = a.as_array();
             if a.ncols() != 3 {
-                return Err(PyValueError::new_err("positions and normals are (n, 3) arrays"));
+                return Err(PyValueError::new_err(
+                    "positions and normals are (n, 3) arrays",
+                ));
             }
             Ok(a.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect())
         };
@@ -675,11 +691,16 @@ fn write<'py>(
                 positions: rows3(positions)?,
                 normals: rows3(normals)?,
                 uvs: uvs.rows().into_iter().map(|r| [r[0], r[1]]).collect(),
-                indices: indices.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect(),
+                indices: indices
+                    .rows()
+                    .into_iter()
+                    .map(|r| [r[0], r[1], r[2]])
+                    .collect(),
                 triangle_leaf: Vec::new(),
             });
         }
-        py.detach(|| cga::write_plain(&mut writer, &model)).map_err(to_py_err)?;
+        py.detach(|| cga::write_plain(&mut writer, &model))
+            .map_err(to_py_err)?;
     }
     let stats = py
         .detach(|| writer.finish())

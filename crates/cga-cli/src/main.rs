@@ -76,6 +76,25 @@ enum Command {
         #[arg(long = "workspace", value_name = "DIR")]
         workspaces: Vec<PathBuf>,
     },
+    /// Format rule files in place (indentation, trailing spaces, blank lines).
+    Fmt {
+        /// The rule files.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Change nothing: list the files that formatting would change,
+        /// and exit with status 1 if there are any.
+        #[arg(long)]
+        check: bool,
+    },
+    /// Language server for editors, on standard input and output.
+    Lsp {
+        /// Accepted for editor clients that pass it; stdio is the only transport.
+        #[arg(long)]
+        stdio: bool,
+        /// Where `/Project/...` paths are looked for (as for `check`).
+        #[arg(long = "workspace", value_name = "DIR")]
+        workspaces: Vec<PathBuf>,
+    },
 }
 
 #[derive(Args)]
@@ -149,6 +168,13 @@ struct GenerateArgs {
     /// memory; more is fewer primitives per material).
     #[arg(long, value_name = "MIB", default_value_t = cga::DEFAULT_FLUSH_MIB)]
     held_mib: usize,
+    /// How lots are kept apart in the model: `lot` (a glTF node per lot,
+    /// named by it, its index and attributes in `extras`; an OBJ group per
+    /// lot) or `material` (everything merged by material). Default: `lot`
+    /// up to 10,000 lots, `material` above, where a node per lot makes the
+    /// glTF JSON large.
+    #[arg(long, value_name = "lot|material")]
+    granularity: Option<cga::Granularity>,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -189,6 +215,9 @@ impl From<Error> for Failure {
 /// cheaper on a thread that starts with room.
 const MAIN_STACK: usize = 64 << 20;
 
+/// Lots up to which a model gets a node (group) per lot by default.
+const NODES_PER_LOT_UP_TO: usize = 10_000;
+
 fn main() -> ExitCode {
     keep_freed_memory();
     let cli = Cli::parse();
@@ -202,6 +231,10 @@ fn main() -> ExitCode {
                 style,
                 workspaces,
             } => check(&rules, format, style.as_deref(), &workspaces),
+            Command::Fmt { files, check } => fmt(&files, check),
+            Command::Lsp { workspaces, .. } => {
+                cga_lsp::run_stdio(&workspaces).map_err(|e| Failure::Error(e.to_string()))
+            }
         });
     let result = match worker.map(|w| w.join()) {
         Ok(Ok(r)) => r,
@@ -222,6 +255,31 @@ fn main() -> ExitCode {
             ExitCode::from(2)
         }
     }
+}
+
+/// `cga fmt`: each file through the formatter of `cga_lsp::format`.
+fn fmt(files: &[PathBuf], check: bool) -> Result<(), Failure> {
+    let mut unformatted = false;
+    for path in files {
+        let bytes = std::fs::read(path)
+            .map_err(|e| Failure::Usage(format!("cannot read {}: {e}", path.display())))?;
+        let text = cga::decode_text(&bytes);
+        let formatted = cga_lsp::format::format(&text);
+        if formatted.as_bytes() == bytes.as_slice() {
+            continue;
+        }
+        if check {
+            eprintln!("{}: not formatted", path.display());
+            unformatted = true;
+        } else {
+            std::fs::write(path, formatted)
+                .map_err(|e| Failure::Error(format!("cannot write {}: {e}", path.display())))?;
+        }
+    }
+    if unformatted {
+        return Err(Failure::Reported);
+    }
+    Ok(())
 }
 
 fn report_diagnostics<'a>(diags: impl IntoIterator<Item = &'a Diagnostic>) {
@@ -257,12 +315,14 @@ fn check(
             return Err(Failure::Reported);
         }
         let size = rules.size();
+        let count =
+            |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
         eprintln!(
-            "{}: ok ({} rules, {} attributes, {} functions)",
+            "{}: ok ({}, {}, {})",
             path.display(),
-            size.rules,
-            size.attributes,
-            size.functions
+            count(size.rules, "rule", "rules"),
+            count(size.attributes, "attribute", "attributes"),
+            count(size.functions, "function or const", "functions and consts")
         );
         eprintln!("styles: {}", rules.styles().join(", "));
         eprintln!("start rules: {}", rules.start_rules().join(", "));
@@ -369,6 +429,17 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
                     projection: o.proj_string(),
                 }),
                 flush_mib: args.held_mib,
+                granularity: args.granularity.unwrap_or_else(|| {
+                    if lots.lots.len() > NODES_PER_LOT_UP_TO {
+                        eprintln!(
+                            "note: {} lots: the model is merged by material (--granularity lot for a node per lot)",
+                            lots.lots.len()
+                        );
+                        cga::Granularity::Material
+                    } else {
+                        cga::Granularity::Lot
+                    }
+                }),
                 ..rules.export_options()
             };
             Some(

@@ -64,8 +64,22 @@ pub fn parse_rect(spec: &str) -> Result<Lot, String> {
 /// Each face of an OBJ file is one lot, with its texture coordinates and
 /// normals (a street given with UVs can be split in uv space).
 pub fn from_obj(path: &std::path::Path) -> Result<Vec<Lot>, String> {
-    let asset = cga_geometry::load_obj(path)
-        .map_err(|e| format!("cannot read lot file {}: {e}", path.display()))?;
+    from_obj_in(&cga_world::DiskWorld, path)
+}
+
+/// [`from_obj`] with the file read through `world` (a lot's material
+/// library is not read: lots take no materials).
+pub fn from_obj_in(
+    world: &dyn cga_world::World,
+    path: &std::path::Path,
+) -> Result<Vec<Lot>, String> {
+    let bad = |e: &dyn std::fmt::Display| format!("cannot read lot file {}: {e}", path.display());
+    let text = world.read_text(path).map_err(|e| bad(&e))?;
+    let dir = path
+        .parent()
+        .map(std::path::Path::to_path_buf)
+        .unwrap_or_default();
+    let asset = cga_geometry::parse_obj(&text, &dir, |_| Ok(String::new())).map_err(|e| bad(&e))?;
     let mesh = asset.mesh;
     let lots: Vec<Lot> = (0..mesh.faces.len())
         .filter(|&f| mesh.outer_loop(f).len >= 3)
@@ -263,6 +277,11 @@ fn first_edge_frame(mesh: &Mesh) -> (DVec3, DVec3) {
 /// `grid:COLSxROWS` (20 x 30 lots) or `grid:COLSxROWS:LOTS.obj` (copies of
 /// the OBJ's lots): a synthetic city of lots in a grid, for benchmarks.
 pub fn grid(spec: &str) -> Result<Vec<Lot>, String> {
+    grid_in(&cga_world::DiskWorld, spec)
+}
+
+/// [`grid`] with the OBJ read through `world`.
+pub fn grid_in(world: &dyn cga_world::World, spec: &str) -> Result<Vec<Lot>, String> {
     let (dims, source) = match spec.split_once(':') {
         Some((d, s)) => (d, Some(s)),
         None => (spec, None),
@@ -275,7 +294,7 @@ pub fn grid(spec: &str) -> Result<Vec<Lot>, String> {
         return Err(bad());
     }
     let base = match source {
-        Some(path) => from_obj(std::path::Path::new(path))?,
+        Some(path) => from_obj_in(world, std::path::Path::new(path))?,
         None => vec![rect(20.0, 30.0)],
     };
     let (lo, hi) = base

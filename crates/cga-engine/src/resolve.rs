@@ -520,6 +520,10 @@ impl Resolver<'_> {
 
         for item in &module.items {
             let Item::Import(decl) = item else { continue };
+            // An import without a path was a syntax error, reported already.
+            if decl.path.is_empty() && decl.path_span.start == decl.path_span.end {
+                continue;
+            }
             let target = match self.find_import(&path, &decl.path) {
                 Ok(t) => t,
                 Err(searched) => {

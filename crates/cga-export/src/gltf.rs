@@ -302,6 +302,51 @@ pub(crate) struct MapUse {
     channel: usize,
 }
 
+/// A node to write: its name, extras and primitives (with their material
+/// ids).
+type NodeGroup = (
+    String,
+    Option<serde_json::Value>,
+    Vec<(u32, json::mesh::Primitive)>,
+);
+
+/// The primitives of each lot (in the order written) with the lot's name
+/// and extras; lots without geometry get no node, primitives added before
+/// the first lot a node `model`.
+#[allow(clippy::type_complexity)]
+fn lot_groups(
+    lots: Vec<LotNode>,
+    primitives: Vec<(u32, json::mesh::Primitive)>,
+) -> Vec<(
+    String,
+    Option<serde_json::Value>,
+    Vec<(u32, json::mesh::Primitive)>,
+)> {
+    let mut groups = Vec::with_capacity(lots.len() + 1);
+    let mut rest = primitives.into_iter();
+    let first = lots.first().map_or(0, |l| l.first);
+    let before: Vec<_> = rest.by_ref().take(first).collect();
+    if !before.is_empty() {
+        groups.push(("model".to_string(), None, before));
+    }
+    let ends: Vec<Option<usize>> = lots
+        .iter()
+        .skip(1)
+        .map(|l| Some(l.first))
+        .chain([None])
+        .collect();
+    for (lot, end) in lots.into_iter().zip(ends) {
+        let prims: Vec<_> = match end {
+            Some(end) => rest.by_ref().take(end - lot.first).collect(),
+            None => rest.by_ref().collect(),
+        };
+        if !prims.is_empty() {
+            groups.push((lot.name, lot.extras, prims));
+        }
+    }
+    groups
+}
+
 /// Where a GLB or a glTF's JSON is written: a file, or any stream that can
 /// also be read back and sought (a GLB's binary data may have to be moved
 /// up: see `finish_early_glb`), such as a `Cursor<Vec<u8>>`.
@@ -344,6 +389,23 @@ pub(crate) struct GltfWriter {
     written_bytes: u64,
     /// glTF: the `.bin` file, once data is written before the end.
     bin_out: Option<BufWriter<File>>,
+    /// A node per lot ([`Granularity::Lot`](crate::Granularity)): each
+    /// lot's data is written out when the next begins.
+    per_lot: bool,
+    lots: Vec<LotNode>,
+    /// How many lots the model will have, if known (see
+    /// `estimated_json_room`).
+    lots_hint: Option<usize>,
+    /// GLB: where the binary data written early starts.
+    json_room: u64,
+}
+
+/// A lot's node: its name and `extras`, and the first of its primitives in
+/// the order written.
+struct LotNode {
+    name: String,
+    extras: Option<serde_json::Value>,
+    first: usize,
 }
 
 impl GltfWriter {
@@ -353,6 +415,7 @@ impl GltfWriter {
         embed_images: bool,
         asset_extras: Option<serde_json::Value>,
         flush_mib: usize,
+        per_lot: bool,
     ) -> Result<GltfWriter, ExportError> {
         // Readable too: a GLB's binary data may have to be moved up (see
         // `finish_early_glb`).
@@ -370,6 +433,7 @@ impl GltfWriter {
             embed_images,
             asset_extras,
             flush_mib,
+            per_lot,
         ))
     }
 
@@ -382,6 +446,7 @@ impl GltfWriter {
         embed_images: bool,
         asset_extras: Option<serde_json::Value>,
         flush_mib: usize,
+        per_lot: bool,
     ) -> GltfWriter {
         let stem = path
             .file_stem()
@@ -402,7 +467,37 @@ impl GltfWriter {
             written: Vec::new(),
             written_bytes: 0,
             bin_out: None,
+            per_lot,
+            lots: Vec::new(),
+            lots_hint: None,
+            json_room: GLB_JSON_ROOM,
         }
+    }
+
+    /// Says how many lots the model will have.
+    pub(crate) fn expect_lots(&mut self, lots: usize) {
+        self.lots_hint = Some(lots);
+    }
+
+    /// Starts a lot's node (see [`LotNode`]): what is held of the lot
+    /// before is written out first, as its primitives.
+    pub(crate) fn begin_lot(
+        &mut self,
+        name: &str,
+        extras: Option<serde_json::Value>,
+    ) -> Result<(), ExportError> {
+        if !self.per_lot {
+            return Ok(());
+        }
+        if self.buckets.iter().any(|b| !b.indices.is_empty()) {
+            self.flush()?;
+        }
+        self.lots.push(LotNode {
+            name: name.to_string(),
+            extras,
+            first: self.written.len(),
+        });
+        Ok(())
     }
 
     /// File names this writer creates next to the output.
@@ -472,13 +567,43 @@ impl GltfWriter {
         self.held += bytes;
     }
 
+    /// The room to leave for a GLB's header and JSON when data is first
+    /// written early. With a node per lot and the number of lots known,
+    /// the JSON grows with the lots: room for as many lots as the first,
+    /// with a quarter more, so that the binary data seldom has to be moved
+    /// up at the end (spaces pad what is left).
+    fn estimated_json_room(&self) -> u64 {
+        // Compact JSON of a primitive with its accessors and buffer views,
+        // and of a lot's node and mesh, in bytes (measured on the example
+        // city: about 2,500 bytes for a lot of four primitives).
+        const PER_PRIMITIVE: u64 = 700;
+        const PER_LOT: u64 = 200;
+        let (Some(lots), true) = (self.lots_hint, self.per_lot) else {
+            return GLB_JSON_ROOM;
+        };
+        let primitives = self
+            .buckets
+            .iter()
+            .filter(|b| !b.indices.is_empty())
+            .count() as u64;
+        let extras = self
+            .lots
+            .last()
+            .and_then(|l| l.extras.as_ref())
+            .map_or(0, |e| e.to_string().len() as u64);
+        let per_lot = primitives * PER_PRIMITIVE + PER_LOT + extras;
+        let room = (lots as u64).saturating_mul(per_lot) / 4 * 5;
+        room.clamp(GLB_JSON_ROOM, 256 << 20) / 4 * 4
+    }
+
     /// Writes every bucket's data as a primitive and empties the buckets.
     fn flush(&mut self) -> Result<(), ExportError> {
         let path = self.path.clone();
         let io = |e| ExportError::io(&path, e);
         let out: &mut dyn Write = if self.binary {
             if self.written_bytes == 0 {
-                self.out.seek(SeekFrom::Start(GLB_JSON_ROOM)).map_err(io)?;
+                self.json_room = self.estimated_json_room();
+                self.out.seek(SeekFrom::Start(self.json_room)).map_err(io)?;
             }
             &mut self.out
         } else {
@@ -545,18 +670,19 @@ impl GltfWriter {
             .filter(|(_, b)| !b.indices.is_empty())
             .map(|(id, b)| b.primitive(id as u32))
             .collect();
-        // Accessors in the order of the binary data; primitives by material.
-        let mut primitives: Vec<Vec<json::mesh::Primitive>> = Vec::new();
-        primitives.resize_with(self.buckets.len(), Vec::new);
+        // Accessors in the order of the binary data, with their material.
+        let mut primitives: Vec<(u32, json::mesh::Primitive)> = Vec::new();
+        let mut used = vec![false; self.buckets.len()];
         for p in self.written.iter().chain(&held) {
             let prim = primitive_accessors(&mut root, &mut layout, p);
-            primitives[p.material as usize].push(prim);
+            primitives.push((p.material, prim));
+            used[p.material as usize] = true;
             stats.vertices += p.vertices;
         }
-        for (id, prims) in primitives.into_iter().enumerate() {
-            if prims.is_empty() {
-                continue;
-            }
+        // The glTF material of each material id that has primitives.
+        let mut gltf_materials: Vec<Option<json::Index<json::Material>>> =
+            vec![None; self.buckets.len()];
+        for id in (0..self.buckets.len()).filter(|&id| used[id]) {
             let bucket = &self.buckets[id];
             let id = id as u32;
             let name = table.name(id).to_string();
@@ -587,16 +713,35 @@ impl GltfWriter {
                     },
                 ));
             }
-            let material = root.push(gltf_material(
+            gltf_materials[id as usize] = Some(root.push(gltf_material(
                 material,
-                name.clone(),
+                name,
                 infos,
                 self.alpha_maps[id as usize],
-            ));
+            )));
+            stats.materials += 1;
+        }
+        // Meshes and nodes: one per lot, or one per material.
+        let groups: Vec<NodeGroup> = if self.per_lot && !self.lots.is_empty() {
+            lot_groups(std::mem::take(&mut self.lots), primitives)
+        } else {
+            let mut by_material: Vec<Vec<(u32, json::mesh::Primitive)>> = Vec::new();
+            by_material.resize_with(self.buckets.len(), Vec::new);
+            for (id, prim) in primitives {
+                by_material[id as usize].push((id, prim));
+            }
+            by_material
+                .into_iter()
+                .enumerate()
+                .filter(|(_, prims)| !prims.is_empty())
+                .map(|(id, prims)| (table.name(id as u32).to_string(), None, prims))
+                .collect()
+        };
+        for (name, extras, prims) in groups {
             let primitives = prims
                 .into_iter()
-                .map(|p| json::mesh::Primitive {
-                    material: Some(material),
+                .map(|(id, p)| json::mesh::Primitive {
+                    material: gltf_materials[id as usize],
                     ..p
                 })
                 .collect();
@@ -610,9 +755,9 @@ impl GltfWriter {
             nodes.push(root.push(json::Node {
                 mesh: Some(mesh),
                 name: Some(name),
+                extras: extras.and_then(|v| serde_json::value::to_raw_value(&v).ok()),
                 ..Default::default()
             }));
-            stats.materials += 1;
         }
         stats.textures = images.len() as u64;
         if self.embed_images {
@@ -713,7 +858,7 @@ impl GltfWriter {
         out.flush().map_err(io)
     }
 
-    /// GLB whose binary data was partly written early, from `GLB_JSON_ROOM` on:
+    /// GLB whose binary data was partly written early, from `json_room` on:
     /// the rest of it follows, then the header and the JSON (padded with
     /// spaces to the room, or, if it does not fit, with the binary data
     /// moved up to make room) go before it.
@@ -730,11 +875,12 @@ impl GltfWriter {
         self.out.flush().map_err(io)?;
         // Header (12), JSON chunk header (8), JSON, BIN chunk header (8).
         let head = 12 + 8 + json.len() as u64 + 8;
-        let start = if head <= GLB_JSON_ROOM {
-            GLB_JSON_ROOM
+        let room = self.json_room;
+        let start = if head <= room {
+            room
         } else {
             let file = self.out.get_mut();
-            move_up(&mut **file, GLB_JSON_ROOM, bin_len, head - GLB_JSON_ROOM).map_err(io)?;
+            move_up(&mut **file, room, bin_len, head - room).map_err(io)?;
             head
         };
         json.resize((start - 28) as usize, b' ');

@@ -55,6 +55,8 @@ use crate::materials::MaterialTable;
 pub use crate::plain::{PlainCollector, PlainMesh, PlainModel};
 use crate::prepare::{FacePrep, SlotIds};
 use crate::textures::{TextureProbe, Textures};
+/// The JSON values of a lot's node `extras` ([`ModelWriter::begin_lot`]).
+pub use serde_json;
 
 /// Output file format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -104,6 +106,36 @@ pub struct ExportOptions {
     pub flush_mib: usize,
     /// Where texture files are read from.
     pub world: Arc<dyn World>,
+    /// How lots are kept apart in the model (see [`Granularity`]).
+    pub granularity: Granularity,
+}
+
+/// How the output keeps lots apart.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Granularity {
+    /// A lot is a node of its own (glTF, GLB: named by the lot, its index
+    /// and attributes in the node's `extras`, a mesh with a primitive per
+    /// material) or a group (OBJ `g`): a building can be picked out of a
+    /// city. Lots are those begun with [`ModelWriter::begin_lot`].
+    #[default]
+    Lot,
+    /// Everything merged by material: one glTF mesh per material, no OBJ
+    /// groups. The fewest draw calls, and the smallest glTF JSON for
+    /// cities of many thousand lots.
+    Material,
+}
+
+impl std::str::FromStr for Granularity {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Granularity, String> {
+        match s {
+            "lot" => Ok(Granularity::Lot),
+            "material" => Ok(Granularity::Material),
+            _ => Err(format!(
+                "unknown granularity `{s}`: expected lot or material"
+            )),
+        }
+    }
 }
 
 impl Default for ExportOptions {
@@ -114,6 +146,7 @@ impl Default for ExportOptions {
             georeference: None,
             flush_mib: gltf::DEFAULT_FLUSH_MIB,
             world: Arc::new(cga_world::DiskWorld),
+            granularity: Granularity::Lot,
         }
     }
 }
@@ -257,6 +290,7 @@ pub struct ModelWriter {
     sink: Sink,
     stats: ExportStats,
     skipped_non_finite: u64,
+    granularity: Granularity,
 }
 
 impl ModelWriter {
@@ -279,6 +313,7 @@ impl ModelWriter {
                     options.embed_textures,
                     options.georeference.as_ref().map(Georeference::to_json),
                     options.flush_mib,
+                    options.granularity == Granularity::Lot,
                 )?;
                 let reserved = w.file_names();
                 (Sink::Gltf(w, Box::default()), reserved)
@@ -323,6 +358,7 @@ impl ModelWriter {
             true,
             options.georeference.as_ref().map(Georeference::to_json),
             options.flush_mib,
+            options.granularity == Granularity::Lot,
         );
         Ok(ModelWriter::with_sink(
             Sink::Gltf(w, Box::default()),
@@ -358,6 +394,7 @@ impl ModelWriter {
             sink,
             stats: ExportStats::default(),
             skipped_non_finite: 0,
+            granularity: options.granularity,
         }
     }
 
@@ -429,12 +466,30 @@ impl ModelWriter {
         }
     }
 
-    /// Starts the output of a lot named `name`: in OBJ a group (`g`) of its
-    /// own; glTF and GLB merge lots by material.
-    pub fn begin_lot(&mut self, name: &str) -> Result<(), ExportError> {
+    /// Says how many lots will be begun ([`begin_lot`](Self::begin_lot)):
+    /// a GLB with a node per lot then leaves room for their JSON at the
+    /// start, instead of moving its binary data up at the end.
+    pub fn expect_lots(&mut self, lots: usize) {
+        if let Sink::Gltf(w, _) = &mut self.sink {
+            w.expect_lots(lots);
+        }
+    }
+
+    /// Starts the output of a lot: what is added from now on belongs to it.
+    /// With [`Granularity::Lot`] it is a glTF node named `name` with
+    /// `extras` (for instance its index and attributes), or an OBJ group;
+    /// with [`Granularity::Material`] nothing changes.
+    pub fn begin_lot(
+        &mut self,
+        name: &str,
+        extras: Option<serde_json::Value>,
+    ) -> Result<(), ExportError> {
+        if self.granularity != Granularity::Lot {
+            return Ok(());
+        }
         match &mut self.sink {
             Sink::Obj(w, ..) => w.begin_group(name),
-            Sink::Gltf(..) => Ok(()),
+            Sink::Gltf(w, _) => w.begin_lot(name, extras),
         }
     }
 

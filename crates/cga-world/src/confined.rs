@@ -52,6 +52,15 @@ impl World for ConfinedWorld {
         self.base.read(&c)
     }
 
+    fn open(&self, path: &Path) -> io::Result<Box<dyn io::Read + Send>> {
+        let c = self.allowed(path).ok_or_else(|| Self::refused(path))?;
+        self.base.open(&c)
+    }
+
+    fn disk_path(&self, path: &Path) -> Option<PathBuf> {
+        self.base.disk_path(&self.allowed(path)?)
+    }
+
     fn read_prefix(&self, path: &Path, max: usize) -> io::Result<Vec<u8>> {
         let c = self.allowed(path).ok_or_else(|| Self::refused(path))?;
         self.base.read_prefix(&c, max)

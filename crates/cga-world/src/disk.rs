@@ -14,6 +14,17 @@ impl World for DiskWorld {
         std::fs::read(path)
     }
 
+    fn open(&self, path: &Path) -> io::Result<Box<dyn io::Read + Send>> {
+        Ok(Box::new(io::BufReader::with_capacity(
+            1 << 16,
+            std::fs::File::open(path)?,
+        )))
+    }
+
+    fn disk_path(&self, path: &Path) -> Option<PathBuf> {
+        path.is_file().then(|| path.to_path_buf())
+    }
+
     fn read_prefix(&self, path: &Path, max: usize) -> io::Result<Vec<u8>> {
         use std::io::Read;
         let mut head = Vec::new();

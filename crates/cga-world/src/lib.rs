@@ -85,6 +85,20 @@ pub trait World: Send + Sync {
     fn read_text(&self, path: &Path) -> io::Result<String> {
         self.read(path).map(|bytes| decode_text(&bytes))
     }
+
+    /// A reader of the file at `path`, for files read as a stream (lot
+    /// files of any size): the file itself on disk, else its bytes.
+    fn open(&self, path: &Path) -> io::Result<Box<dyn io::Read + Send>> {
+        Ok(Box::new(io::Cursor::new(self.read(path)?)))
+    }
+
+    /// Where the file at `path` is on disk, for readers that can only open
+    /// a path (a GeoPackage's SQLite database); `None` when this world does
+    /// not show it as a plain file on disk.
+    fn disk_path(&self, path: &Path) -> Option<PathBuf> {
+        let _ = path;
+        None
+    }
 }
 
 /// `path` made absolute (from the working folder) with `.` and `..`

@@ -95,6 +95,23 @@ impl Default for MemoryWorld {
 }
 
 impl World for MemoryWorld {
+    fn open(&self, path: &Path) -> io::Result<Box<dyn io::Read + Send>> {
+        match (self.held(path), &self.base) {
+            (Some(h), _) => Ok(Box::new(io::Cursor::new(h.bytes))),
+            (None, Some(base)) => base.open(path),
+            (None, None) => self
+                .read(path)
+                .map(|b| -> Box<dyn io::Read + Send> { Box::new(io::Cursor::new(b)) }),
+        }
+    }
+
+    fn disk_path(&self, path: &Path) -> Option<PathBuf> {
+        match self.held(path) {
+            Some(_) => None,
+            None => self.base.as_ref()?.disk_path(path),
+        }
+    }
+
     fn read(&self, path: &Path) -> io::Result<Vec<u8>> {
         if let Some(h) = self.held(path) {
             return Ok(h.bytes.to_vec());

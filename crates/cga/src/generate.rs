@@ -7,7 +7,8 @@ use cga_engine::context::{LotContext, SceneContext};
 use cga_engine::derive::{Leaf, RtErrorKind};
 use cga_engine::generate::{collect_lot, generate_lot_streaming};
 use cga_engine::{GenerateOptions, LotOutput, RtError};
-use cga_export::{ModelWriter, PlainCollector};
+use cga_export::{serde_json, ModelWriter, PlainCollector};
+use cga_value::Value;
 
 use crate::diagnostics::Diagnostic;
 use crate::lots::Lot;
@@ -114,13 +115,17 @@ impl Rules {
             lots: lots.len(),
             ..Summary::default()
         };
-        // The lot whose output was begun last (OBJ groups per lot).
+        // The lot whose output was begun last (a node or group per lot).
         let mut begun: Option<usize> = None;
+        if let Some(w) = writer.as_deref_mut() {
+            w.expect_lots(lots.len());
+        }
         let mut take = |i: usize, taken: Taken<Piece, Done>| -> Result<(), Error> {
             if begun != Some(i) {
                 begun = Some(i);
                 if let Some(w) = writer.as_deref_mut() {
-                    w.begin_lot(&lots[i].name).map_err(Error::Export)?;
+                    w.begin_lot(&lots[i].name, Some(lot_extras(i, &lots[i])))
+                        .map_err(Error::Export)?;
                 }
             }
             let mut result = Ok(());
@@ -381,6 +386,31 @@ impl Rules {
             shapes,
         }
     }
+}
+
+/// A lot's node `extras` in glTF: its index and its own attributes (a GIS
+/// feature's properties).
+fn lot_extras(index: usize, lot: &Lot) -> serde_json::Value {
+    use serde_json::{json, Map, Value as Json};
+    fn number(x: f64) -> Json {
+        serde_json::Number::from_f64(x).map_or(Json::Null, Json::Number)
+    }
+    fn to_json(v: &Value) -> Json {
+        match v {
+            Value::Float(x) => number(*x),
+            Value::Bool(b) => Json::Bool(*b),
+            Value::Str(s) => Json::String(s.to_string()),
+            Value::FloatArray(a) => a.data.iter().map(|x| number(*x)).collect(),
+            Value::BoolArray(a) => a.data.iter().map(|b| Json::Bool(*b)).collect(),
+            Value::StrArray(a) => a.data.iter().map(|s| Json::String(s.to_string())).collect(),
+        }
+    }
+    let attributes: Map<String, Json> = lot
+        .attrs
+        .iter()
+        .map(|(k, v)| (k.to_string(), to_json(v)))
+        .collect();
+    json!({ "lot": index, "attributes": attributes })
 }
 
 /// What a worker hands over at the end of a lot.

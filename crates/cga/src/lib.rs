@@ -24,6 +24,9 @@
 //!   stop runaway rules, and a [`Cancel`] stops a generation within
 //!   milliseconds.
 //!
+//! - [`syntax`]: the syntax tree of a rule file's text and where the paths
+//!   it names lead, for editors and formatters.
+//!
 //! `docs/library.md` has a complete example.
 
 mod attributes;
@@ -37,11 +40,12 @@ mod options;
 mod pipeline;
 mod rules;
 mod stack;
+pub mod syntax;
 mod values;
 
 pub use attributes::{Annotation, Attribute, Range};
 pub use cga_engine::Workspaces;
-pub use cga_export::{ExportOptions, ExportStats, Format, Georeference, ModelWriter};
+pub use cga_export::{ExportOptions, ExportStats, Format, Georeference, Granularity, ModelWriter};
 pub use cga_value::{Array, Value, ValueType};
 pub use cga_world::{decode_text, ConfinedWorld, DiskWorld, MemoryWorld, Metadata, World};
 pub use diagnostics::{Diagnostic, Location, Severity};

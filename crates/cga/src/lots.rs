@@ -172,8 +172,18 @@ pub fn read(specs: &[impl AsRef<str>]) -> Result<LotSet, Error> {
 /// [`read`] with a CRS for every lot file (`--crs`) and what to do with
 /// invalid lots (`--invalid`).
 pub fn read_with(specs: &[impl AsRef<str>], options: &LotOptions) -> Result<LotSet, Error> {
+    read_in(&crate::DiskWorld, specs, options)
+}
+
+/// [`read_with`], every lot file read through `world` (see
+/// [`Engine::read_lots`](crate::Engine::read_lots)).
+pub fn read_in(
+    world: &dyn crate::World,
+    specs: &[impl AsRef<str>],
+    options: &LotOptions,
+) -> Result<LotSet, Error> {
     let specs: Vec<String> = specs.iter().map(|s| s.as_ref().to_string()).collect();
-    let read = cga_engine::gis::read_lots(&specs, options).map_err(Error::Lot)?;
+    let read = cga_engine::gis::read_lots_in(world, &specs, options).map_err(Error::Lot)?;
     let mut set = LotSet {
         lots: read.lots,
         origin: read.frame,

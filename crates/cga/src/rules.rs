@@ -80,6 +80,18 @@ impl Engine {
         &self.world
     }
 
+    /// Lots from specifications as [`lots::read_with`](crate::lots::read_with)
+    /// takes them, every lot file read through this engine's world: lots
+    /// from memory, or only from the folders of a confined world. (A
+    /// GeoPackage must be a file on disk: SQLite opens it by its path.)
+    pub fn read_lots(
+        &self,
+        specs: &[impl AsRef<str>],
+        options: &crate::LotOptions,
+    ) -> Result<crate::LotSet, crate::Error> {
+        crate::lots::read_in(self.world.as_ref(), specs, options)
+    }
+
     /// Loads the rule file at `path` and everything it imports. Always
     /// gives rules: a file with errors (even an unreadable one) gives what
     /// could be resolved, with the errors in [`Rules::diagnostics`].

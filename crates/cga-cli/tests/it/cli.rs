@@ -309,10 +309,17 @@ fn written_models_do_not_depend_on_the_thread_count() {
          Floor --> split(x) { ~0.7 : Tile }*\n\
          Tile --> case split.index % 2 == 0 : color(\"#cccccc\") X. else : color(0.2, 0.3, split.index / 40) extrude(0.2) Y.\n",
     );
-    for (ext, held) in [("glb", "64"), ("glb", "1"), ("gltf", "1"), ("obj", "64")] {
+    for (ext, held, granularity) in [
+        ("glb", "64", "material"),
+        ("glb", "1", "material"),
+        ("gltf", "1", "material"),
+        ("obj", "64", "material"),
+        ("glb", "64", "lot"),
+        ("obj", "64", "lot"),
+    ] {
         let mut want: Option<Vec<u8>> = None;
         for jobs in ["1", "2", "3"] {
-            let sub = dir.join(format!("{ext}-{held}-{jobs}"));
+            let sub = dir.join(format!("{ext}-{held}-{granularity}-{jobs}"));
             std::fs::create_dir_all(&sub).unwrap();
             let model = sub.join(format!("city.{ext}"));
             let out = run(&[
@@ -324,6 +331,8 @@ fn written_models_do_not_depend_on_the_thread_count() {
                 jobs,
                 "--held-mib",
                 held,
+                "--granularity",
+                granularity,
                 "-o",
                 model.to_str().unwrap(),
             ]);
@@ -332,9 +341,17 @@ fn written_models_do_not_depend_on_the_thread_count() {
             if ext != "obj" {
                 assert_valid_gltf(&model);
                 let json = gltf_json(&model);
-                let prims = json["meshes"][0]["primitives"].as_array().unwrap().len();
-                // Written early: several primitives per material.
-                assert_eq!(prims > 1, held == "1", "{ext} {held}: {prims} primitives");
+                let meshes = json["meshes"].as_array().unwrap();
+                let prims = meshes[0]["primitives"].as_array().unwrap().len();
+                if granularity == "material" {
+                    // Written early: several primitives per material.
+                    assert_eq!(prims > 1, held == "1", "{ext} {held}: {prims} primitives");
+                } else {
+                    // A mesh per lot, a primitive per material (3 colours
+                    // and the tiles' blues).
+                    assert_eq!(meshes.len(), 12);
+                    assert_eq!(json["nodes"][11]["extras"]["lot"], 11);
+                }
             }
             if ext == "gltf" {
                 bytes.extend(std::fs::read(model.with_extension("bin")).unwrap());
@@ -1009,7 +1026,7 @@ fn rule_packages_are_read_directly() {
     let pkg = package.to_str().unwrap();
     let check = run(&["check", pkg]);
     assert_eq!(check.status.code(), Some(0), "{}", stderr(&check));
-    assert!(stderr(&check).contains("ok (1 rules, 1 attributes, 0 functions)"));
+    assert!(stderr(&check).contains("ok (1 rule, 1 attribute, 0 functions and consts)"));
     let glb = dir.join("tower.glb");
     let o = run(&[
         "generate",
@@ -1255,4 +1272,77 @@ fn obj_groups_per_lot_and_material_names_say_what_they_are() {
         .filter_map(|l| l.strip_prefix("newmtl "))
         .collect();
     assert_eq!(names, ["color_ff8000", "color_ffffff"]);
+}
+
+/// A glTF model keeps its lots apart: a node per lot named by its feature
+/// id, with the lot index and the feature's properties in `extras`;
+/// `--granularity material` merges them by material.
+#[test]
+fn gltf_nodes_per_lot_carry_the_lot_and_its_attributes() {
+    let dir = temp_dir("gltf-nodes");
+    let gj = dir.join("two.geojson");
+    std::fs::write(
+        &gj,
+        r#"{"type":"FeatureCollection","features":[
+          {"type":"Feature","id":"n1","properties":{"height":12,"use":"office"},"geometry":{"type":"Polygon",
+           "coordinates":[[[0,0],[10,0],[10,10],[0,10],[0,0]]]}},
+          {"type":"Feature","id":"n2","properties":{"height":6,"use":"home"},"geometry":{"type":"Polygon",
+           "coordinates":[[[20,0],[30,0],[30,10],[20,10],[20,0]]]}}]}"#,
+    )
+    .unwrap();
+    let rules = rule_file(
+        &dir,
+        "n.cga",
+        "attr height = 3\nLot --> extrude(height) comp(f) { top : color(\"#ff8000\") Roof. | all : Wall. }\n",
+    );
+    let gltf = dir.join("m.gltf");
+    let generate = |extra: &[&str]| {
+        let mut args = vec![
+            "generate",
+            rules.to_str().unwrap(),
+            "--lot",
+            gj.to_str().unwrap(),
+            "--crs",
+            "local",
+            "-o",
+            gltf.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let out = run(&args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let doc: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&gltf).unwrap()).unwrap();
+        doc
+    };
+    let doc = generate(&[]);
+    let nodes = doc["nodes"].as_array().unwrap();
+    assert_eq!(nodes.len(), 2);
+    assert_eq!(nodes[0]["name"], "n1");
+    assert_eq!(
+        nodes[0]["extras"],
+        serde_json::json!({"lot": 0, "attributes": {"height": 12.0, "use": "office"}})
+    );
+    assert_eq!(nodes[1]["name"], "n2");
+    assert_eq!(nodes[1]["extras"]["lot"], 1);
+    // Each lot's mesh: the roof and the walls.
+    for n in nodes {
+        let mesh = &doc["meshes"][n["mesh"].as_u64().unwrap() as usize];
+        assert_eq!(mesh["primitives"].as_array().unwrap().len(), 2);
+    }
+    let names: Vec<&str> = doc["materials"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["color_ff8000", "color_ffffff"]);
+
+    let doc = generate(&["--granularity", "material"]);
+    let nodes: Vec<&str> = doc["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(nodes, ["color_ff8000", "color_ffffff"]);
 }

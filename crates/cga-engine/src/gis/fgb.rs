@@ -13,10 +13,14 @@ use cga_value::Value;
 
 /// Reads the features of a FlatGeobuf file into `sink`; returns the CRS
 /// its header declares.
-pub fn read(path: &Path, sink: &mut dyn FnMut(Feature)) -> Result<Option<Declared>, String> {
+pub fn read(
+    world: &dyn cga_world::World,
+    path: &Path,
+    sink: &mut dyn FnMut(Feature),
+) -> Result<Option<Declared>, String> {
     let bad = |e: &dyn std::fmt::Display| format!("cannot read FlatGeobuf {}: {e}", path.display());
-    let file = std::fs::File::open(path).map_err(|e| bad(&e))?;
-    let reader = FgbReader::open(std::io::BufReader::new(file)).map_err(|e| bad(&e))?;
+    let file = world.open(path).map_err(|e| bad(&e))?;
+    let reader = FgbReader::open(file).map_err(|e| bad(&e))?;
     let declared = reader.header().crs().and_then(|crs| {
         let org = crs.org().unwrap_or("EPSG");
         if crs.code() > 0 && org.eq_ignore_ascii_case("EPSG") {

@@ -18,10 +18,15 @@ use super::feature::{close_ring, json_value, Feature, Polygon};
 /// Reads the features of a GeoJSON file (a FeatureCollection, a Feature
 /// or a bare geometry) into `sink`, in order; returns the CRS its legacy
 /// `crs` member declares, if it has one.
-pub fn read(path: &Path, sink: &mut dyn FnMut(Feature)) -> Result<Option<Declared>, String> {
-    let file = std::fs::File::open(path)
+pub fn read(
+    world: &dyn cga_world::World,
+    path: &Path,
+    sink: &mut dyn FnMut(Feature),
+) -> Result<Option<Declared>, String> {
+    let file = world
+        .open(path)
         .map_err(|e| format!("cannot read lot file {}: {e}", path.display()))?;
-    read_from(path, std::io::BufReader::with_capacity(1 << 16, file), sink)
+    read_from(path, file, sink)
 }
 
 /// [`read`] from any reader (`path` names it in messages).

@@ -22,13 +22,21 @@ pub struct Layer {
 /// Reads every feature table of a GeoPackage: `begin` is told of each
 /// table before its features go to `sink`.
 pub fn read(
+    world: &dyn cga_world::World,
     path: &Path,
     begin: &mut dyn FnMut(&Layer),
     sink: &mut dyn FnMut(Feature),
 ) -> Result<(), String> {
     let bad = |e: &dyn std::fmt::Display| format!("cannot read GeoPackage {}: {e}", path.display());
+    // SQLite opens files by their path: a GeoPackage must be a file on disk.
+    let Some(file) = world.disk_path(path) else {
+        return Err(match world.metadata(path) {
+            Some(_) => bad(&"a GeoPackage is read from a file on disk, and this one is not"),
+            None => bad(&"no such file"),
+        });
+    };
     let db = rusqlite::Connection::open_with_flags(
-        path,
+        file,
         rusqlite::OpenFlags::SQLITE_OPEN_READ_ONLY | rusqlite::OpenFlags::SQLITE_OPEN_NO_MUTEX,
     )
     .map_err(|e| bad(&e))?;

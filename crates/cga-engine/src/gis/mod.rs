@@ -112,6 +112,16 @@ fn clockwise_warning(path: &Path, lots: &[Lot]) -> Option<String> {
 /// `.shp`). Without any, the 20 x 30 rectangle. Errors are for the user
 /// (a usage error: the command's status 2).
 pub fn read_lots(specs: &[String], options: &LotOptions) -> Result<LotSet, String> {
+    read_lots_in(&cga_world::DiskWorld, specs, options)
+}
+
+/// [`read_lots`] with every file read through `world` (a GeoPackage must
+/// still be a file on disk: SQLite opens it by its path).
+pub fn read_lots_in(
+    world: &dyn cga_world::World,
+    specs: &[String],
+    options: &LotOptions,
+) -> Result<LotSet, String> {
     if specs.is_empty() {
         return Ok(LotSet {
             lots: vec![crate::lot::rect(20.0, 30.0)],
@@ -128,7 +138,7 @@ pub fn read_lots(specs: &[String], options: &LotOptions) -> Result<LotSet, Strin
             continue;
         }
         if let Some(grid) = spec.strip_prefix("grid:") {
-            parts.push(Ok(crate::lot::grid(grid)?));
+            parts.push(Ok(crate::lot::grid_in(world, grid)?));
             continue;
         }
         let path = Path::new(spec);
@@ -138,14 +148,14 @@ pub fn read_lots(specs: &[String], options: &LotOptions) -> Result<LotSet, Strin
             .map(|e| e.to_ascii_lowercase())
             .unwrap_or_default();
         if ext == "obj" {
-            let lots = crate::lot::from_obj(path)?;
+            let lots = crate::lot::from_obj_in(world, path)?;
             if let Some(w) = clockwise_warning(path, &lots) {
                 reader.messages.push(Message::Warning(w));
             }
             parts.push(Ok(lots));
         } else if is_gis_file(&ext) {
             let start = reader.pending.len();
-            reader.read_file(path, &ext)?;
+            reader.read_file(world, path, &ext)?;
             parts.push(Err(start..reader.pending.len()));
         } else {
             return Err(format!(
@@ -244,7 +254,12 @@ impl Reader {
     }
 
     /// Reads one file's features.
-    fn read_file(&mut self, path: &Path, ext: &str) -> Result<(), String> {
+    fn read_file(
+        &mut self,
+        world: &dyn cga_world::World,
+        path: &Path,
+        ext: &str,
+    ) -> Result<(), String> {
         let label: Arc<str> = Arc::from(path.display().to_string());
         let first_source = self.sources.len();
         let mut skipped = Skipped::default();
@@ -268,6 +283,7 @@ impl Reader {
         if ext == "gpkg" {
             let layers = std::cell::RefCell::new(Vec::new());
             gpkg::read(
+                world,
                 path,
                 &mut |layer| {
                     let mut layers = layers.borrow_mut();
@@ -291,9 +307,9 @@ impl Reader {
         } else {
             let sink = &mut |f| add(f, &label);
             let declared = match ext {
-                "fgb" => fgb::read(path, sink)?,
-                "shp" => shp::read(path, sink)?,
-                _ => geojson::read(path, sink)?,
+                "fgb" => fgb::read(world, path, sink)?,
+                "shp" => shp::read(world, path, sink)?,
+                _ => geojson::read(world, path, sink)?,
             };
             self.sources.push(Source {
                 label: label.clone(),

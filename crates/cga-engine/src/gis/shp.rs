@@ -2,8 +2,12 @@
 //! it and the CRS of its `.prj` (WKT), record by record. A record's holes
 //! are given to the outer ring that contains them.
 
+use std::io::{Cursor, Read, Seek};
 use std::path::Path;
 use std::sync::Arc;
+
+use cga_world::World;
+use shapefile::dbase;
 
 use cga_geometry::DVec3;
 use cga_value::Value;
@@ -14,24 +18,61 @@ use super::crs::Declared;
 use super::feature::{close_ring, Feature, Polygon, Ring};
 
 /// Reads the records of a Shapefile into `sink`; returns the CRS of its
-/// `.prj`, if there is one.
-pub fn read(path: &Path, sink: &mut dyn FnMut(Feature)) -> Result<Option<Declared>, String> {
+/// `.prj`, if there is one. Files on disk are read record by record; the
+/// files of other worlds (in memory) are read whole first.
+pub fn read(
+    world: &dyn World,
+    path: &Path,
+    sink: &mut dyn FnMut(Feature),
+) -> Result<Option<Declared>, String> {
     let bad = |e: &dyn std::fmt::Display| format!("cannot read Shapefile {}: {e}", path.display());
-    let prj = path.with_extension("prj");
-    let declared = match std::fs::read(&prj) {
+    let declared = match world.read(&path.with_extension("prj")) {
         Ok(bytes) => {
             let wkt = String::from_utf8_lossy(&bytes).trim().to_string();
             (!wkt.is_empty()).then_some(Declared::Wkt(wkt))
         }
         Err(_) => None,
     };
-    // The .dbf's columns in order: a record hands its values over in no
-    // particular order.
-    let columns: Vec<String> = shapefile::dbase::Reader::from_path(path.with_extension("dbf"))
-        .map(|r| r.fields().iter().map(|f| f.name().to_string()).collect())
-        .unwrap_or_default();
+    let dbf = path.with_extension("dbf");
+    if let (Some(shp_file), Some(dbf_file)) = (world.disk_path(path), world.disk_path(&dbf)) {
+        // The .dbf's columns in order: a record hands its values over in
+        // no particular order.
+        let columns = dbase::Reader::from_path(&dbf_file)
+            .map(|r| columns(&r))
+            .unwrap_or_default();
+        let reader = shapefile::Reader::from_path(&shp_file).map_err(|e| bad(&e))?;
+        records(reader, &columns, sink, &bad)?;
+    } else {
+        let shp_bytes = world.read(path).map_err(|e| bad(&e))?;
+        let dbf_bytes = world.read(&dbf).map_err(|e| bad(&e))?;
+        let columns = dbase::Reader::new(Cursor::new(&dbf_bytes))
+            .map(|r| columns(&r))
+            .unwrap_or_default();
+        let shapes = shapefile::ShapeReader::new(Cursor::new(shp_bytes)).map_err(|e| bad(&e))?;
+        let table = dbase::Reader::new(Cursor::new(dbf_bytes)).map_err(|e| bad(&e))?;
+        records(shapefile::Reader::new(shapes, table), &columns, sink, &bad)?;
+    }
+    Ok(declared)
+}
+
+/// The names of a `.dbf`'s columns, in order.
+fn columns<T: Read + Seek>(table: &dbase::Reader<T>) -> Vec<String> {
+    table
+        .fields()
+        .iter()
+        .map(|f| f.name().to_string())
+        .collect()
+}
+
+/// Every record of `reader` as a feature into `sink`, its properties in
+/// the order of `columns`.
+fn records<T: Read + Seek, D: Read + Seek>(
+    mut reader: shapefile::Reader<T, D>,
+    columns: &[String],
+    sink: &mut dyn FnMut(Feature),
+    bad: &dyn Fn(&dyn std::fmt::Display) -> String,
+) -> Result<(), String> {
     let column = |name: &str| columns.iter().position(|c| c == name).unwrap_or(usize::MAX);
-    let mut reader = shapefile::Reader::from_path(path).map_err(|e| bad(&e))?;
     for (index, item) in reader.iter_shapes_and_records().enumerate() {
         let (shape, record) = item.map_err(|e| bad(&format!("record {index}: {e}")))?;
         let mut feature = Feature::default();
@@ -76,7 +117,7 @@ pub fn read(path: &Path, sink: &mut dyn FnMut(Feature)) -> Result<Option<Declare
         }
         sink(feature);
     }
-    Ok(declared)
+    Ok(())
 }
 
 /// Polygons from a record's rings: each outer ring with the inner rings

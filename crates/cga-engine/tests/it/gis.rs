@@ -585,6 +585,19 @@ fn geopackage_tables_with_their_crs_attributes_and_feature_ids() {
     let set = read(&path, &LotOptions::default());
     let names: Vec<&str> = set.lots.iter().map(|l| l.name.as_str()).collect();
     assert_eq!(names, ["100", "101", "7"]);
+    // SQLite opens files by path: a GeoPackage held in memory is refused
+    // with a reason.
+    let memory = cga_world::MemoryWorld::new().with("/mem/x.gpkg", std::fs::read(&path).unwrap());
+    let e = cga_engine::gis::read_lots_in(
+        &memory,
+        &["/mem/x.gpkg".to_string()],
+        &LotOptions::default(),
+    )
+    .unwrap_err();
+    assert_eq!(
+        e,
+        "cannot read GeoPackage /mem/x.gpkg: a GeoPackage is read from a file on disk, and this one is not"
+    );
     for (lot, sq) in set.lots.iter().zip(&squares) {
         for (got, want) in lot_edges(lot).iter().zip(geodesic_edges(sq)) {
             assert!((got - want).abs() < 1e-4 * want, "{got} vs {want}");
@@ -654,7 +667,26 @@ fn shapefile_with_its_prj_holes_and_attributes() {
             .unwrap();
     }
     drop(w);
+    // The same files in memory (a world that is no disk) give the same lots.
+    let memory = cga_world::MemoryWorld::new();
+    for ext in ["shp", "dbf", "prj"] {
+        memory.set(
+            format!("/mem/lots.{ext}"),
+            std::fs::read(path.with_extension(ext)).unwrap(),
+        );
+    }
+    let from_memory = cga_engine::gis::read_lots_in(
+        &memory,
+        &["/mem/lots.shp".to_string()],
+        &LotOptions::default(),
+    )
+    .unwrap();
     let set = read(&path, &LotOptions::default());
+    assert_eq!(from_memory.lots.len(), 2);
+    for (a, b) in from_memory.lots.iter().zip(&set.lots) {
+        assert_eq!(a.mesh.positions, b.mesh.positions);
+        assert_eq!(a.attrs, b.attrs);
+    }
     assert_eq!(set.lots.len(), 2);
     assert_eq!(set.lots[0].mesh.loops.len(), 2, "the hole is kept");
     assert_eq!(set.lots[1].name, "1");

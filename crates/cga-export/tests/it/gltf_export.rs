@@ -467,3 +467,85 @@ fn format_from_extension() {
     assert_eq!(Format::from_path(Path::new("city.fbx")), None);
     assert_eq!(Format::from_path(Path::new("city")), None);
 }
+
+/// Lots begun with `begin_lot` are nodes of their own (named, with their
+/// extras, a primitive per material), also when data was written out early;
+/// with `Granularity::Material` everything is merged by material.
+#[test]
+fn a_node_per_lot_or_a_mesh_per_material() {
+    use cga_export::{serde_json::json, Granularity};
+    let dir = out_dir("gltf_lots");
+    let red = colored("red", [1.0, 0.0, 0.0]);
+    let blue = colored("blue", [0.0, 0.0, 1.0]);
+    let lot_a = [
+        box_mesh(DVec3::ZERO, DVec3::ONE, red.clone()),
+        box_mesh(DVec3::Y, DVec3::ONE, blue.clone()),
+    ];
+    let lot_b = [box_mesh(DVec3::new(5.0, 0.0, 0.0), DVec3::ONE, red.clone())];
+    for (name, granularity, flush_mib) in [
+        ("lots.glb", Granularity::Lot, 64),
+        ("lots.gltf", Granularity::Lot, 0),
+        ("merged.glb", Granularity::Material, 64),
+    ] {
+        let path = dir.join(name);
+        let options = ExportOptions {
+            granularity,
+            flush_mib,
+            ..ExportOptions::default()
+        };
+        let mut w = ModelWriter::create(&path, Format::from_path(&path).unwrap(), options).unwrap();
+        w.expect_lots(3);
+        w.begin_lot("a", Some(json!({"lot": 0, "attributes": {"height": 12.5}})))
+            .unwrap();
+        for m in &lot_a {
+            w.add_mesh(m).unwrap();
+        }
+        // A lot without geometry gets no node.
+        w.begin_lot("empty", None).unwrap();
+        w.begin_lot("b", Some(json!({"lot": 2}))).unwrap();
+        for m in &lot_b {
+            w.add_mesh(m).unwrap();
+        }
+        let stats = w.finish().unwrap();
+        assert_eq!((stats.materials, stats.faces), (2, 18), "{name}");
+        assert_valid_gltf(&path);
+        let g = read_gltf(&path);
+        let nodes: Vec<(String, usize, Option<String>)> = g
+            .doc
+            .nodes()
+            .map(|n| {
+                (
+                    n.name().unwrap().to_string(),
+                    n.mesh().unwrap().primitives().count(),
+                    n.extras().as_ref().map(|e| e.get().to_string()),
+                )
+            })
+            .collect();
+        let areas: Vec<f64> = primitives(&g).iter().map(Prim::area).collect();
+        match granularity {
+            Granularity::Lot => {
+                assert_eq!(
+                    nodes,
+                    [
+                        (
+                            "a".to_string(),
+                            2,
+                            Some(r#"{"attributes":{"height":12.5},"lot":0}"#.to_string())
+                        ),
+                        ("b".to_string(), 1, Some(r#"{"lot":2}"#.to_string())),
+                    ],
+                    "{name}"
+                );
+                // Lot a: a red and a blue cube; lot b: a red cube.
+                assert_eq!(areas, [6.0, 6.0, 6.0], "{name}");
+            }
+            Granularity::Material => {
+                assert_eq!(
+                    nodes,
+                    [("red".to_string(), 1, None), ("blue".to_string(), 1, None)]
+                );
+                assert_eq!(areas, [12.0, 6.0]);
+            }
+        }
+    }
+}

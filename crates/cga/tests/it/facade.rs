@@ -224,7 +224,87 @@ fn a_confined_world_refuses_files_outside_its_roots() {
     );
     std::fs::write(dir.join("private/lib.cga"), "A --> X.").unwrap();
     assert!(outside.has_errors());
+    // Lot files are read through the world too: inside the roots, yes.
+    std::fs::write(
+        dir.join("project/lots.obj"),
+        "v 0 0 0\nv 4 0 0\nv 4 0 -4\nv 0 0 -4\nf 1 2 3 4\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("private/lots.obj"),
+        "v 0 0 0\nv 4 0 0\nv 4 0 -4\nf 1 2 3\n",
+    )
+    .unwrap();
+    let inside = engine
+        .read_lots(
+            &[dir.join("project/lots.obj").display().to_string()],
+            &Default::default(),
+        )
+        .unwrap();
+    assert_eq!(inside.lots.len(), 1);
+    let Err(Error::Lot(e)) = engine.read_lots(
+        &[dir.join("private/lots.obj").display().to_string()],
+        &Default::default(),
+    ) else {
+        panic!("a lot file outside the roots was read");
+    };
+    assert!(
+        e.contains("outside the folders this engine may read"),
+        "{e}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Lots from files held in memory (an upload, a notebook's string): OBJ,
+/// GeoJSON, FlatGeobuf and Shapefile go through the engine's world.
+#[test]
+fn lots_are_read_through_the_engines_world() {
+    let world = MemoryWorld::new()
+        .with(
+            "/data/parcels.geojson",
+            r#"{"type":"FeatureCollection","features":[
+              {"type":"Feature","id":"p1","properties":{"floors":3},"geometry":{"type":"Polygon",
+               "coordinates":[[[0,0],[10,0],[10,20],[0,20],[0,0]]]}}]}"#,
+        )
+        .with(
+            "/data/lots.obj",
+            "v 0 0 0\nv 5 0 0\nv 5 0 -5\nv 0 0 -5\nf 1 2 3 4\n",
+        );
+    let engine = Engine::new(world);
+    let options = cga::LotOptions {
+        crs: Some(cga::CrsOption::Local),
+        ..Default::default()
+    };
+    let set = engine
+        .read_lots(
+            &[
+                "/data/parcels.geojson",
+                "/data/lots.obj",
+                "grid:2x1:/data/lots.obj",
+            ],
+            &options,
+        )
+        .unwrap();
+    let names: Vec<&str> = set.lots.iter().map(|l| l.name.as_str()).collect();
+    assert_eq!(names.len(), 4, "{names:?}");
+    assert_eq!(names[0], "p1");
+    assert_eq!(
+        set.lots[0].attrs,
+        vec![("floors".into(), Value::Float(3.0))]
+    );
+    let area = |l: &cga::Lot| -> f64 {
+        let rules = engine.load_text("/data/a.cga", "Lot --> print(geometry.area)\n");
+        rules.generate(l, &Options::default()).unwrap().prints[0]
+            .parse()
+            .unwrap()
+    };
+    assert_eq!(area(&set.lots[0]), 200.0);
+    assert_eq!(area(&set.lots[1]), 25.0);
+    // Not on disk: the same names fail there.
+    let Err(Error::Lot(e)) = cga::lots::read_with(&["/data/lots.obj"], &options) else {
+        panic!("read from disk");
+    };
+    assert!(e.starts_with("cannot read lot file /data/lots.obj"), "{e}");
 }
 
 #[test]

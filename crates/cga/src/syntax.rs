@@ -1,0 +1,55 @@
+//! Rule files as text: the syntax tree and where a path written in a rule
+//! file leads, for tools that work on the text itself (the language server,
+//! a formatter) rather than on loaded [`Rules`](crate::Rules).
+//!
+//! [`parse`] is the engine's own error-tolerant parser: it never panics,
+//! always gives a tree (with placeholders where text was missing) and the
+//! syntax errors found. Spans are byte offsets into the text parsed.
+//! [`sexpr`] writes a tree in a compact text form without spans: two
+//! texts with the same form mean the same (a formatter's test).
+
+use std::path::{Path, PathBuf};
+
+pub use cga_syntax::ast;
+pub use cga_syntax::{parse, sexpr, FileId, Span};
+
+use crate::{Workspaces, World};
+
+/// The file `target` (an import, asset or texture path as written in the
+/// rule file `from`) names, found as the engine finds it when loading:
+/// workspace paths (`/Project/...`) in the ancestors of `from` then in
+/// `workspaces`, other paths relative to `from`'s folder and its
+/// ancestors' `assets/`. `Err` lists every place searched.
+pub fn locate(
+    world: &dyn World,
+    from: &Path,
+    target: &str,
+    workspaces: &Workspaces,
+) -> Result<PathBuf, Vec<PathBuf>> {
+    cga_engine::locate::locate(world, from, target, workspaces)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::MemoryWorld;
+
+    #[test]
+    fn parses_and_locates_as_the_engine_does() {
+        let text = "import f : \"/Lib/rules/f.cga\"\nLot --> f.Facade";
+        let (module, errors) = parse(FileId(0), text);
+        assert!(errors.is_empty());
+        let ast::Item::Import(import) = &module.items[0] else {
+            panic!("an import");
+        };
+        assert_eq!(import.path, "/Lib/rules/f.cga");
+        assert_eq!(&text[import.path_span.range()], "\"/Lib/rules/f.cga\"");
+
+        let world = MemoryWorld::new().with("/ws/Lib/rules/f.cga", "Facade --> X.");
+        let from = Path::new("/ws/Main/rules/main.cga");
+        let found = locate(&world, from, &import.path, &Workspaces::default());
+        assert_eq!(found, Ok(PathBuf::from("/ws/Lib/rules/f.cga")));
+        let missing = locate(&world, from, "g.cga", &Workspaces::default()).unwrap_err();
+        assert_eq!(missing[0], PathBuf::from("/ws/Main/rules/g.cga"));
+    }
+}

@@ -500,6 +500,9 @@ pub struct SceneContext {
     /// For each lot, the other lots within [`OCCLUSION_NEIGHBOURHOOD`].
     neighbours: Vec<Vec<u32>>,
     labels: HashMap<Arc<str>, LabelIndex>,
+    /// The lot index of `lots[0]`, when the scene is a part of a larger
+    /// run (see [`SceneContext::starting_at`]).
+    first: usize,
 }
 
 impl SceneContext {
@@ -545,6 +548,7 @@ impl SceneContext {
             lots,
             neighbours,
             labels,
+            first: 0,
         }
     }
 
@@ -554,15 +558,26 @@ impl SceneContext {
 
     /// The records of lot `index` (empty if there is no such lot).
     pub fn lot(&self, index: usize) -> Arc<LotContext> {
-        self.lots
-            .get(index)
+        index
+            .checked_sub(self.first)
+            .and_then(|i| self.lots.get(i))
             .cloned()
             .unwrap_or_else(|| Arc::new(LotContext::default()))
     }
 
     /// The lots inter occlusion queries of lot `index` test against.
     pub fn neighbours(&self, index: usize) -> &[u32] {
-        self.neighbours.get(index).map_or(&[], Vec::as_slice)
+        index
+            .checked_sub(self.first)
+            .and_then(|i| self.neighbours.get(i))
+            .map_or(&[], Vec::as_slice)
+    }
+
+    /// The scene with its lots numbered from `first` (the lot indices of a
+    /// part of a larger run); neighbours stay positions in the scene.
+    pub fn starting_at(mut self, first: usize) -> SceneContext {
+        self.first = first;
+        self
     }
 
     fn label_total(&self, label: &str) -> usize {
@@ -622,7 +637,7 @@ impl SceneContext {
             let env = envelope(bounds, margin);
             let mut best = f64::INFINITY;
             for item in tree.locate_in_envelope_intersecting(&env) {
-                if item.data.0 as usize != own {
+                if item.data.0 as usize + self.first != own {
                     best = best.min(box_distance(scope, &self.record(item.data).scope));
                 }
             }

@@ -302,6 +302,19 @@ pub(crate) struct MapUse {
     channel: usize,
 }
 
+/// The box around primitives (min, max), if there are any.
+fn bounds_of(primitives: &[&PrimitiveLayout]) -> Option<[[f64; 3]; 2]> {
+    let first = primitives.first()?;
+    let mut b = [first.min.map(f64::from), first.max.map(f64::from)];
+    for p in &primitives[1..] {
+        for k in 0..3 {
+            b[0][k] = b[0][k].min(f64::from(p.min[k]));
+            b[1][k] = b[1][k].max(f64::from(p.max[k]));
+        }
+    }
+    Some(b)
+}
+
 /// A node to write: its name, extras and primitives (with their material
 /// ids).
 type NodeGroup = (
@@ -678,6 +691,15 @@ impl GltfWriter {
             primitives.push((p.material, prim));
             used[p.material as usize] = true;
             stats.vertices += p.vertices;
+        }
+        let layouts: Vec<&PrimitiveLayout> = self.written.iter().chain(&held).collect();
+        stats.bounds = bounds_of(&layouts);
+        if self.per_lot {
+            let starts: Vec<usize> = self.lots.iter().map(|l| l.first).collect();
+            for (k, &start) in starts.iter().enumerate() {
+                let end = starts.get(k + 1).copied().unwrap_or(layouts.len());
+                stats.lot_bounds.push(bounds_of(&layouts[start..end]));
+            }
         }
         // The glTF material of each material id that has primitives.
         let mut gltf_materials: Vec<Option<json::Index<json::Material>>> =

@@ -75,6 +75,7 @@ impl Rules {
             engine_options.scene = Some(Arc::new(self.collect_scene(
                 rule,
                 lots,
+                options.first_index,
                 &engine_options,
                 jobs,
             )?));
@@ -124,8 +125,11 @@ impl Rules {
             if begun != Some(i) {
                 begun = Some(i);
                 if let Some(w) = writer.as_deref_mut() {
-                    w.begin_lot(&lots[i].name, Some(lot_extras(i, &lots[i])))
-                        .map_err(Error::Export)?;
+                    w.begin_lot(
+                        &lots[i].name,
+                        Some(lot_extras(options.first_index + i, &lots[i])),
+                    )
+                    .map_err(Error::Export)?;
                 }
             }
             let mut result = Ok(());
@@ -160,7 +164,7 @@ impl Rules {
             {
                 return Err(Error::Cancelled);
             }
-            let mut lot = self.lot_result(i, &lots[i], done);
+            let mut lot = self.lot_result(options.first_index + i, &lots[i], done);
             let mut warnings = self.annotation_warnings(options, &lots[i]);
             warnings.append(&mut lot.warnings);
             lot.warnings = warnings;
@@ -178,7 +182,7 @@ impl Rules {
                 assets,
                 rule.0,
                 &lots[i],
-                i,
+                options.first_index + i,
                 &engine_options,
                 |leaf| {
                     leaves += 1;
@@ -273,6 +277,7 @@ impl Rules {
         &self,
         rule: RuleRef,
         lots: &[Lot],
+        first: usize,
         options: &GenerateOptions,
         jobs: usize,
     ) -> Result<SceneContext, Error> {
@@ -288,7 +293,7 @@ impl Rules {
                 }
                 done.push((
                     i,
-                    collect_lot(program, assets, rule.0, &lots[i], i, options),
+                    collect_lot(program, assets, rule.0, &lots[i], first + i, options),
                 ));
             }
             done
@@ -317,10 +322,7 @@ impl Rules {
             .into_iter()
             .map(|r| r.unwrap_or_else(|| LotContext::new(None)))
             .collect();
-        Ok(SceneContext::new(
-            records,
-            options.context_use.unwrap_or_default(),
-        ))
+        Ok(SceneContext::new(records, options.context_use.unwrap_or_default()).starting_at(first))
     }
 
     /// Warnings for the values `options` and `lot` give attributes that

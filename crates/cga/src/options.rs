@@ -30,6 +30,11 @@ pub struct Options {
     pub jobs: Option<usize>,
     /// Stops a running generation from another thread.
     pub cancel: Option<Cancel>,
+    /// The index of the first of the lots given in a larger run (a city
+    /// generated in parts: tiles, partitions): lot `i` of the call derives
+    /// with the seed of lot `first_index + i`, and its results carry that
+    /// index, so the parts make the city one call would.
+    pub first_index: usize,
 }
 
 impl Options {

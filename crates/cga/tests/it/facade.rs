@@ -488,9 +488,9 @@ fn seven_zip_packages_of_cityengine_load_and_generate() {
 }
 
 /// A city generated in parts (tiles, partitions) is the city of one call:
-/// `first_index` numbers the lots of a part as in the whole.
+/// `lot_indices` number the lots of a part as in the whole.
 #[test]
-fn parts_with_their_first_index_make_the_same_city() {
+fn parts_with_their_lot_indices_make_the_same_city() {
     let rules = memory_rules(
         "attr h = rand(5, 50)\nLot --> print(h + \" \" + rand(0, 1) + \" \" + initialShape.name) X.\n",
     );
@@ -508,20 +508,18 @@ fn parts_with_their_first_index_make_the_same_city() {
         .into_iter()
         .flat_map(|r| r.prints)
         .collect();
-    let mut parts = Vec::new();
-    for (first, part) in [(0, &lots[..2]), (2, &lots[2..])] {
+    // Lots 3, 0 and 4, then 1 and 2: each part in any order.
+    let mut parts = vec![String::new(); 5];
+    for indices in [vec![3, 0, 4], vec![1, 2]] {
+        let part: Vec<cga::Lot> = indices.iter().map(|&i| lots[i].clone()).collect();
         let options = Options {
-            first_index: first,
+            lot_indices: Some(indices.clone().into()),
             ..options.clone()
         };
-        for (k, r) in rules
-            .generate_all(part, &options)
-            .unwrap()
-            .into_iter()
-            .enumerate()
-        {
-            assert_eq!(r.index, first + k);
-            parts.extend(r.prints);
+        let results = rules.generate_all(&part, &options).unwrap();
+        for (k, r) in results.into_iter().enumerate() {
+            assert_eq!(r.index, indices[k]);
+            parts[r.index] = r.prints[0].clone();
         }
     }
     assert_eq!(whole.len(), 5);

@@ -307,9 +307,9 @@ fn bounds_of(primitives: &[&PrimitiveLayout]) -> Option<[[f64; 3]; 2]> {
     let first = primitives.first()?;
     let mut b = [first.min.map(f64::from), first.max.map(f64::from)];
     for p in &primitives[1..] {
-        for k in 0..3 {
-            b[0][k] = b[0][k].min(f64::from(p.min[k]));
-            b[1][k] = b[1][k].max(f64::from(p.max[k]));
+        for (k, (lo, hi)) in p.min.iter().zip(&p.max).enumerate() {
+            b[0][k] = b[0][k].min(f64::from(*lo));
+            b[1][k] = b[1][k].max(f64::from(*hi));
         }
     }
     Some(b)

@@ -1,0 +1,203 @@
+//! 3D Tiles output (`-o tileset.json`): a tileset of valid GLB tiles over
+//! a quadtree of the lots, placed on the globe when the lots are, checked
+//! by a structural check of our own (the 3D Tiles validator is not in the
+//! package registries reachable here) and the Khronos glTF validator.
+
+use std::path::Path;
+
+use serde_json::Value;
+
+use crate::common::*;
+
+/// The JSON of a GLB file.
+fn glb_json(path: &Path) -> Value {
+    let bytes = std::fs::read(path).unwrap();
+    assert!(
+        bytes.starts_with(b"glTF"),
+        "{} is not a GLB",
+        path.display()
+    );
+    let len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    serde_json::from_slice(&bytes[20..20 + len]).unwrap()
+}
+
+/// `n` x `n` lots of 20 x 30 m in longitude/latitude around 8.5 E, 47.3 N,
+/// with a `height` property.
+fn lonlat_lots(dir: &Path, n: usize) -> std::path::PathBuf {
+    let (dlon, dlat) = (1.0 / 75_500.0, 1.0 / 111_200.0); // about a metre
+    let mut features = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            let (x, y) = (
+                8.5 + (i as f64 * 40.0) * dlon,
+                47.3 + (j as f64 * 45.0) * dlat,
+            );
+            let ring = [
+                (x, y),
+                (x + 20.0 * dlon, y),
+                (x + 20.0 * dlon, y + 30.0 * dlat),
+                (x, y + 30.0 * dlat),
+                (x, y),
+            ];
+            let coords: Vec<String> = ring.iter().map(|(a, b)| format!("[{a},{b}]")).collect();
+            features.push(format!(
+                r#"{{"type":"Feature","id":"b{i}_{j}","properties":{{"height":{}}},"geometry":{{"type":"Polygon","coordinates":[[{}]]}}}}"#,
+                8 + (i * n + j) % 7 * 3,
+                coords.join(",")
+            ));
+        }
+    }
+    let path = dir.join("lots.geojson");
+    std::fs::write(
+        &path,
+        format!(
+            r#"{{"type":"FeatureCollection","features":[{}]}}"#,
+            features.join(",")
+        ),
+    )
+    .unwrap();
+    path
+}
+
+/// A box's corners' ranges: centre ± |half axes|.
+fn box_range(b: &Value) -> [[f64; 2]; 3] {
+    let v: Vec<f64> = b["box"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert_eq!(v.len(), 12);
+    std::array::from_fn(|k| {
+        let r: f64 = (0..3).map(|a| v[3 + 3 * a + k].abs()).sum();
+        [v[k] - r, v[k] + r]
+    })
+}
+
+/// Checks a tile and its children; returns the lots in its leaves.
+fn check_tile(dir: &Path, tile: &Value, parent: Option<([[f64; 2]; 3], f64)>, lots: &mut Vec<u64>) {
+    let range = box_range(&tile["boundingVolume"]);
+    let error = tile["geometricError"].as_f64().unwrap();
+    assert!(error >= 0.0);
+    if let Some((outer, parent_error)) = parent {
+        assert!(error <= parent_error, "{error} > {parent_error}");
+        for k in 0..3 {
+            assert!(range[k][0] >= outer[k][0] - 1e-3 && range[k][1] <= outer[k][1] + 1e-3);
+        }
+    }
+    let children = tile["children"].as_array().cloned().unwrap_or_default();
+    if let Some(uri) = tile["content"]["uri"].as_str() {
+        let glb = dir.join(uri);
+        assert_valid_gltf(&glb);
+        let json = glb_json(&glb);
+        if children.is_empty() {
+            for node in json["nodes"].as_array().unwrap() {
+                lots.push(node["extras"]["lot"].as_u64().unwrap());
+            }
+        }
+    }
+    if children.is_empty() {
+        assert_eq!(error, 0.0, "leaves are the full model");
+    } else {
+        assert_eq!(tile["refine"], "REPLACE");
+    }
+    for c in &children {
+        check_tile(dir, c, Some((range, error)), lots);
+    }
+}
+
+#[test]
+fn a_georeferenced_city_as_a_tileset() {
+    let dir = temp_dir("tiles");
+    let lots = lonlat_lots(&dir, 12);
+    let rules = rule_file(
+        &dir,
+        "city.cga",
+        "attr height = 10\nLot --> extrude(height) comp(f) { top : color(\"#a04030\") Roof. | side : split(y) { ~3 : Floor }* }\n\
+         Floor --> print(\"floor \" + split.index) color(rand(0.5, 1), 0.8, 0.7) X.\n",
+    );
+    let tileset = dir.join("out/tileset.json");
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--lot",
+        lots.to_str().unwrap(),
+        "-o",
+        tileset.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("144 lots"), "{}", stderr(&out));
+    let t: Value = serde_json::from_str(&std::fs::read_to_string(&tileset).unwrap()).unwrap();
+    assert_eq!(t["asset"]["version"], "1.1");
+    let root = &t["root"];
+    assert!(t["geometricError"].as_f64().unwrap() >= root["geometricError"].as_f64().unwrap());
+    // East-north-up at the frame's origin to ECEF: the origin is on the
+    // WGS84 ellipsoid near 8.5 E, 47.3 N.
+    let m: Vec<f64> = root["transform"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert_eq!(m.len(), 16);
+    let (x, y, z) = (m[12], m[13], m[14]);
+    let r = (x * x + y * y + z * z).sqrt();
+    assert!((6_360_000.0..6_380_000.0).contains(&r), "{r}");
+    let lon = y.atan2(x).to_degrees();
+    assert!((lon - 8.5).abs() < 0.01, "{lon}");
+    // Every lot in exactly one leaf; leaves hold at most 64 lots, so 144
+    // lots make a parent with children.
+    let mut seen = Vec::new();
+    check_tile(&dir.join("out"), root, None, &mut seen);
+    seen.sort();
+    assert_eq!(seen, (0..144).collect::<Vec<u64>>());
+    assert!(root["children"].as_array().is_some_and(|c| c.len() >= 2));
+    // The parent's massing: a node per lot.
+    let massing = glb_json(
+        &dir.join("out")
+            .join(root["content"]["uri"].as_str().unwrap()),
+    );
+    assert_eq!(massing["nodes"].as_array().unwrap().len(), 144);
+
+    // The same city as one GLB prints the same lines in the same order.
+    let glb = dir.join("out/city.glb");
+    let one = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--lot",
+        lots.to_str().unwrap(),
+        "-o",
+        glb.to_str().unwrap(),
+    ]);
+    assert!(one.status.success());
+    assert_eq!(stdout(&one), stdout(&out));
+}
+
+#[test]
+fn lots_in_metres_make_a_local_tileset() {
+    let dir = temp_dir("tiles-local");
+    let rules = rule_file(&dir, "b.cga", "Lot --> extrude(6) X.\n");
+    let tileset = dir.join("tileset.json");
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--lot",
+        "grid:3x2",
+        "-o",
+        tileset.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let t: Value = serde_json::from_str(&std::fs::read_to_string(&tileset).unwrap()).unwrap();
+    // Six lots: one leaf tile, no transform.
+    assert!(t["root"].get("transform").is_none());
+    assert!(t["root"].get("children").is_none());
+    let mut seen = Vec::new();
+    check_tile(&dir, &t["root"], None, &mut seen);
+    assert_eq!(seen, [0, 1, 2, 3, 4, 5]);
+    // z up: the box's height is the extrusion (half axis 3 m).
+    let b = box_range(&t["root"]["boundingVolume"]);
+    assert!(
+        (b[2][0] - 0.0).abs() < 1e-6 && (b[2][1] - 6.0).abs() < 1e-6,
+        "{b:?}"
+    );
+}

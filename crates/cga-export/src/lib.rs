@@ -471,6 +471,17 @@ impl ModelWriter {
         }
     }
 
+    /// Gives the vertices of each lot begun (with [`Granularity::Lot`]) the
+    /// lot's feature id, and writes a property table of the lots (index,
+    /// name, attributes): `EXT_mesh_features` and
+    /// `EXT_structural_metadata`, with which 3D Tiles viewers pick a
+    /// building and show what it is. glTF and GLB only.
+    pub fn with_features(&mut self) {
+        if let Sink::Gltf(w, _) = &mut self.sink {
+            w.with_features();
+        }
+    }
+
     /// Says how many lots will be begun ([`begin_lot`](Self::begin_lot)):
     /// a GLB with a node per lot then leaves room for their JSON at the
     /// start, instead of moving its binary data up at the end.

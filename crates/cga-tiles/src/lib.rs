@@ -275,6 +275,7 @@ impl<F: FnMut(LotResult)> Writer<'_, F> {
             ..self.tiles.export.clone()
         };
         let mut writer = ModelWriter::create(&path, Format::Glb, export).map_err(Error::Export)?;
+        writer.with_features();
         let part: Vec<Lot> = node.lots.iter().map(|&i| self.lots[i].clone()).collect();
         let indices: Arc<[usize]> = node.lots.clone().into();
         let options = Options {
@@ -318,6 +319,7 @@ impl<F: FnMut(LotResult)> Writer<'_, F> {
         };
         let mut writer = ModelWriter::create(&path, Format::Glb, export).map_err(Error::Export)?;
         writer.expect_lots(lots.len());
+        writer.with_features();
         let material = Material {
             color: [0.82, 0.8, 0.76],
             ..Material::default()

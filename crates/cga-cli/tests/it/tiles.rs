@@ -21,6 +21,87 @@ fn glb_json(path: &Path) -> Value {
     serde_json::from_slice(&bytes[20..20 + len]).unwrap()
 }
 
+/// The JSON and binary chunk of a GLB file.
+fn glb_parts(path: &Path) -> (Value, Vec<u8>) {
+    let bytes = std::fs::read(path).unwrap();
+    let len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let json = serde_json::from_slice(&bytes[20..20 + len]).unwrap();
+    let bin_len = u32::from_le_bytes(bytes[20 + len..24 + len].try_into().unwrap()) as usize;
+    (json, bytes[28 + len..28 + len + bin_len].to_vec())
+}
+
+/// The bytes of buffer view `v`, checking the 8-byte alignment that
+/// `EXT_structural_metadata` asks of its views.
+fn view_bytes<'a>(json: &Value, bin: &'a [u8], v: &Value) -> &'a [u8] {
+    let view = &json["bufferViews"][v.as_u64().unwrap() as usize];
+    let offset = view["byteOffset"].as_u64().unwrap_or(0) as usize;
+    assert_eq!(offset % 8, 0);
+    &bin[offset..offset + view["byteLength"].as_u64().unwrap() as usize]
+}
+
+/// The strings of a STRING property of a property table.
+fn strings(json: &Value, bin: &[u8], property: &Value) -> Vec<String> {
+    let text = view_bytes(json, bin, &property["values"]);
+    let offsets: Vec<usize> = view_bytes(json, bin, &property["stringOffsets"])
+        .chunks(4)
+        .map(|c| u32::from_le_bytes(c.try_into().unwrap()) as usize)
+        .collect();
+    offsets
+        .windows(2)
+        .map(|w| String::from_utf8(text[w[0]..w[1]].to_vec()).unwrap())
+        .collect()
+}
+
+/// A tile's lots as its property table has them (EXT_structural_metadata):
+/// index, name and the `height` attribute; and every primitive's feature
+/// ids name the lot of its node.
+fn property_table(path: &Path) -> Vec<(u64, String, String)> {
+    let (json, bin) = glb_parts(path);
+    let used: Vec<&str> = json["extensionsUsed"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap())
+        .collect();
+    assert!(used.contains(&"EXT_mesh_features") && used.contains(&"EXT_structural_metadata"));
+    let table = &json["extensions"]["EXT_structural_metadata"]["propertyTables"][0];
+    let count = table["count"].as_u64().unwrap() as usize;
+    let index: Vec<u64> = view_bytes(&json, &bin, &table["properties"]["index"]["values"])
+        .chunks(4)
+        .map(|c| u32::from_le_bytes(c.try_into().unwrap()) as u64)
+        .collect();
+    let names = strings(&json, &bin, &table["properties"]["name"]);
+    let heights = strings(&json, &bin, &table["properties"]["attr_height"]);
+    assert_eq!(
+        (index.len(), names.len(), heights.len()),
+        (count, count, count)
+    );
+    for (k, node) in json["nodes"].as_array().unwrap().iter().enumerate() {
+        assert_eq!(node["extras"]["lot"].as_u64().unwrap(), index[k]);
+        for p in json["meshes"][node["mesh"].as_u64().unwrap() as usize]["primitives"]
+            .as_array()
+            .unwrap()
+        {
+            let ids = &p["extensions"]["EXT_mesh_features"]["featureIds"][0];
+            assert_eq!(ids["featureCount"].as_u64().unwrap() as usize, count);
+            let acc =
+                &json["accessors"][p["attributes"]["_FEATURE_ID_0"].as_u64().unwrap() as usize];
+            let view = &json["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
+            let offset = view["byteOffset"].as_u64().unwrap_or(0) as usize;
+            let n = acc["count"].as_u64().unwrap() as usize;
+            for c in bin[offset..offset + 4 * n].chunks(4) {
+                assert_eq!(f32::from_le_bytes(c.try_into().unwrap()), k as f32);
+            }
+        }
+    }
+    index
+        .into_iter()
+        .zip(names)
+        .zip(heights)
+        .map(|((i, n), h)| (i, n, h))
+        .collect()
+}
+
 /// `n` x `n` lots of 20 x 30 m in longitude/latitude around 8.5 E, 47.3 N,
 /// with a `height` property.
 fn lonlat_lots(dir: &Path, n: usize) -> std::path::PathBuf {
@@ -152,6 +233,24 @@ fn a_georeferenced_city_as_a_tileset() {
     seen.sort();
     assert_eq!(seen, (0..144).collect::<Vec<u64>>());
     assert!(root["children"].as_array().is_some_and(|c| c.len() >= 2));
+    // Per-building metadata in a leaf: feature ids and a property table
+    // with the lot's index, its feature id and its `height` property.
+    let leaf = &root["children"][0];
+    let leaf = if leaf["children"].is_array() {
+        &leaf["children"][0]
+    } else {
+        leaf
+    };
+    let rows = property_table(
+        &dir.join("out")
+            .join(leaf["content"]["uri"].as_str().unwrap()),
+    );
+    assert!(!rows.is_empty());
+    for (index, name, height) in &rows {
+        let (i, j) = (*index as usize / 12, *index as usize % 12);
+        assert_eq!(name, &format!("b{i}_{j}"));
+        assert_eq!(height, &(8 + (i * 12 + j) % 7 * 3).to_string());
+    }
     // The parent's massing: a node per lot.
     let massing = glb_json(
         &dir.join("out")

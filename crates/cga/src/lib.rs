@@ -46,20 +46,30 @@ mod values;
 pub use attributes::{Annotation, Attribute, Range};
 pub use cga_engine::Workspaces;
 pub use cga_export::{ExportOptions, ExportStats, Format, Georeference, Granularity, ModelWriter};
-pub use cga_value::{Value, ValueType};
+pub use cga_value::{Array, Value, ValueType};
 pub use cga_world::{decode_text, ConfinedWorld, DiskWorld, MemoryWorld, Metadata, World};
 pub use diagnostics::{Diagnostic, Location, Severity};
 pub use error::{Error, ExportError};
 pub use generate::Target;
-pub use lots::{CrsOption, GeoOrigin, InvalidPolicy, Lot, LotOptions, LotSet};
-pub use model::{LeafOrigin, LotResult, Material, PlainMesh, PlainModel, Provenance, Summary};
+pub use lots::{Axes, CrsOption, GeoOrigin, InvalidPolicy, Lot, LotOptions, LotSet};
+pub use model::{
+    write_plain, LeafOrigin, LotResult, Material, PlainMesh, PlainModel, Provenance, Summary,
+};
 pub use options::{Cancel, Limits, Options};
 pub use rules::{Engine, ProgramSize, RuleInfo, RuleRef, Rules};
 
 /// Default largest asset file read, in MiB ([`Engine::max_asset_mib`]).
 pub use cga_engine::assets::DEFAULT_MAX_ASSET_MIB;
+/// The seed lot `index` of a run with seed `seed` derives with (unless it
+/// has its own): hosts that split one run into parts (the Python
+/// package's Dask partitions) give each lot this seed as its own `seed`,
+/// so that every part generates what the whole run would.
+pub use cga_engine::generate::lot_seed;
 /// Default vertex data a glTF/GLB writer holds before writing it out, in MiB.
 pub use cga_export::DEFAULT_FLUSH_MIB;
+/// The names of a material's ten texture channels, in the order of
+/// [`Material::maps`] (and of CGA's UV sets).
+pub use cga_geometry::material::TEXTURE_CHANNELS;
 pub use values::parse_value;
 
 /// A value's text form, as `print()` and `str()` write it.

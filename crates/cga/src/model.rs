@@ -95,3 +95,66 @@ pub struct Summary {
     /// Seconds from the start until every lot was derived.
     pub derived_after: f64,
 }
+
+/// Adds plain meshes (made by [`Rules::generate`] or a host's own code:
+/// the Python package writes the models its users kept) to a model file:
+/// each triangle is written as a face with its vertices' normals and
+/// texture coordinates and its mesh's material. Meshes that name a
+/// material the model does not have, or indices out of range, are an
+/// [`Error::Export`](crate::Error::Export).
+pub fn write_plain(
+    writer: &mut cga_export::ModelWriter,
+    model: &PlainModel,
+) -> Result<(), crate::Error> {
+    use cga_geometry::{DVec2, DVec3, Mesh};
+    let bad = |why: String| crate::Error::Export(cga_export::ExportError::InvalidMesh(why));
+    let mut mesh = Mesh::new();
+    mesh.materials = model.materials.clone().into();
+    if mesh.materials.is_empty() {
+        mesh.materials = vec![Material::default()].into();
+    }
+    let corners: usize = model.meshes.iter().map(|m| m.indices.len() * 3).sum();
+    mesh.uvs[0] = Some(Vec::with_capacity(corners));
+    mesh.normals = Some(Vec::with_capacity(corners));
+    mesh.reserve(corners);
+    for (k, m) in model.meshes.iter().enumerate() {
+        if m.material >= mesh.materials.len() {
+            return Err(bad(format!(
+                "mesh {k} names material {} of {}",
+                m.material,
+                mesh.materials.len()
+            )));
+        }
+        let n = m.positions.len();
+        if m.normals.len() != n || m.uvs.len() != n {
+            return Err(bad(format!(
+                "mesh {k} has {n} positions, {} normals and {} texture coordinates",
+                m.normals.len(),
+                m.uvs.len()
+            )));
+        }
+        let base = mesh.positions.len() as u32;
+        mesh.positions
+            .extend(m.positions.iter().map(|p| DVec3::from_array(*p)));
+        for t in &m.indices {
+            if t.iter().any(|&i| i as usize >= n) {
+                return Err(bad(format!(
+                    "mesh {k} has a triangle {t:?} past its {n} vertices"
+                )));
+            }
+            let idx = [base + t[0], base + t[1], base + t[2]];
+            mesh.add_face(&[&idx], m.material as u32);
+            let start = mesh.corners.len() - 3;
+            for (c, &i) in t.iter().enumerate() {
+                let i = i as usize;
+                if let Some(uvs) = &mut mesh.uvs[0] {
+                    uvs[start + c] = DVec2::from_array(m.uvs[i]);
+                }
+                if let Some(normals) = &mut mesh.normals {
+                    normals[start + c] = DVec3::from_array(m.normals[i]);
+                }
+            }
+        }
+    }
+    writer.add_mesh(&mesh).map_err(crate::Error::Export)
+}

@@ -2,3 +2,4 @@
 //! integration-test file would link the whole engine again).
 
 mod facade;
+mod plain;

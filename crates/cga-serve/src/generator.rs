@@ -391,14 +391,16 @@ impl Preview {
             .attributes()
             .iter()
             .map(|a| {
-                let range = a.range().map(|r| json!({"min": r.min, "max": r.max, "step": r.step}));
+                let range = a
+                    .range()
+                    .map(|r| json!({"min": r.min, "max": r.max, "step": r.step}));
                 let files = a.file_extensions().map(|ext| self.files_with(&ext));
                 json!({
                     "name": a.name,
                     "type": a.ty.map(|t| format!("{t:?}").to_lowercase()),
                     "default": a.default.as_ref().map(encode::value),
                     "range": range,
-                    "enum": a.enum_values().map(|vs| vs.iter().map(encode::value).collect::<Vec<_>>()),
+                    "enum": choices(a).map(|vs| vs.iter().map(encode::value).collect::<Vec<_>>()),
                     "color": a.is_color(),
                     "group": a.group().map(|(g, o)| json!({"name": g, "order": o})),
                     "order": a.order(),
@@ -478,6 +480,19 @@ impl Preview {
         }
         path.to_string_lossy().into_owned()
     }
+}
+
+/// The values a drop-down offers: `@Enum`'s, or those of a `@Range` of
+/// strings (`@Range("Visualization", "3DPrint")`, an older form
+/// CityEngine's Inspector also shows as a list).
+fn choices(a: &cga::Attribute) -> Option<Vec<cga::Value>> {
+    if let Some(values) = a.enum_values() {
+        return Some(values);
+    }
+    let range = a.annotation("Range")?;
+    let values: Vec<cga::Value> = range.args.iter().filter_map(|(_, v)| v.clone()).collect();
+    let strings = !values.is_empty() && values.iter().all(|v| matches!(v, cga::Value::Str(_)));
+    strings.then_some(values)
 }
 
 /// `path` relative to `base` (`../assets/a.obj` where it is not below).

@@ -83,6 +83,8 @@ const RULE: &str = r##"
 attr height = 10
 @Enum("flat", "gable") @Group("Massing", 1) @Order(2)
 attr roof = "flat"
+@Range("Visualization", "3DPrint")
+attr mode = "Visualization"
 @Color @Description("The wall's colour")
 attr wall = "#c0b0a0"
 @File("png")
@@ -118,6 +120,11 @@ fn state_model_provenance_and_parameters() {
     assert_eq!(attr("height")["group"]["name"], "Massing");
     assert_eq!(attr("height")["order"], 1.0);
     assert_eq!(attr("roof")["enum"], serde_json::json!(["flat", "gable"]));
+    assert_eq!(
+        attr("mode")["enum"],
+        serde_json::json!(["Visualization", "3DPrint"])
+    );
+    assert_eq!(attr("height")["enum"], Json::Null);
     assert_eq!(attr("wall")["color"], true);
     assert_eq!(attr("wall")["description"], "The wall's colour");
     assert_eq!(attr("secret")["hidden"], true);
@@ -140,7 +147,7 @@ fn state_model_provenance_and_parameters() {
     let p: Json = serde_json::from_slice(&body).unwrap();
     assert_eq!(p["rule"], "Lot");
     assert_eq!(p["file"], "rules/a.cga");
-    assert_eq!(p["line"], 15);
+    assert_eq!(p["line"], 17);
     assert_eq!(get(addr, "/api/provenance?lot=0&mesh=0&tri=99999").0, 404);
     assert_eq!(get(addr, "/api/provenance?lot=7&mesh=0&tri=0").0, 404);
 

@@ -126,12 +126,29 @@ function decodeModel(buffer) {
   return { header, data: 8 + headerLength };
 }
 
+// Colour maps by URL, loaded once; a texture that changes on disk is
+// seen after a reload of the page.
+const textures = new Map();
+const textureLoader = new THREE.TextureLoader();
+function texture(url) {
+  if (!textures.has(url)) {
+    const t = textureLoader.load(url, render);
+    t.colorSpace = THREE.SRGBColorSpace;
+    t.wrapS = t.wrapT = THREE.RepeatWrapping;
+    t.anisotropy = 4;
+    textures.set(url, t);
+  }
+  return textures.get(url);
+}
+
 function srgb(c) {
   return new THREE.Color().setRGB(c[0], c[1], c[2], THREE.SRGBColorSpace);
 }
 
 function buildMeshes(buffer, group, { lots = false } = {}) {
   const { header, data } = decodeModel(buffer);
+  // Textures are shared between models (see `texture`): only geometry
+  // and materials are freed.
   for (const child of group.children) {
     child.geometry.dispose();
     child.material.dispose();
@@ -146,9 +163,13 @@ function buildMeshes(buffer, group, { lots = false } = {}) {
       } else {
         geometry.computeVertexNormals();
       }
+      if (m.uvs !== null) {
+        geometry.setAttribute('uv', new THREE.BufferAttribute(new Float32Array(buffer, data + m.uvs, m.vertices * 2), 2));
+      }
       geometry.setIndex(new THREE.BufferAttribute(new Uint32Array(buffer, data + m.indices, m.triangles * 3), 1));
       const material = new THREE.MeshStandardMaterial({
         color: lots ? 0xa8a89e : srgb(m.color),
+        map: !lots && m.texture && m.uvs !== null ? texture(m.texture) : null,
         roughness: 0.85,
         metalness: 0,
         transparent: m.opacity < 1,

@@ -9,8 +9,8 @@
 //! ```
 //!
 //! The header: `{"lots": [{"index", "name", "meshes": [{"mesh", "vertices",
-//! "triangles", "positions", "normals", "indices", "color", "opacity",
-//! "material", "double_sided"}]}]}`, offsets in bytes from the start of
+//! "triangles", "positions", "normals", "uvs", "indices", "color",
+//! "opacity", "material", "double_sided", "texture"}]}]}`, offsets in bytes from the start of
 //! the data. `mesh` is the mesh's number in the lot's plain model, which
 //! [`cga::LotResult::provenance`] takes with a triangle number. The page
 //! builds its three.js geometry from these arrays directly, with no glTF
@@ -19,8 +19,10 @@
 use cga::{LotResult, Value};
 use serde_json::{json, Value as Json};
 
-/// The lots' meshes in the binary form above.
-pub fn model(results: &[LotResult]) -> Vec<u8> {
+/// The lots' meshes in the binary form above; `texture` gives the URL of
+/// a colour map path as the rules wrote it (`None`: not found, drawn
+/// without).
+pub fn model(results: &[LotResult], texture: &mut dyn FnMut(&str) -> Option<String>) -> Vec<u8> {
     let mut data: Vec<u8> = Vec::new();
     let mut lots = Vec::with_capacity(results.len());
     for lot in results {
@@ -42,6 +44,12 @@ pub fn model(results: &[LotResult]) -> Vec<u8> {
                     data.extend_from_slice(&(*c as f32).to_le_bytes());
                 }
             }
+            let uvs = data.len();
+            for uv in &mesh.uvs {
+                for c in uv {
+                    data.extend_from_slice(&(*c as f32).to_le_bytes());
+                }
+            }
             let indices = data.len();
             for t in &mesh.indices {
                 for i in t {
@@ -54,7 +62,9 @@ pub fn model(results: &[LotResult]) -> Vec<u8> {
                 "triangles": mesh.indices.len(),
                 "positions": positions,
                 "normals": if mesh.normals.len() == mesh.positions.len() { json!(normals) } else { Json::Null },
+                "uvs": if mesh.uvs.len() == mesh.positions.len() { json!(uvs) } else { Json::Null },
                 "indices": indices,
+                "texture": material.map(|m| m.colormap()).filter(|p| !p.is_empty()).and_then(&mut *texture),
                 "color": material.map(|m| m.color).unwrap_or([0.8, 0.8, 0.8]),
                 "opacity": material.map(|m| m.opacity).unwrap_or(1.0),
                 "material": material.map(|m| m.name.to_string()).unwrap_or_default(),
@@ -130,7 +140,7 @@ mod tests {
         let results = rules
             .generate_all(&[cga::lots::rect(10.0, 20.0)], &cga::Options::default())
             .unwrap();
-        let bytes = model(&results);
+        let bytes = model(&results, &mut |_| None);
         assert_eq!(&bytes[..4], b"CGAM");
         let h = u32::from_le_bytes(bytes[4..8].try_into().unwrap()) as usize;
         assert_eq!(h % 4, 0);
@@ -152,6 +162,7 @@ mod tests {
         assert_eq!(top, 7.0);
         let indices = mesh["indices"].as_u64().unwrap() as usize;
         assert_eq!(data.len(), indices + 12 * 12);
+        assert_eq!(mesh["texture"], Json::Null);
     }
 
     #[test]

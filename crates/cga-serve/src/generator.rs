@@ -105,7 +105,7 @@ impl Preview {
         let empty = Snapshot {
             version: 0,
             state: Arc::new("{}".to_string()),
-            model: Arc::new(encode::model(&[])),
+            model: Arc::new(encode::model(&[], &mut |_| None)),
             model_version: 0,
             made_by: None,
         };
@@ -326,7 +326,20 @@ impl Preview {
         let version = previous.version + 1;
         let fresh = made.is_some();
         let (model, model_version, made_by) = match made {
-            Some(m) => (Arc::new(encode::model(&m.results)), version, Some(m)),
+            Some(m) => {
+                let mut found = std::collections::HashMap::new();
+                let mut texture = |path: &str| {
+                    found
+                        .entry(path.to_string())
+                        .or_insert_with(|| self.texture_url(path))
+                        .clone()
+                };
+                (
+                    Arc::new(encode::model(&m.results, &mut texture)),
+                    version,
+                    Some(m),
+                )
+            }
             None => (
                 previous.model.clone(),
                 previous.model_version,
@@ -471,6 +484,28 @@ impl Preview {
         j
     }
 
+    /// The URL (`files/...`) of a texture the rules name, found as the
+    /// engine finds it from the rule file; `None` when it is not in the
+    /// workspace.
+    fn texture_url(&self, written: &str) -> Option<String> {
+        let found = cga::syntax::locate(
+            self.engine.world().as_ref(),
+            &self.rules_path,
+            written,
+            &cga::Workspaces::default(),
+        )
+        .ok()?;
+        let rel = self.roots.iter().find_map(|r| found.strip_prefix(r).ok())?;
+        let parts: Vec<String> = rel
+            .components()
+            .map(|c| {
+                percent_encoding::utf8_percent_encode(&c.as_os_str().to_string_lossy(), URL_PART)
+                    .to_string()
+            })
+            .collect();
+        Some(format!("files/{}", parts.join("/")))
+    }
+
     /// A path as the user reads it: relative to the workspace it is in.
     fn display_path(&self, path: &Path) -> String {
         for root in &self.roots {
@@ -495,6 +530,13 @@ fn choices(a: &cga::Attribute) -> Option<Vec<cga::Value>> {
     strings.then_some(values)
 }
 
+/// What is escaped in a part of a URL path: all but letters, digits and
+/// `.-_` (so `/` and `%` in names stay inside their part).
+const URL_PART: &percent_encoding::AsciiSet = &percent_encoding::NON_ALPHANUMERIC
+    .remove(b'.')
+    .remove(b'-')
+    .remove(b'_');
+
 /// `path` relative to `base` (`../assets/a.obj` where it is not below).
 fn relative_to(path: &Path, base: &Path) -> String {
     let p: Vec<_> = path.components().collect();
@@ -518,8 +560,8 @@ fn lot_outlines(engine: &Engine, root: &Path, lots: &[Lot]) -> Vec<u8> {
         "Lot --> color(\"#9a9a92\") Ground.\n",
     );
     match rules.generate_all(lots, &Options::default()) {
-        Ok(results) => encode::model(&results),
-        Err(_) => encode::model(&[]),
+        Ok(results) => encode::model(&results, &mut |_| None),
+        Err(_) => encode::model(&[], &mut |_| None),
     }
 }
 

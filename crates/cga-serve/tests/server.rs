@@ -94,7 +94,7 @@ attr secret = 1
 attr tall = false
 
 @StartRule
-Lot --> extrude(height) color(wall) print("made") report("h", height) Mass.
+Lot --> extrude(height) color(wall) texture(texture) print("made") report("h", height) Mass.
 "##;
 
 #[test]
@@ -138,6 +138,12 @@ fn state_model_provenance_and_parameters() {
     let (status, model) = get(addr, "/api/model.bin");
     assert_eq!(status, 200);
     assert_eq!(&model[..4], b"CGAM");
+    let length = u32::from_le_bytes(model[4..8].try_into().unwrap()) as usize;
+    let header: Json = serde_json::from_slice(&model[8..8 + length]).unwrap();
+    let mesh = &header["lots"][0]["meshes"][0];
+    // The texture named relative to the rule file, served from the workspace.
+    assert_eq!(mesh["texture"], "files/assets/brick.png");
+    assert_eq!(mesh["triangles"], 12);
     let (status, lots) = get(addr, "/api/lots.bin");
     assert_eq!((status, &lots[..4]), (200, &b"CGAM"[..]));
     let (status, glb) = get(addr, "/api/model.glb");

@@ -216,6 +216,9 @@ async function loadModel(version) {
     fit();
   }
   render();
+  // Drawn is when the browser has shown the frame, not when the commands
+  // were issued.
+  await new Promise((r) => requestAnimationFrame(() => r()));
   page.modelVersion = version;
   page.drawnAt = performance.now();
   page.drawMs = page.drawnAt - t;

@@ -149,6 +149,11 @@ impl Preview {
             if matches!(event.kind, EventKind::Access(_) | EventKind::Other) {
                 return;
             }
+            // Build output and version control under a workspace change
+            // often and are never read by rules.
+            if !event.paths.iter().any(|p| !is_ignored(p)) {
+                return;
+            }
             if let Some(p) = weak.upgrade() {
                 p.request(|r| r.reload = true);
             }
@@ -528,6 +533,17 @@ fn choices(a: &cga::Attribute) -> Option<Vec<cga::Value>> {
     let values: Vec<cga::Value> = range.args.iter().filter_map(|(_, v)| v.clone()).collect();
     let strings = !values.is_empty() && values.iter().all(|v| matches!(v, cga::Value::Str(_)));
     strings.then_some(values)
+}
+
+/// Paths whose changes do not regenerate: inside `.git`, `target` or
+/// `node_modules` folders.
+fn is_ignored(path: &Path) -> bool {
+    path.components().any(|c| {
+        matches!(
+            c.as_os_str().to_str(),
+            Some(".git" | "target" | "node_modules")
+        )
+    })
 }
 
 /// What is escaped in a part of a URL path: all but letters, digits and

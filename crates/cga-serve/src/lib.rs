@@ -145,14 +145,14 @@ pub fn start(config: Config) -> Result<Server, String> {
     let thread = std::thread::Builder::new()
         .name("cga-serve".into())
         .spawn(move || {
+            // Not a graceful shutdown: open event streams would hold it
+            // forever. Dropping the server drops its connections.
             runtime.block_on(async move {
-                let _ = axum::serve(listener, app)
-                    .with_graceful_shutdown(async {
-                        let _ = rx.await;
-                    })
-                    .await;
+                tokio::select! {
+                    _ = axum::serve(listener, app) => {}
+                    _ = rx => {}
+                }
             });
-            // Open event streams would hold a graceful shutdown forever.
             runtime.shutdown_timeout(std::time::Duration::from_millis(100));
         })
         .map_err(|e| format!("cannot start the server: {e}"))?;

@@ -289,6 +289,17 @@ fn malformed_requests_get_4xx_and_the_server_stays_up() {
     assert!(out.is_empty() || String::from_utf8_lossy(&out).starts_with("HTTP/1.1 4"));
     // Still serving.
     assert_eq!(state(addr)["stale"], false);
+    // An open event stream does not keep the server from stopping.
+    let mut events = TcpStream::connect(addr).unwrap();
+    events
+        .write_all(b"GET /api/events HTTP/1.1\r\nHost: x\r\n\r\n")
+        .unwrap();
+    let mut first = [0u8; 256];
+    let n = events.read(&mut first).unwrap();
+    assert!(String::from_utf8_lossy(&first[..n]).contains("text/event-stream"));
+    let t = std::time::Instant::now();
+    drop(server);
+    assert!(t.elapsed() < Duration::from_secs(5));
 }
 
 #[test]

@@ -11,6 +11,9 @@ use serde_json::{json, Value as Json};
 
 use crate::encode;
 
+/// How long a file change may take to settle before it is read.
+const SETTLE: std::time::Duration = std::time::Duration::from_millis(15);
+
 /// What the page asked for.
 #[derive(Clone, Debug, Default)]
 pub struct Params {
@@ -228,6 +231,14 @@ impl Preview {
                 let mut r = self.request.lock().unwrap();
                 while !r.dirty && !r.stop {
                     r = self.wake.wait(r).unwrap();
+                }
+                if r.reload && !r.stop {
+                    // An editor saves in steps (truncate, write, rename):
+                    // the events of one save come within milliseconds,
+                    // and a file read between them would be half-written.
+                    drop(r);
+                    std::thread::sleep(SETTLE);
+                    r = self.request.lock().unwrap();
                 }
                 if r.stop {
                     return;

@@ -43,6 +43,7 @@ try {
   // Saving the file: from the write to the frame shown.
   const fileTimes = [];
   const generateTimes = [];
+  const drawTimes = [];
   for (let i = 1; i <= edits; i++) {
     const v = await version();
     const text = original.replace(/attr BuildingHeight\s*=\s*62/, `attr BuildingHeight = ${62 + (i % 2 ? 4 : 0) + i * 0.5}`);
@@ -52,6 +53,7 @@ try {
     const drawn = await page.evaluate(() => performance.timeOrigin + window.cgaPreview.drawnAt);
     fileTimes.push(drawn - t0);
     generateTimes.push((await stats()).generate_ms);
+    drawTimes.push(await page.evaluate(() => window.cgaPreview.drawMs));
     await page.waitForTimeout(150);
   }
 
@@ -76,6 +78,8 @@ try {
     file: { median: f(median(fileTimes)), p90: f(p90(fileTimes)) },
     slider: { median: f(median(sliderTimes)), p90: f(p90(sliderTimes)) },
     generate: { median: f(median(generateTimes)) },
+    // Fetching the model, building the meshes, drawing, the frame shown.
+    draw: { median: f(median(drawTimes)) },
   }, null, 1));
 } finally {
   await browser.close();

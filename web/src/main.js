@@ -159,14 +159,16 @@ function buildMeshes(buffer, group, { lots = false } = {}) {
       const geometry = new THREE.BufferGeometry();
       geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(buffer, data + m.positions, m.vertices * 3), 3));
       if (m.normals !== null) {
-        geometry.setAttribute('normal', new THREE.BufferAttribute(new Float32Array(buffer, data + m.normals, m.vertices * 3), 3));
+        // Bytes scaled by 127, read as normalised.
+        geometry.setAttribute('normal', new THREE.BufferAttribute(new Int8Array(buffer, data + m.normals, m.vertices * 3), 3, true));
       } else {
         geometry.computeVertexNormals();
       }
       if (m.uvs !== null) {
         geometry.setAttribute('uv', new THREE.BufferAttribute(new Float32Array(buffer, data + m.uvs, m.vertices * 2), 2));
       }
-      geometry.setIndex(new THREE.BufferAttribute(new Uint32Array(buffer, data + m.indices, m.triangles * 3), 1));
+      const Indices = m.index_bytes === 2 ? Uint16Array : Uint32Array;
+      geometry.setIndex(new THREE.BufferAttribute(new Indices(buffer, data + m.indices, m.triangles * 3), 1));
       const material = new THREE.MeshStandardMaterial({
         color: lots ? 0xa8a89e : srgb(m.color),
         map: !lots && m.texture && m.uvs !== null ? texture(m.texture) : null,

@@ -4,8 +4,9 @@
 //!
 //! ```text
 //! "CGAM"  u32 header length H  header (JSON, H bytes, padded with spaces to 4)
-//! data: per mesh, positions (f32 x 3 per vertex), normals (f32 x 3),
-//!       indices (u32 x 3 per triangle)
+//! data: per mesh, positions (f32 x 3 per vertex), texture coordinates
+//!       (f32 x 2), normals (i8 x 3, x 127), indices (u16 or u32 x 3 per
+//!       triangle: "index_bytes"); each array padded to 4 bytes
 //! ```
 //!
 //! The header: `{"lots": [{"index", "name", "meshes": [{"mesh", "vertices",
@@ -38,24 +39,34 @@ pub fn model(results: &[LotResult], texture: &mut dyn FnMut(&str) -> Option<Stri
                     data.extend_from_slice(&(*c as f32).to_le_bytes());
                 }
             }
-            let normals = data.len();
-            for n in &mesh.normals {
-                for c in n {
-                    data.extend_from_slice(&(*c as f32).to_le_bytes());
-                }
-            }
             let uvs = data.len();
             for uv in &mesh.uvs {
                 for c in uv {
                     data.extend_from_slice(&(*c as f32).to_le_bytes());
                 }
             }
-            let indices = data.len();
-            for t in &mesh.indices {
-                for i in t {
-                    data.extend_from_slice(&i.to_le_bytes());
+            // Unit normals need no more than a byte per coordinate (the
+            // page reads them as normalised): a quarter of the bytes to
+            // send, which is most of the time a model takes to arrive.
+            let normals = data.len();
+            for n in &mesh.normals {
+                for c in n {
+                    data.push(((c.clamp(-1.0, 1.0) * 127.0).round() as i8) as u8);
                 }
             }
+            pad(&mut data);
+            let indices = data.len();
+            let short = mesh.positions.len() <= 1 << 16;
+            for t in &mesh.indices {
+                for &i in t {
+                    if short {
+                        data.extend_from_slice(&(i as u16).to_le_bytes());
+                    } else {
+                        data.extend_from_slice(&i.to_le_bytes());
+                    }
+                }
+            }
+            pad(&mut data);
             meshes.push(json!({
                 "mesh": m,
                 "vertices": mesh.positions.len(),
@@ -64,6 +75,7 @@ pub fn model(results: &[LotResult], texture: &mut dyn FnMut(&str) -> Option<Stri
                 "normals": if mesh.normals.len() == mesh.positions.len() { json!(normals) } else { Json::Null },
                 "uvs": if mesh.uvs.len() == mesh.positions.len() { json!(uvs) } else { Json::Null },
                 "indices": indices,
+                "index_bytes": if short { 2 } else { 4 },
                 "texture": material.map(|m| m.colormap()).filter(|p| !p.is_empty()).and_then(&mut *texture),
                 "color": material.map(|m| m.color).unwrap_or([0.8, 0.8, 0.8]),
                 "opacity": material.map(|m| m.opacity).unwrap_or(1.0),
@@ -83,6 +95,14 @@ pub fn model(results: &[LotResult], texture: &mut dyn FnMut(&str) -> Option<Stri
     out.extend_from_slice(&header);
     out.extend_from_slice(&data);
     out
+}
+
+/// Zeros up to a multiple of 4 bytes: typed arrays over the data must
+/// start aligned.
+fn pad(data: &mut Vec<u8>) {
+    while !data.len().is_multiple_of(4) {
+        data.push(0);
+    }
 }
 
 /// A CGA value as JSON: numbers (non-finite ones as their text), booleans,
@@ -161,7 +181,23 @@ mod tests {
         let top = ys.iter().cloned().fold(f32::MIN, f32::max);
         assert_eq!(top, 7.0);
         let indices = mesh["indices"].as_u64().unwrap() as usize;
-        assert_eq!(data.len(), indices + 12 * 12);
+        // 12 triangles of 16-bit indices.
+        assert_eq!(mesh["index_bytes"], 2);
+        assert_eq!(data.len(), indices + 12 * 3 * 2);
+        let normals = mesh["normals"].as_u64().unwrap() as usize;
+        assert_eq!(indices, normals + (vertices * 3).next_multiple_of(4));
+        let n: Vec<i8> = data[normals..normals + vertices * 3]
+            .iter()
+            .map(|&b| b as i8)
+            .collect();
+        // Every normal a unit axis, scaled by 127.
+        for v in n.chunks(3) {
+            assert_eq!(
+                v.iter().map(|c| (*c as i32).abs()).sum::<i32>(),
+                127,
+                "{v:?}"
+            );
+        }
         assert_eq!(mesh["texture"], Json::Null);
     }
 

@@ -34,6 +34,8 @@ const p90 = (xs) => { const s = [...xs].sort((a, b) => a - b); return s[Math.min
 
 try {
   const page = await browser.context.newPage();
+  page.on('pageerror', (e) => console.error('page error:', e));
+  page.on('console', (m) => console.error('console:', m.text()));
   await page.goto(server.url);
   await page.waitForFunction(() => window.cgaPreview.modelVersion > 0, null, { timeout: 120000 });
   const version = () => page.evaluate(() => window.cgaPreview.modelVersion);
@@ -68,7 +70,16 @@ try {
       slider.dispatchEvent(new Event('input', { bubbles: true }));
       return t;
     }, 40 + i * 3);
-    await page.waitForFunction((old) => window.cgaPreview.modelVersion > old, v, { timeout: 60000 });
+    if (process.env.DEBUG) console.error('slider', i, await page.evaluate(() => JSON.stringify([window.cgaPreview.modelVersion, window.cgaPreview.stateVersion, window.cgaPreview.values])));
+    try {
+      await page.waitForFunction((old) => window.cgaPreview.modelVersion > old, v, { timeout: 20000 });
+    } catch (e) {
+      console.error('stuck at slider', i, 'model version', v, await page.evaluate(async () => JSON.stringify({
+        page: [window.cgaPreview.modelVersion, window.cgaPreview.stateVersion, window.cgaPreview.values],
+        server: await (await fetch('api/state')).json().then((s) => [s.version, s.model_version, s.values]),
+      })));
+      throw e;
+    }
     sliderTimes.push(await page.evaluate((t) => window.cgaPreview.drawnAt - t, t0));
     await page.waitForTimeout(150);
   }

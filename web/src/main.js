@@ -221,6 +221,8 @@ async function loadModel(version) {
   // Drawn is when the browser has shown the frame, not when the commands
   // were issued.
   await new Promise((r) => requestAnimationFrame(() => r()));
+  // A newer model may have been drawn meanwhile: the version only grows.
+  if (version < page.modelVersion) return;
   page.modelVersion = version;
   page.drawnAt = performance.now();
   page.drawMs = page.drawnAt - t;

@@ -51,6 +51,8 @@ pub(crate) struct Request {
     /// Reload the rules (a file changed).
     reload: bool,
     stop: bool,
+    /// Counts requests: a generation serves the request of this number.
+    number: u64,
 }
 
 /// The preview's engine, rules and lots, and the thread that generates.
@@ -65,7 +67,9 @@ pub struct Preview {
     limits: cga::Limits,
     request: Mutex<Request>,
     wake: Condvar,
-    running: Mutex<Option<Cancel>>,
+    /// The generation running: the number of the request it serves, and
+    /// its switch.
+    running: Mutex<Option<(u64, Cancel)>>,
     published: RwLock<Arc<Snapshot>>,
     events: tokio::sync::watch::Sender<u64>,
     watcher: Mutex<Option<notify::RecommendedWatcher>>,
@@ -124,6 +128,7 @@ impl Preview {
                 dirty: true,
                 reload: true,
                 stop: false,
+                number: 0,
             }),
             wake: Condvar::new(),
             running: Mutex::new(None),
@@ -177,14 +182,21 @@ impl Preview {
     /// Asks for a new generation (after `change`), cancelling the running
     /// one, which the change makes obsolete.
     pub(crate) fn request(&self, change: impl FnOnce(&mut Request)) {
-        {
+        let number = {
             let mut r = self.request.lock().unwrap();
             change(&mut r);
             r.dirty = true;
-        }
+            r.number += 1;
+            r.number
+        };
         self.wake.notify_all();
-        if let Some(cancel) = self.running.lock().unwrap().take() {
-            cancel.cancel();
+        // Only an older request's generation: the worker may already have
+        // taken this very request.
+        let mut running = self.running.lock().unwrap();
+        if running.as_ref().is_some_and(|(n, _)| *n < number) {
+            if let Some((_, cancel)) = running.take() {
+                cancel.cancel();
+            }
         }
     }
 
@@ -227,7 +239,7 @@ impl Preview {
         let mut rules: Option<Rules> = None;
         let mut load_ms = 0.0;
         loop {
-            let (params, reload) = {
+            let (params, reload, number) = {
                 let mut r = self.request.lock().unwrap();
                 while !r.dirty && !r.stop {
                     r = self.wake.wait(r).unwrap();
@@ -244,7 +256,7 @@ impl Preview {
                     return;
                 }
                 r.dirty = false;
-                (r.params.clone(), std::mem::take(&mut r.reload))
+                (r.params.clone(), std::mem::take(&mut r.reload), r.number)
             };
             if reload || rules.is_none() {
                 let t = Instant::now();
@@ -252,12 +264,12 @@ impl Preview {
                 load_ms = t.elapsed().as_secs_f64() * 1e3;
             }
             let rules = rules.clone().expect("loaded above");
-            self.generate(&rules, &params, load_ms);
+            self.generate(&rules, &params, load_ms, number);
         }
     }
 
     /// One generation, published unless a newer request cancelled it.
-    fn generate(&self, rules: &Rules, params: &Params, load_ms: f64) {
+    fn generate(&self, rules: &Rules, params: &Params, load_ms: f64, number: u64) {
         let mut problems: Vec<Json> = rules
             .diagnostics()
             .iter()
@@ -272,7 +284,13 @@ impl Preview {
             return;
         }
         let cancel = Cancel::new();
-        *self.running.lock().unwrap() = Some(cancel.clone());
+        *self.running.lock().unwrap() = Some((number, cancel.clone()));
+        // A newer request that came before the switch was set: it did not
+        // cancel this generation, so this one is not started.
+        if self.request.lock().unwrap().number != number {
+            self.running.lock().unwrap().take();
+            return;
+        }
         let mut options = Options::default()
             .seed(params.seed)
             .limits(self.limits)

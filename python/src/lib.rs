@@ -221,15 +221,12 @@ impl NativeRules {
     ) -> PyResult<Generated<'py>> {
         let rules = &self.rules;
         if rules.has_errors() {
-            return Err(to_py_err(
-                rules
-                    .check_attributes(&Options::default())
-                    .err()
-                    .unwrap_or(Error::Rules {
-                        path: rules.path().to_path_buf(),
-                        errors: 1,
-                    }),
-            ));
+            // (The Python side raises RuleError, with the diagnostics, first.)
+            let errors = rules.diagnostics().iter().filter(|d| d.is_error()).count();
+            return Err(to_py_err(Error::Rules {
+                path: rules.path().to_path_buf(),
+                errors,
+            }));
         }
         let (mut lots, places, invalid) = read_lots(rules, lots, skip_invalid)?;
         // A lot's seed depends on its place in the run: lots of a part of

@@ -408,8 +408,8 @@ fn read_lots(
     Ok((out, places, invalid))
 }
 
-/// One lot, or its name and why it cannot be made.
-/// `(name, why)` is a lot the Python side found invalid.
+/// One lot, or its name and why it cannot be made (`(name, why)`: a lot
+/// the Python side found invalid).
 fn read_lot(
     rules: &Rules,
     i: usize,
@@ -418,55 +418,53 @@ fn read_lot(
     if let Ok((name, why)) = item.extract::<(String, String)>() {
         return Err((name, why));
     }
-    {
-        type Item<'py> = (
-            String,
-            Vec<Vec<PyReadonlyArray2<'py, f64>>>,
-            bool,
-            Vec<(String, Bound<'py, PyAny>)>,
-        );
-        let (name, polygons, gis, attrs): Item<'_> = item
-            .extract()
-            .map_err(|e| (format!("{i}"), format!("not a lot the package made: {e}")))?;
-        let bad = |why: String| (name.clone(), why);
-        let mut rings_of = Vec::with_capacity(polygons.len());
-        for polygon in &polygons {
-            let mut rings = Vec::with_capacity(polygon.len());
-            for ring in polygon {
-                let a = ring.as_array();
-                if a.ncols() != 3 {
-                    return Err(bad(format!(
-                        "a ring must be an (n, 3) array of coordinates, not ({}, {})",
-                        a.nrows(),
-                        a.ncols()
-                    )));
-                }
-                rings.push(
-                    a.rows()
-                        .into_iter()
-                        .map(|r| [r[0], r[1], r[2]])
-                        .collect::<Vec<_>>(),
-                );
+    type Item<'py> = (
+        String,
+        Vec<Vec<PyReadonlyArray2<'py, f64>>>,
+        bool,
+        Vec<(String, Bound<'py, PyAny>)>,
+    );
+    let (name, polygons, gis, attrs): Item<'_> = item
+        .extract()
+        .map_err(|e| (format!("{i}"), format!("not a lot the package made: {e}")))?;
+    let bad = |why: String| (name.clone(), why);
+    let mut rings_of = Vec::with_capacity(polygons.len());
+    for polygon in &polygons {
+        let mut rings = Vec::with_capacity(polygon.len());
+        for ring in polygon {
+            let a = ring.as_array();
+            if a.ncols() != 3 {
+                return Err(bad(format!(
+                    "a ring must be an (n, 3) array of coordinates, not ({}, {})",
+                    a.nrows(),
+                    a.ncols()
+                )));
             }
-            rings_of.push(rings);
+            rings.push(
+                a.rows()
+                    .into_iter()
+                    .map(|r| [r[0], r[1], r[2]])
+                    .collect::<Vec<_>>(),
+            );
         }
-        let axes = if gis { Axes::Gis } else { Axes::Engine };
-        let mut lot = cga::lots::from_polygons(name.clone(), &rings_of, axes).map_err(bad)?;
-        for (attr, value) in attrs {
-            if attr != "seed" && rules.attribute(&attr).is_none() {
-                return Err(bad(Error::UnknownAttribute {
-                    name: attr,
-                    known: rules.attributes().iter().map(|a| a.name.clone()).collect(),
-                }
-                .to_string()));
-            }
-            let value = py_value(&value).map_err(|e| bad(format!("attribute `{attr}`: {e}")))?;
-            if let Some(v) = value {
-                lot.attrs.push((Arc::from(attr.as_str()), v));
-            }
-        }
-        Ok(lot)
+        rings_of.push(rings);
     }
+    let axes = if gis { Axes::Gis } else { Axes::Engine };
+    let mut lot = cga::lots::from_polygons(name.clone(), &rings_of, axes).map_err(bad)?;
+    for (attr, value) in attrs {
+        if attr != "seed" && rules.attribute(&attr).is_none() {
+            return Err(bad(Error::UnknownAttribute {
+                name: attr,
+                known: rules.attributes().iter().map(|a| a.name.clone()).collect(),
+            }
+            .to_string()));
+        }
+        let value = py_value(&value).map_err(|e| bad(format!("attribute `{attr}`: {e}")))?;
+        if let Some(v) = value {
+            lot.attrs.push((Arc::from(attr.as_str()), v));
+        }
+    }
+    Ok(lot)
 }
 
 /// A Python value as a CGA value: bool, number, string, or a sequence of

@@ -368,10 +368,16 @@ fn diagnostic_json(d: &Diagnostic) -> serde_json::Value {
 
 fn generate(args: GenerateArgs) -> Result<(), Failure> {
     let started = std::time::Instant::now();
+    // `.json`: a 3D Tiles tileset (its tiles are written beside it).
+    let tileset = args.output.as_ref().filter(|p| {
+        p.extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+    });
     let format = match &args.output {
+        Some(_) if tileset.is_some() => None,
         Some(path) => Some(Format::from_path(path).ok_or_else(|| {
             Failure::Usage(format!(
-                "cannot tell the output format of {}: use .glb, .gltf or .obj",
+                "cannot tell the output format of {}: use .glb, .gltf, .obj or tileset.json (3D Tiles)",
                 path.display()
             ))
         })?),
@@ -480,11 +486,30 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
         }
         progress.inc(1);
     };
-    let target = match &mut writer {
-        Some(w) => Target::Writer(w),
-        None => Target::Nothing,
+    let mut tiles_written = None;
+    let summary = match tileset {
+        Some(path) => {
+            let tiles = cga_tiles::TilesetOptions {
+                export: ExportOptions {
+                    georeference: cga_tiles::georeference(lots.origin),
+                    flush_mib: args.held_mib,
+                    ..rules.export_options()
+                },
+                ..Default::default()
+            };
+            let stats = cga_tiles::write_tileset(&rules, &lots.lots, &options, &tiles, path, each)?;
+            let summary = stats.summary.clone();
+            tiles_written = Some(stats);
+            summary
+        }
+        None => {
+            let target = match &mut writer {
+                Some(w) => Target::Writer(w),
+                None => Target::Nothing,
+            };
+            rules.generate_lots(&lots.lots, &options, target, each)?
+        }
     };
-    let summary = rules.generate_lots(&lots.lots, &options, target, each)?;
     progress.finish_and_clear();
     if summary.failed > 0 && many {
         eprintln!(
@@ -493,6 +518,23 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
         );
     }
     let mut triangles = 0u64;
+    if let (Some(stats), Some(path)) = (&tiles_written, tileset) {
+        triangles = stats.triangles;
+        for warning in &stats.warnings {
+            eprintln!("warning: {warning}");
+        }
+        eprintln!(
+            "wrote {}: {} lots, {} shapes, {} leaf shapes, {} tiles ({} leaves), {} triangles (and {} in the parents' massing)",
+            path.display(),
+            summary.lots,
+            summary.shapes,
+            summary.leaves,
+            stats.tiles,
+            stats.leaves,
+            stats.triangles,
+            stats.massing_triangles
+        );
+    }
     match (writer, &args.output) {
         (Some(w), Some(path)) => {
             let stats = w
@@ -512,6 +554,7 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
                 stats.triangles
             );
         }
+        _ if tiles_written.is_some() => {}
         _ => eprintln!(
             "derived {} lot{}: {} shapes, {} leaf shapes; no model written (write one with -o OUT.glb, .gltf or .obj)",
             summary.lots,

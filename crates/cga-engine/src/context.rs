@@ -500,6 +500,9 @@ pub struct SceneContext {
     /// For each lot, the other lots within [`OCCLUSION_NEIGHBOURHOOD`].
     neighbours: Vec<Vec<u32>>,
     labels: HashMap<Arc<str>, LabelIndex>,
+    /// The lot index of each position, when the scene is a part of a
+    /// larger run (see [`SceneContext::numbered`]), and back.
+    numbers: Option<HashMap<usize, usize>>,
 }
 
 impl SceneContext {
@@ -545,6 +548,7 @@ impl SceneContext {
             lots,
             neighbours,
             labels,
+            numbers: None,
         }
     }
 
@@ -554,15 +558,38 @@ impl SceneContext {
 
     /// The records of lot `index` (empty if there is no such lot).
     pub fn lot(&self, index: usize) -> Arc<LotContext> {
-        self.lots
-            .get(index)
+        self.position(index)
+            .and_then(|i| self.lots.get(i))
             .cloned()
             .unwrap_or_else(|| Arc::new(LotContext::default()))
     }
 
     /// The lots inter occlusion queries of lot `index` test against.
     pub fn neighbours(&self, index: usize) -> &[u32] {
-        self.neighbours.get(index).map_or(&[], Vec::as_slice)
+        self.position(index)
+            .and_then(|i| self.neighbours.get(i))
+            .map_or(&[], Vec::as_slice)
+    }
+
+    /// The scene with its lots numbered `indices` (the lot indices of a
+    /// part of a larger run, by position); neighbours stay positions.
+    pub fn numbered(mut self, indices: Vec<usize>) -> SceneContext {
+        self.numbers = Some(
+            indices
+                .into_iter()
+                .enumerate()
+                .map(|(p, i)| (i, p))
+                .collect(),
+        );
+        self
+    }
+
+    /// The position in the scene of lot `index`.
+    fn position(&self, index: usize) -> Option<usize> {
+        match &self.numbers {
+            Some(map) => map.get(&index).copied(),
+            None => Some(index),
+        }
     }
 
     fn label_total(&self, label: &str) -> usize {
@@ -601,6 +628,7 @@ impl SceneContext {
         let Some(index) = self.labels.get(label) else {
             return f64::INFINITY;
         };
+        let own_position = self.position(own);
         let tree = index.scopes.get_or_init(|| {
             RTree::bulk_load(
                 index
@@ -622,7 +650,7 @@ impl SceneContext {
             let env = envelope(bounds, margin);
             let mut best = f64::INFINITY;
             for item in tree.locate_in_envelope_intersecting(&env) {
-                if item.data.0 as usize != own {
+                if Some(item.data.0 as usize) != own_position {
                     best = best.min(box_distance(scope, &self.record(item.data).scope));
                 }
             }

@@ -58,6 +58,9 @@ struct PrimitiveLayout {
     coords: Vec<usize>,
     tangents: Option<usize>,
     indices: usize,
+    /// With per-lot features (EXT_mesh_features): the feature id of every
+    /// vertex (the lot's position in the model), written after the indices.
+    feature: Option<u32>,
     min: [f32; 3],
     max: [f32; 3],
 }
@@ -126,13 +129,18 @@ impl Bucket {
             coords: self.coords.iter().map(|c| c.len() * 8).collect(),
             tangents: self.tangents.as_ref().map(|t| t.len() * 16),
             indices: self.indices.len() * 12,
+            feature: None,
             min: self.min,
             max: self.max,
         }
     }
 
     /// The arrays in the order of the binary layout.
-    fn write_arrays(&self, w: &mut (impl Write + ?Sized)) -> std::io::Result<()> {
+    fn write_arrays(
+        &self,
+        w: &mut (impl Write + ?Sized),
+        feature: Option<u32>,
+    ) -> std::io::Result<()> {
         write_le(w, &self.positions)?;
         write_le(w, &self.normals)?;
         for coords in &self.coords {
@@ -141,7 +149,12 @@ impl Bucket {
         if let Some(tangents) = &self.tangents {
             write_le(w, tangents)?;
         }
-        write_le(w, &self.indices)
+        write_le(w, &self.indices)?;
+        if let Some(f) = feature {
+            // Feature ids as floats: exact below 2^24 lots per model.
+            write_le(w, &vec![f as f32; self.positions.len()])?;
+        }
+        Ok(())
     }
 }
 
@@ -302,6 +315,142 @@ pub(crate) struct MapUse {
     channel: usize,
 }
 
+/// The lots' property table (EXT_structural_metadata): for each lot its
+/// index, name and attributes (as text), in views after everything laid
+/// out so far (8-byte aligned, as the extension asks); sets the feature
+/// count of every primitive's feature ids. Returns the table's bytes,
+/// padding first, as they follow the rest of the binary data.
+fn property_table(root: &mut json::Root, layout: &mut Layout, lots: &[LotNode]) -> Vec<u8> {
+    use serde_json::{json, Map, Value};
+    let mut tail = Vec::new();
+    let view = |root: &mut json::Root, layout: &mut Layout, tail: &mut Vec<u8>, bytes: &[u8]| {
+        while !layout.len.is_multiple_of(8) {
+            layout.len += 4;
+            tail.extend([0u8; 4]);
+        }
+        let v = layout.view(root, bytes.len() as u64, None);
+        tail.extend(bytes);
+        tail.resize(tail.len().next_multiple_of(4), 0);
+        v.value()
+    };
+    let strings =
+        |values: Vec<String>, root: &mut json::Root, layout: &mut Layout, tail: &mut Vec<u8>| {
+            let mut text = Vec::new();
+            let mut offsets = vec![0u32];
+            for v in values {
+                text.extend(v.as_bytes());
+                offsets.push(text.len() as u32);
+            }
+            let values = view(root, layout, tail, &text);
+            let offsets: Vec<u8> = offsets.iter().flat_map(|o| o.to_le_bytes()).collect();
+            let offsets = view(root, layout, tail, &offsets);
+            json!({"values": values, "stringOffsets": offsets, "stringOffsetType": "UINT32"})
+        };
+    let index: Vec<u8> = lots
+        .iter()
+        .enumerate()
+        .flat_map(|(k, l)| {
+            let i = l
+                .extras
+                .as_ref()
+                .and_then(|e| e["lot"].as_u64())
+                .unwrap_or(k as u64);
+            (i as u32).to_le_bytes()
+        })
+        .collect();
+    let mut class = Map::new();
+    let mut table = Map::new();
+    class.insert(
+        "index".into(),
+        json!({"type": "SCALAR", "componentType": "UINT32"}),
+    );
+    table.insert(
+        "index".into(),
+        json!({"values": view(root, layout, &mut tail, &index)}),
+    );
+    class.insert("name".into(), json!({"type": "STRING"}));
+    let names = lots.iter().map(|l| l.name.clone()).collect();
+    table.insert("name".into(), strings(names, root, layout, &mut tail));
+    // Attributes by name, in order of first appearance, as text.
+    let mut keys: Vec<String> = Vec::new();
+    for l in lots {
+        if let Some(Value::Object(a)) = l.extras.as_ref().map(|e| &e["attributes"]) {
+            for k in a.keys() {
+                if !keys.contains(k) {
+                    keys.push(k.clone());
+                }
+            }
+        }
+    }
+    for key in keys {
+        let id: String = format!(
+            "attr_{}",
+            key.chars()
+                .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+                .collect::<String>()
+        );
+        if class.contains_key(&id) {
+            continue;
+        }
+        let values = lots
+            .iter()
+            .map(
+                |l| match l.extras.as_ref().map(|e| &e["attributes"][&key]) {
+                    Some(Value::String(s)) => s.clone(),
+                    Some(Value::Null) | None => String::new(),
+                    // Whole numbers without a decimal point, as CGA prints them.
+                    Some(Value::Number(n)) => match n.as_f64() {
+                        Some(x) if x.fract() == 0.0 && x.abs() < 1e15 => format!("{}", x as i64),
+                        _ => n.to_string(),
+                    },
+                    Some(v) => v.to_string(),
+                },
+            )
+            .collect();
+        class.insert(id.clone(), json!({"type": "STRING", "name": key}));
+        table.insert(id, strings(values, root, layout, &mut tail));
+    }
+    root.extensions = Some(json::extensions::Root {
+        others: [(
+            "EXT_structural_metadata".to_string(),
+            json!({
+                "schema": {"id": "cga", "classes": {"lot": {"properties": class}}},
+                "propertyTables": [{"class": "lot", "count": lots.len(), "properties": table}],
+            }),
+        )]
+        .into_iter()
+        .collect(),
+    });
+    for name in ["EXT_mesh_features", "EXT_structural_metadata"] {
+        root.extensions_used.push(name.to_string());
+    }
+    for mesh in &mut root.meshes {
+        for p in &mut mesh.primitives {
+            if let Some(f) = p
+                .extensions
+                .as_mut()
+                .and_then(|e| e.others.get_mut("EXT_mesh_features"))
+            {
+                f["featureIds"][0]["featureCount"] = json!(lots.len());
+            }
+        }
+    }
+    tail
+}
+
+/// The box around primitives (min, max), if there are any.
+fn bounds_of(primitives: &[&PrimitiveLayout]) -> Option<[[f64; 3]; 2]> {
+    let first = primitives.first()?;
+    let mut b = [first.min.map(f64::from), first.max.map(f64::from)];
+    for p in &primitives[1..] {
+        for (k, (lo, hi)) in p.min.iter().zip(&p.max).enumerate() {
+            b[0][k] = b[0][k].min(f64::from(*lo));
+            b[1][k] = b[1][k].max(f64::from(*hi));
+        }
+    }
+    Some(b)
+}
+
 /// A node to write: its name, extras and primitives (with their material
 /// ids).
 type NodeGroup = (
@@ -398,10 +547,16 @@ pub(crate) struct GltfWriter {
     lots_hint: Option<usize>,
     /// GLB: where the binary data written early starts.
     json_room: u64,
+    /// Per-lot features: a feature id per vertex and a property table of
+    /// the lots (EXT_mesh_features, EXT_structural_metadata).
+    features: bool,
+    /// The property table's bytes, written after everything else.
+    tail: Vec<u8>,
 }
 
 /// A lot's node: its name and `extras`, and the first of its primitives in
 /// the order written.
+#[derive(Clone)]
 struct LotNode {
     name: String,
     extras: Option<serde_json::Value>,
@@ -471,7 +626,15 @@ impl GltfWriter {
             lots: Vec::new(),
             lots_hint: None,
             json_room: GLB_JSON_ROOM,
+            features: false,
+            tail: Vec::new(),
         }
+    }
+
+    /// Gives each lot's vertices its feature id and writes a property
+    /// table of the lots (for 3D Tiles viewers that pick buildings).
+    pub(crate) fn with_features(&mut self) {
+        self.features = self.per_lot;
     }
 
     /// Says how many lots the model will have.
@@ -596,8 +759,18 @@ impl GltfWriter {
         room.clamp(GLB_JSON_ROOM, 256 << 20) / 4 * 4
     }
 
+    /// The feature id of what is added now: the current lot's position,
+    /// when the model has per-lot features.
+    fn feature(&self) -> Option<u32> {
+        if !self.features {
+            return None;
+        }
+        Some(self.lots.len().saturating_sub(1) as u32)
+    }
+
     /// Writes every bucket's data as a primitive and empties the buckets.
     fn flush(&mut self) -> Result<(), ExportError> {
+        let feature = self.feature();
         let path = self.path.clone();
         let io = |e| ExportError::io(&path, e);
         let out: &mut dyn Write = if self.binary {
@@ -619,9 +792,10 @@ impl GltfWriter {
                 continue;
             }
             b.unmerged_coords();
-            b.write_arrays(out).map_err(io)?;
-            let p = b.primitive(id as u32);
-            self.written_bytes += b.bytes() as u64;
+            b.write_arrays(out, feature).map_err(io)?;
+            let mut p = b.primitive(id as u32);
+            p.feature = feature;
+            self.written_bytes += b.bytes() as u64 + p.feature.map_or(0, |_| p.vertices * 4);
             self.written.push(p);
             b.clear();
         }
@@ -668,7 +842,10 @@ impl GltfWriter {
             .iter()
             .enumerate()
             .filter(|(_, b)| !b.indices.is_empty())
-            .map(|(id, b)| b.primitive(id as u32))
+            .map(|(id, b)| PrimitiveLayout {
+                feature: self.feature(),
+                ..b.primitive(id as u32)
+            })
             .collect();
         // Accessors in the order of the binary data, with their material.
         let mut primitives: Vec<(u32, json::mesh::Primitive)> = Vec::new();
@@ -678,6 +855,15 @@ impl GltfWriter {
             primitives.push((p.material, prim));
             used[p.material as usize] = true;
             stats.vertices += p.vertices;
+        }
+        let layouts: Vec<&PrimitiveLayout> = self.written.iter().chain(&held).collect();
+        stats.bounds = bounds_of(&layouts);
+        if self.per_lot {
+            let starts: Vec<usize> = self.lots.iter().map(|l| l.first).collect();
+            for (k, &start) in starts.iter().enumerate() {
+                let end = starts.get(k + 1).copied().unwrap_or(layouts.len());
+                stats.lot_bounds.push(bounds_of(&layouts[start..end]));
+            }
         }
         // The glTF material of each material id that has primitives.
         let mut gltf_materials: Vec<Option<json::Index<json::Material>>> =
@@ -723,7 +909,7 @@ impl GltfWriter {
         }
         // Meshes and nodes: one per lot, or one per material.
         let groups: Vec<NodeGroup> = if self.per_lot && !self.lots.is_empty() {
-            lot_groups(std::mem::take(&mut self.lots), primitives)
+            lot_groups(self.lots.clone(), primitives)
         } else {
             let mut by_material: Vec<Vec<(u32, json::mesh::Primitive)>> = Vec::new();
             by_material.resize_with(self.buckets.len(), Vec::new);
@@ -781,6 +967,9 @@ impl GltfWriter {
             });
             root.scene = Some(scene);
         }
+        if self.features && !self.lots.is_empty() {
+            self.tail = property_table(&mut root, &mut layout, &self.lots);
+        }
         let bin_len = layout.len;
         if bin_len > 0 {
             root.push(json::Buffer {
@@ -818,7 +1007,12 @@ impl GltfWriter {
                         BufWriter::with_capacity(1 << 16, file)
                     }
                 };
-                write_bin(&mut w, &self.buckets, &[], textures, &bin_path)?;
+                let held = Held {
+                    buckets: &self.buckets,
+                    feature: self.feature(),
+                    tail: &self.tail,
+                };
+                write_bin(&mut w, &held, &[], textures, &bin_path)?;
                 w.flush().map_err(|e| ExportError::io(&bin_path, e))?;
             }
         }
@@ -850,10 +1044,16 @@ impl GltfWriter {
         }
         let bin_chunk = if bin_len > 0 { 8 + bin_len } else { 0 };
         let total = glb_length(12 + 8 + json.len() as u64 + bin_chunk)?;
+        let feature = self.feature();
         let out = &mut self.out;
         write_glb_head(out, total, &json, bin_len).map_err(io)?;
         if bin_len > 0 {
-            write_bin(out, &self.buckets, images, textures, &path)?;
+            let held = Held {
+                buckets: &self.buckets,
+                feature,
+                tail: &self.tail,
+            };
+            write_bin(out, &held, images, textures, &path)?;
         }
         out.flush().map_err(io)
     }
@@ -871,7 +1071,12 @@ impl GltfWriter {
     ) -> Result<(), ExportError> {
         let path = self.path.clone();
         let io = |e| ExportError::io(&path, e);
-        write_bin(&mut self.out, &self.buckets, images, textures, &path)?;
+        let held = Held {
+            buckets: &self.buckets,
+            feature: self.feature(),
+            tail: &self.tail,
+        };
+        write_bin(&mut self.out, &held, images, textures, &path)?;
         self.out.flush().map_err(io)?;
         // Header (12), JSON chunk header (8), JSON, BIN chunk header (8).
         let head = 12 + 8 + json.len() as u64 + 8;
@@ -1053,9 +1258,27 @@ fn primitive_accessors(
         ComponentType::U32,
         Some(json::buffer::Target::ElementArrayBuffer),
     );
+    let extensions = p.feature.map(|_| {
+        let acc = layout.accessor(
+            root,
+            p.vertices as usize,
+            p.vertices,
+            Type::Scalar,
+            ComponentType::F32,
+            vertex_data,
+        );
+        attributes.insert(Valid(json::mesh::Semantic::Extras("FEATURE_ID_0".into())), acc);
+        let mut others = serde_json::Map::new();
+        // The feature count is set when every lot is known (see `finish`).
+        others.insert(
+            "EXT_mesh_features".into(),
+            serde_json::json!({"featureIds": [{"featureCount": 0, "attribute": 0, "propertyTable": 0}]}),
+        );
+        json::extensions::mesh::Primitive { others }
+    });
     json::mesh::Primitive {
         attributes,
-        extensions: None,
+        extensions,
         extras: Default::default(),
         indices: Some(indices),
         material: None,
@@ -1239,7 +1462,7 @@ fn gltf_material(
 /// positions, normals, UVs and indices, then the embedded `images`.
 fn write_bin(
     w: &mut impl Write,
-    buckets: &[Bucket],
+    held: &Held,
     images: &[u32],
     textures: &Textures,
     path: &Path,
@@ -1247,8 +1470,8 @@ fn write_bin(
     let io = |e| ExportError::io(path, e);
     // The arrays hold the bytes to write; arrays larger than the output
     // buffer go to the file directly.
-    for b in buckets.iter().filter(|b| !b.indices.is_empty()) {
-        b.write_arrays(w).map_err(io)?;
+    for b in held.buckets.iter().filter(|b| !b.indices.is_empty()) {
+        b.write_arrays(w, held.feature).map_err(io)?;
     }
     for &t in images {
         let tex = textures.get(t);
@@ -1256,7 +1479,15 @@ fn write_bin(
         let pad = (tex.len.next_multiple_of(4) - tex.len) as usize;
         w.write_all(&[0u8; 3][..pad]).map_err(io)?;
     }
-    Ok(())
+    w.write_all(held.tail).map_err(io)
+}
+
+/// What `finish` writes of the binary data: the buckets held (with their
+/// feature id), then the images, then `tail` (the property table).
+struct Held<'a> {
+    buckets: &'a [Bucket],
+    feature: Option<u32>,
+    tail: &'a [u8],
 }
 
 #[cfg(test)]

@@ -186,7 +186,7 @@ impl Georeference {
 }
 
 /// What [`ModelWriter::finish`] wrote.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct ExportStats {
     /// Vertices written (glTF: vertex count of all primitives; OBJ: `v` lines).
     pub vertices: u64,
@@ -201,6 +201,11 @@ pub struct ExportStats {
     /// Problems that did not stop the export (missing textures, skipped
     /// faces), one line each.
     pub warnings: Vec<String>,
+    /// glTF and GLB: the box around everything written (min, max; y up),
+    /// and around each lot begun with [`ModelWriter::begin_lot`] with
+    /// [`Granularity::Lot`] (`None` for a lot without geometry).
+    pub bounds: Option<[[f64; 3]; 2]>,
+    pub lot_bounds: Vec<Option<[[f64; 3]; 2]>>,
 }
 
 /// Why an export failed.
@@ -463,6 +468,17 @@ impl ModelWriter {
                 self.skipped_non_finite += result?;
                 Ok(())
             }
+        }
+    }
+
+    /// Gives the vertices of each lot begun (with [`Granularity::Lot`]) the
+    /// lot's feature id, and writes a property table of the lots (index,
+    /// name, attributes): `EXT_mesh_features` and
+    /// `EXT_structural_metadata`, with which 3D Tiles viewers pick a
+    /// building and show what it is. glTF and GLB only.
+    pub fn with_features(&mut self) {
+        if let Sink::Gltf(w, _) = &mut self.sink {
+            w.with_features();
         }
     }
 

@@ -63,6 +63,17 @@ impl Rules {
         mut each: impl FnMut(LotResult),
     ) -> Result<Summary, Error> {
         self.check_usable()?;
+        if let Some(v) = options
+            .lot_indices
+            .as_ref()
+            .filter(|v| v.len() != lots.len())
+        {
+            return Err(Error::Value(format!(
+                "{} lot indices for {} lots",
+                v.len(),
+                lots.len()
+            )));
+        }
         let started = std::time::Instant::now();
         let rule = self.start_rule(options.start_rule.as_deref())?;
         let mut engine_options = self.engine_options(options)?;
@@ -75,6 +86,7 @@ impl Rules {
             engine_options.scene = Some(Arc::new(self.collect_scene(
                 rule,
                 lots,
+                options,
                 &engine_options,
                 jobs,
             )?));
@@ -124,8 +136,11 @@ impl Rules {
             if begun != Some(i) {
                 begun = Some(i);
                 if let Some(w) = writer.as_deref_mut() {
-                    w.begin_lot(&lots[i].name, Some(lot_extras(i, &lots[i])))
-                        .map_err(Error::Export)?;
+                    w.begin_lot(
+                        &lots[i].name,
+                        Some(lot_extras(options.lot_index(i), &lots[i])),
+                    )
+                    .map_err(Error::Export)?;
                 }
             }
             let mut result = Ok(());
@@ -160,7 +175,7 @@ impl Rules {
             {
                 return Err(Error::Cancelled);
             }
-            let mut lot = self.lot_result(i, &lots[i], done);
+            let mut lot = self.lot_result(options.lot_index(i), &lots[i], done);
             let mut warnings = self.annotation_warnings(options, &lots[i]);
             warnings.append(&mut lot.warnings);
             lot.warnings = warnings;
@@ -178,7 +193,7 @@ impl Rules {
                 assets,
                 rule.0,
                 &lots[i],
-                i,
+                options.lot_index(i),
                 &engine_options,
                 |leaf| {
                     leaves += 1;
@@ -273,6 +288,7 @@ impl Rules {
         &self,
         rule: RuleRef,
         lots: &[Lot],
+        indices: &Options,
         options: &GenerateOptions,
         jobs: usize,
     ) -> Result<SceneContext, Error> {
@@ -288,7 +304,14 @@ impl Rules {
                 }
                 done.push((
                     i,
-                    collect_lot(program, assets, rule.0, &lots[i], i, options),
+                    collect_lot(
+                        program,
+                        assets,
+                        rule.0,
+                        &lots[i],
+                        indices.lot_index(i),
+                        options,
+                    ),
                 ));
             }
             done
@@ -317,10 +340,11 @@ impl Rules {
             .into_iter()
             .map(|r| r.unwrap_or_else(|| LotContext::new(None)))
             .collect();
-        Ok(SceneContext::new(
-            records,
-            options.context_use.unwrap_or_default(),
-        ))
+        let scene = SceneContext::new(records, options.context_use.unwrap_or_default());
+        Ok(match &indices.lot_indices {
+            Some(v) => scene.numbered(v.to_vec()),
+            None => scene,
+        })
     }
 
     /// Warnings for the values `options` and `lot` give attributes that

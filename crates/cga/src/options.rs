@@ -30,9 +30,22 @@ pub struct Options {
     pub jobs: Option<usize>,
     /// Stops a running generation from another thread.
     pub cancel: Option<Cancel>,
+    /// The index of each lot given in a larger run (a city generated in
+    /// parts: tiles, partitions): lot `i` of the call derives with the seed
+    /// of lot `lot_indices[i]` and its results carry that index, so the
+    /// parts make the city one call would. `None`: their positions. Must
+    /// have one index per lot.
+    pub lot_indices: Option<std::sync::Arc<[usize]>>,
 }
 
 impl Options {
+    /// The index of lot `i` of a call ([`Options::lot_indices`]).
+    pub(crate) fn lot_index(&self, i: usize) -> usize {
+        self.lot_indices
+            .as_ref()
+            .map_or(i, |v| v.get(i).copied().unwrap_or(i))
+    }
+
     pub fn seed(mut self, seed: u64) -> Options {
         self.seed = seed;
         self

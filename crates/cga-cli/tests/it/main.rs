@@ -9,4 +9,5 @@ mod context;
 mod lsp;
 mod oracle;
 mod texturing;
+mod tiles;
 mod workspace;

@@ -486,3 +486,50 @@ fn seven_zip_packages_of_cityengine_load_and_generate() {
         .ends_with("envelope2002.rpk/rules/typology/envelope2002.cga"));
     assert!(!rules.has_errors(), "{}", rules.render_diagnostics());
 }
+
+/// A city generated in parts (tiles, partitions) is the city of one call:
+/// `lot_indices` number the lots of a part as in the whole.
+#[test]
+fn parts_with_their_lot_indices_make_the_same_city() {
+    let rules = memory_rules(
+        "attr h = rand(5, 50)\nLot --> print(h + \" \" + rand(0, 1) + \" \" + initialShape.name) X.\n",
+    );
+    let lots: Vec<cga::Lot> = (0..5)
+        .map(|k| {
+            let mut lot = cga::lots::rect(10.0 + k as f64, 10.0);
+            lot.name = format!("lot{k}");
+            lot
+        })
+        .collect();
+    let options = Options::default().seed(7);
+    let whole: Vec<String> = rules
+        .generate_all(&lots, &options)
+        .unwrap()
+        .into_iter()
+        .flat_map(|r| r.prints)
+        .collect();
+    // Lots 3, 0 and 4, then 1 and 2: each part in any order.
+    let mut parts = vec![String::new(); 5];
+    for indices in [vec![3, 0, 4], vec![1, 2]] {
+        let part: Vec<cga::Lot> = indices.iter().map(|&i| lots[i].clone()).collect();
+        let options = Options {
+            lot_indices: Some(indices.clone().into()),
+            ..options.clone()
+        };
+        let results = rules.generate_all(&part, &options).unwrap();
+        for (k, r) in results.into_iter().enumerate() {
+            assert_eq!(r.index, indices[k]);
+            parts[r.index] = r.prints[0].clone();
+        }
+    }
+    assert_eq!(whole.len(), 5);
+    assert_eq!(parts, whole);
+    // Without it the second part would repeat the first lots' draws.
+    let alone: Vec<String> = rules
+        .generate_all(&lots[2..], &options)
+        .unwrap()
+        .into_iter()
+        .flat_map(|r| r.prints)
+        .collect();
+    assert_ne!(alone, whole[2..]);
+}

@@ -228,21 +228,15 @@ impl NativeRules {
                 errors,
             }));
         }
-        let (mut lots, places, invalid) = read_lots(rules, lots, skip_invalid)?;
-        // A lot's seed depends on its place in the run: lots of a part of
-        // a run, or after lots left out, are given the seed of their
-        // place as their own (unless they have one, or the rules declare
-        // an attribute `seed`, which then is no seed).
-        if (first_index > 0 || !invalid.is_empty()) && rules.attribute("seed").is_none() {
-            for (lot, &place) in lots.iter_mut().zip(&places) {
-                if !lot.attrs.iter().any(|(n, _)| &**n == "seed") {
-                    let s = cga::lot_seed(seed, first_index + place);
-                    lot.attrs.push((Arc::from("seed"), Value::Float(s as f64)));
-                }
-            }
-        }
+        let (lots, places, invalid) = read_lots(rules, lots, skip_invalid)?;
+        // Each lot derives with its place in the whole run (its seed, its
+        // number in context queries), also when it is a part of a run
+        // (`first_index`) or lots before it were left out: the facade's
+        // `Options::lot_indices`.
+        let indices: Arc<[usize]> = places.iter().map(|&p| first_index + p).collect();
         let mut options = Options::default().seed(seed);
         options.start_rule = start_rule;
+        options.lot_indices = Some(indices);
         for (name, value) in attrs {
             if let Some(v) = py_value(&value)? {
                 options = options.attr(name, v);
@@ -324,8 +318,7 @@ impl NativeRules {
                 match got {
                     Ok(result) => {
                         if failure.is_none() {
-                            let place = first_index + places[result.index];
-                            match model_dict(py, result, place) {
+                            match model_dict(py, result) {
                                 Ok(d) => models.push(d),
                                 Err(e) => {
                                     cancel.cancel();
@@ -581,10 +574,10 @@ fn array<'py, T: numpy::Element, const N: usize>(
     PyArray2::from_owned_array(py, a)
 }
 
-/// A lot's result as a dict; `index`: its place in the whole run.
-fn model_dict(py: Python<'_>, r: LotResult, index: usize) -> PyResult<Bound<'_, PyDict>> {
+/// A lot's result as a dict (its index: its place in the whole run).
+fn model_dict(py: Python<'_>, r: LotResult) -> PyResult<Bound<'_, PyDict>> {
     let d = PyDict::new(py);
-    d.set_item("index", index)?;
+    d.set_item("index", r.index)?;
     d.set_item("name", &r.name)?;
     d.set_item("prints", &r.prints)?;
     let reports = r

@@ -75,6 +75,10 @@ pub const DEFAULT_FLUSH_MIB: usize = 64;
 /// binary data is moved up).
 const GLB_JSON_ROOM: u64 = 1 << 20;
 
+/// The least room left when the number of lots is known (see
+/// `GltfWriter::estimated_json_room`).
+const MIN_ESTIMATED_ROOM: u64 = 16 << 10;
+
 /// Writes values as the little-endian bytes glTF's binary buffer holds.
 fn write_le<T: bytemuck::Pod>(w: &mut (impl Write + ?Sized), values: &[T]) -> std::io::Result<()> {
     if cfg!(target_endian = "little") {
@@ -754,9 +758,17 @@ impl GltfWriter {
             .last()
             .and_then(|l| l.extras.as_ref())
             .map_or(0, |e| e.to_string().len() as u64);
-        let per_lot = primitives * PER_PRIMITIVE + PER_LOT + extras;
+        // Feature ids add an accessor and a view per primitive, and the
+        // property table a few views and the lots' names.
+        let (per_primitive, per_lot) = match self.features {
+            true => (PER_PRIMITIVE + 250, PER_LOT + 64),
+            false => (PER_PRIMITIVE, PER_LOT),
+        };
+        let per_lot = primitives * per_primitive + per_lot + extras;
         let room = (lots as u64).saturating_mul(per_lot) / 4 * 5;
-        room.clamp(GLB_JSON_ROOM, 256 << 20) / 4 * 4
+        // Small models (3D Tiles' tiles) get small room: should the JSON
+        // not fit, moving a small file's data up costs little.
+        room.clamp(MIN_ESTIMATED_ROOM, 256 << 20) / 4 * 4
     }
 
     /// The feature id of what is added now: the current lot's position,

@@ -276,6 +276,7 @@ impl<F: FnMut(LotResult)> Writer<'_, F> {
         };
         let mut writer = ModelWriter::create(&path, Format::Glb, export).map_err(Error::Export)?;
         writer.with_features();
+        writer.expect_lots(node.lots.len());
         let part: Vec<Lot> = node.lots.iter().map(|&i| self.lots[i].clone()).collect();
         let indices: Arc<[usize]> = node.lots.clone().into();
         let options = Options {
@@ -309,17 +310,18 @@ impl<F: FnMut(LotResult)> Writer<'_, F> {
     }
 
     /// A parent's GLB of the massing of `lots`: each lot's outline
-    /// extruded from its lowest point to the top of its building.
+    /// extruded from its lowest point to the top of its building, all in
+    /// one mesh.
     fn massing(&mut self, node: &tree::Node, lots: &[usize]) -> Result<Option<String>, Error> {
         let name = format!("{}.glb", node.name());
         let path = self.tiles_dir.join(&name);
+        // One mesh for the tile: a node per lot would cost more JSON than
+        // a box's twelve triangles.
         let export = ExportOptions {
-            granularity: Granularity::Lot,
+            granularity: Granularity::Material,
             ..self.tiles.export.clone()
         };
         let mut writer = ModelWriter::create(&path, Format::Glb, export).map_err(Error::Export)?;
-        writer.expect_lots(lots.len());
-        writer.with_features();
         let material = Material {
             color: [0.82, 0.8, 0.76],
             ..Material::default()
@@ -345,9 +347,6 @@ impl<F: FnMut(LotResult)> Writer<'_, F> {
             for f in &mut mesh.faces {
                 f.material = 0;
             }
-            writer
-                .begin_lot(&lot.name, Some(json!({ "lot": i })))
-                .map_err(Error::Export)?;
             writer.add_mesh(&mesh).map_err(Error::Export)?;
         }
         let stats = writer.finish().map_err(Error::Export)?;

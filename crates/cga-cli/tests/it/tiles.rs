@@ -251,12 +251,16 @@ fn a_georeferenced_city_as_a_tileset() {
         assert_eq!(name, &format!("b{i}_{j}"));
         assert_eq!(height, &(8 + (i * 12 + j) % 7 * 3).to_string());
     }
-    // The parent's massing: a node per lot.
+    // The parent's massing: one mesh of every building's box (4 walls,
+    // the top and the base: 12 triangles each).
     let massing = glb_json(
         &dir.join("out")
             .join(root["content"]["uri"].as_str().unwrap()),
     );
-    assert_eq!(massing["nodes"].as_array().unwrap().len(), 144);
+    assert_eq!(massing["nodes"].as_array().unwrap().len(), 1);
+    let primitive = &massing["meshes"][0]["primitives"][0];
+    let indices = &massing["accessors"][primitive["indices"].as_u64().unwrap() as usize];
+    assert_eq!(indices["count"].as_u64().unwrap(), 144 * 12 * 3);
 
     // The same city as one GLB prints the same lines in the same order.
     let glb = dir.join("out/city.glb");

@@ -407,7 +407,7 @@ class Rules:
         naming it (``"raise"``), or is a model with that ``error`` and no
         geometry (``"report"``). ``first_index``: the place of the first lot
         in a larger run (a partition's): each lot gets the index and the
-        seed it has in that run.
+        seed it has in that run (also after lots left out as invalid).
 
         Returns one :class:`Model` per lot, in order. Lots run in parallel
         with the GIL released; Ctrl-C stops the generation.

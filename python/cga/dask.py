@@ -65,6 +65,7 @@ def _generate_partition(part, offsets, rules, out_dir, keys, kwargs, partition_i
         partial = output[: -len(".glb")] + ".partial.glb"
         write([m for m in models if m.meshes], partial)
         os.replace(partial, output)
+    index = part.index if hasattr(part, "index") and not isinstance(part, list) else pd.RangeIndex(first, first + len(models))
     frame = pd.DataFrame(
         {
             "name": [m.name for m in models],
@@ -73,7 +74,7 @@ def _generate_partition(part, offsets, rules, out_dir, keys, kwargs, partition_i
             "error": [m.error for m in models],
             "reports": [m.reports for m in models],
         },
-        index=part.index,
+        index=index,
     )
     for k in keys:
         frame[k] = np.array(
@@ -95,11 +96,35 @@ def _number(v):
     return np.nan
 
 
+def _is_bag(x):
+    return type(x).__name__ == "Bag" and type(x).__module__.startswith("dask.bag")
+
+
+def _generate_bag(bag, rules, out_dir, keys, kwargs):
+    """A Dask bag of lots (shapely geometries, GeoJSON features, arrays):
+    one task per bag partition, through ``to_delayed`` and
+    ``dask.dataframe.from_delayed``; rows indexed by the lots' places."""
+    import dask
+    import dask.dataframe as dd
+
+    parts = [dask.delayed(list)(p) for p in bag.to_delayed()]
+    offsets = dask.delayed(_offsets)([dask.delayed(len)(p) for p in parts])
+    frames = [
+        dask.delayed(_generate_partition)(p, offsets, rules, out_dir, keys, kwargs, {"number": i})
+        for i, p in enumerate(parts)
+    ]
+    # The `reports` dicts stay objects (Dask would make object columns
+    # strings).
+    with dask.config.set({"dataframe.convert-string": False}):
+        return dd.from_delayed(frames, meta=_meta(np.int64, keys), verify_meta=False)
+
+
 def generate(ddf, rules, out_dir=None, attrs=None, seed=0, start_rule=None, jobs=1, *,
              report_keys=(), limits=None):
     """A lazy Dask DataFrame with one row per lot of ``ddf`` (a
-    dask-geopandas GeoDataFrame; columns named like attributes set them
-    per lot), indexed like it: ``name``, ``triangles``, ``shapes``,
+    dask-geopandas GeoDataFrame, columns named like attributes setting them
+    per lot; or a Dask bag of lots, rows indexed by their places), indexed
+    like it: ``name``, ``triangles``, ``shapes``,
     ``error`` (None, or why the lot stopped or could not be made: a lot's
     failure is a value, not a lost partition), ``reports`` (a dict per
     lot) and a float column per name in ``report_keys``.
@@ -108,24 +133,27 @@ def generate(ddf, rules, out_dir=None, attrs=None, seed=0, start_rule=None, jobs
     ``out_dir/part-NNNNN.glb``. ``rules``: :class:`cga.Rules` or a path.
     ``jobs``: threads per task (1: Dask's workers are the parallelism).
     A task whose worker dies is run again by Dask's scheduler; one that
-    raises is retried ``retries`` times when computed with
-    ``.compute(retries=N)`` on a distributed cluster. The lots get the seeds they have in one ``rules.generate``
-    of the whole frame, so the result is that of one process.
+    raises is retried when computed with ``.compute(retries=N)`` on a
+    distributed cluster. The lots get the seeds they have in one
+    ``rules.generate`` of the whole frame, so the result is that of one
+    process.
     """
     if not isinstance(rules, Rules):
         rules = Rules.open(rules)
     if out_dir is not None:
         out_dir = os.path.abspath(os.fspath(out_dir))
         os.makedirs(out_dir, exist_ok=True)
+    kwargs = dict(attrs=attrs, seed=seed, start_rule=start_rule, jobs=jobs, limits=limits)
+    keys = list(report_keys)
+    if _is_bag(ddf):
+        return _generate_bag(ddf, rules, out_dir, keys, kwargs)
+    import dask
+
     # Each lot's place in the whole frame, for its seed: from the lengths
     # of the partitions before it, in the same graph (so a failed task is
     # retried like any other, and each partition is read once).
-    import dask
-
     lengths = ddf.map_partitions(len, meta=(None, "int64")).to_delayed()
     offsets = dask.delayed(_offsets)(lengths)
-    kwargs = dict(attrs=attrs, seed=seed, start_rule=start_rule, jobs=jobs, limits=limits)
-    keys = list(report_keys)
     return ddf.map_partitions(
         _generate_partition, offsets, rules, out_dir, keys, kwargs,
         meta=_meta(ddf._meta.index.dtype, keys),

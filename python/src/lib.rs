@@ -221,31 +221,22 @@ impl NativeRules {
     ) -> PyResult<Generated<'py>> {
         let rules = &self.rules;
         if rules.has_errors() {
-            return Err(to_py_err(
-                rules
-                    .check_attributes(&Options::default())
-                    .err()
-                    .unwrap_or(Error::Rules {
-                        path: rules.path().to_path_buf(),
-                        errors: 1,
-                    }),
-            ));
+            // (The Python side raises RuleError, with the diagnostics, first.)
+            let errors = rules.diagnostics().iter().filter(|d| d.is_error()).count();
+            return Err(to_py_err(Error::Rules {
+                path: rules.path().to_path_buf(),
+                errors,
+            }));
         }
-        let (mut lots, places, invalid) = read_lots(rules, lots, skip_invalid)?;
-        // A lot's seed depends on its place in the run: lots of a part of
-        // a run, or after lots left out, are given the seed of their
-        // place as their own (unless they have one, or the rules declare
-        // an attribute `seed`, which then is no seed).
-        if (first_index > 0 || !invalid.is_empty()) && rules.attribute("seed").is_none() {
-            for (lot, &place) in lots.iter_mut().zip(&places) {
-                if !lot.attrs.iter().any(|(n, _)| &**n == "seed") {
-                    let s = cga::lot_seed(seed, first_index + place);
-                    lot.attrs.push((Arc::from("seed"), Value::Float(s as f64)));
-                }
-            }
-        }
+        let (lots, places, invalid) = read_lots(rules, lots, skip_invalid)?;
+        // Each lot derives with its place in the whole run (its seed, its
+        // number in context queries), also when it is a part of a run
+        // (`first_index`) or lots before it were left out: the facade's
+        // `Options::lot_indices`.
+        let indices: Arc<[usize]> = places.iter().map(|&p| first_index + p).collect();
         let mut options = Options::default().seed(seed);
         options.start_rule = start_rule;
+        options.lot_indices = Some(indices);
         for (name, value) in attrs {
             if let Some(v) = py_value(&value)? {
                 options = options.attr(name, v);
@@ -327,8 +318,7 @@ impl NativeRules {
                 match got {
                     Ok(result) => {
                         if failure.is_none() {
-                            let place = first_index + places[result.index];
-                            match model_dict(py, result, place) {
+                            match model_dict(py, result) {
                                 Ok(d) => models.push(d),
                                 Err(e) => {
                                     cancel.cancel();
@@ -411,8 +401,8 @@ fn read_lots(
     Ok((out, places, invalid))
 }
 
-/// One lot, or its name and why it cannot be made.
-/// `(name, why)` is a lot the Python side found invalid.
+/// One lot, or its name and why it cannot be made (`(name, why)`: a lot
+/// the Python side found invalid).
 fn read_lot(
     rules: &Rules,
     i: usize,
@@ -421,55 +411,53 @@ fn read_lot(
     if let Ok((name, why)) = item.extract::<(String, String)>() {
         return Err((name, why));
     }
-    {
-        type Item<'py> = (
-            String,
-            Vec<Vec<PyReadonlyArray2<'py, f64>>>,
-            bool,
-            Vec<(String, Bound<'py, PyAny>)>,
-        );
-        let (name, polygons, gis, attrs): Item<'_> = item
-            .extract()
-            .map_err(|e| (format!("{i}"), format!("not a lot the package made: {e}")))?;
-        let bad = |why: String| (name.clone(), why);
-        let mut rings_of = Vec::with_capacity(polygons.len());
-        for polygon in &polygons {
-            let mut rings = Vec::with_capacity(polygon.len());
-            for ring in polygon {
-                let a = ring.as_array();
-                if a.ncols() != 3 {
-                    return Err(bad(format!(
-                        "a ring must be an (n, 3) array of coordinates, not ({}, {})",
-                        a.nrows(),
-                        a.ncols()
-                    )));
-                }
-                rings.push(
-                    a.rows()
-                        .into_iter()
-                        .map(|r| [r[0], r[1], r[2]])
-                        .collect::<Vec<_>>(),
-                );
+    type Item<'py> = (
+        String,
+        Vec<Vec<PyReadonlyArray2<'py, f64>>>,
+        bool,
+        Vec<(String, Bound<'py, PyAny>)>,
+    );
+    let (name, polygons, gis, attrs): Item<'_> = item
+        .extract()
+        .map_err(|e| (format!("{i}"), format!("not a lot the package made: {e}")))?;
+    let bad = |why: String| (name.clone(), why);
+    let mut rings_of = Vec::with_capacity(polygons.len());
+    for polygon in &polygons {
+        let mut rings = Vec::with_capacity(polygon.len());
+        for ring in polygon {
+            let a = ring.as_array();
+            if a.ncols() != 3 {
+                return Err(bad(format!(
+                    "a ring must be an (n, 3) array of coordinates, not ({}, {})",
+                    a.nrows(),
+                    a.ncols()
+                )));
             }
-            rings_of.push(rings);
+            rings.push(
+                a.rows()
+                    .into_iter()
+                    .map(|r| [r[0], r[1], r[2]])
+                    .collect::<Vec<_>>(),
+            );
         }
-        let axes = if gis { Axes::Gis } else { Axes::Engine };
-        let mut lot = cga::lots::from_polygons(name.clone(), &rings_of, axes).map_err(bad)?;
-        for (attr, value) in attrs {
-            if attr != "seed" && rules.attribute(&attr).is_none() {
-                return Err(bad(Error::UnknownAttribute {
-                    name: attr,
-                    known: rules.attributes().iter().map(|a| a.name.clone()).collect(),
-                }
-                .to_string()));
-            }
-            let value = py_value(&value).map_err(|e| bad(format!("attribute `{attr}`: {e}")))?;
-            if let Some(v) = value {
-                lot.attrs.push((Arc::from(attr.as_str()), v));
-            }
-        }
-        Ok(lot)
+        rings_of.push(rings);
     }
+    let axes = if gis { Axes::Gis } else { Axes::Engine };
+    let mut lot = cga::lots::from_polygons(name.clone(), &rings_of, axes).map_err(bad)?;
+    for (attr, value) in attrs {
+        if attr != "seed" && rules.attribute(&attr).is_none() {
+            return Err(bad(Error::UnknownAttribute {
+                name: attr,
+                known: rules.attributes().iter().map(|a| a.name.clone()).collect(),
+            }
+            .to_string()));
+        }
+        let value = py_value(&value).map_err(|e| bad(format!("attribute `{attr}`: {e}")))?;
+        if let Some(v) = value {
+            lot.attrs.push((Arc::from(attr.as_str()), v));
+        }
+    }
+    Ok(lot)
 }
 
 /// A Python value as a CGA value: bool, number, string, or a sequence of
@@ -586,10 +574,10 @@ fn array<'py, T: numpy::Element, const N: usize>(
     PyArray2::from_owned_array(py, a)
 }
 
-/// A lot's result as a dict; `index`: its place in the whole run.
-fn model_dict(py: Python<'_>, r: LotResult, index: usize) -> PyResult<Bound<'_, PyDict>> {
+/// A lot's result as a dict (its index: its place in the whole run).
+fn model_dict(py: Python<'_>, r: LotResult) -> PyResult<Bound<'_, PyDict>> {
     let d = PyDict::new(py);
-    d.set_item("index", index)?;
+    d.set_item("index", r.index)?;
     d.set_item("name", &r.name)?;
     d.set_item("prints", &r.prints)?;
     let reports = r

@@ -35,7 +35,8 @@ def frame(n):
     d = rng.uniform(8, 25, n)
     geoms = [shapely.box(100 * (i % 40), 100 * (i // 40), 100 * (i % 40) + w[i], 100 * (i // 40) + d[i]) for i in range(n)]
     # One lot that cannot be made: a failure is a row, not a lost partition.
-    geoms[123] = shapely.Polygon([(0, 0), (1, 1), (0, 0)]) if n > 123 else geoms[123]
+    if n > 123:
+        geoms[123] = shapely.Polygon([(0, 0), (1, 1), (0, 0)])
     return gpd.GeoDataFrame({"floors": (np.arange(n) % 9 + 1).astype(float), "other": "x"}, geometry=geoms)
 
 
@@ -124,3 +125,21 @@ def test_a_killed_worker_still_gives_the_complete_result(cluster, tmp_path):
     assert table["triangles"].tolist() == [m.triangles for m in want]
     assert table["reports"].tolist() == [m.reports for m in want]
     assert sorted(os.listdir(out)) == [f"part-{i:05d}.glb" for i in range(8)]
+
+
+def test_a_bag_of_lots(cluster):
+    import dask.bag
+
+    rules = cga.Rules.from_string(RULES)
+    gdf = frame(100)
+    features = [
+        {"type": "Feature", "properties": {"floors": f}, "geometry": shapely.geometry.mapping(g)}
+        for f, g in zip(gdf["floors"], gdf.geometry)
+    ]
+    bag = dask.bag.from_sequence(features, npartitions=4)
+    table = cga.dask.generate(bag, rules).compute()
+    want = rules.generate(features, invalid="report")
+    assert list(table.index) == list(range(100))
+    assert table["triangles"].tolist() == [m.triangles for m in want]
+    assert table["reports"].tolist() == [m.reports for m in want]
+    assert table["reports"].iloc[5]["floors"] == 6.0

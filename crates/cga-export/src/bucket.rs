@@ -32,6 +32,9 @@ pub(crate) struct Bucket {
     pub tangents: Option<Vec<[f32; 4]>>,
     /// Vertex indices per triangle.
     pub indices: Vec<[u32; 3]>,
+    /// With per-lot features: the feature id of each vertex so far (filled
+    /// up to the vertex count when the lot changes or data is written).
+    pub features: Vec<f32>,
     pub min: [f32; 3],
     pub max: [f32; 3],
 }
@@ -113,6 +116,7 @@ impl Bucket {
             t.clear();
         }
         self.indices.clear();
+        self.features.clear();
         self.min = [f32::INFINITY; 3];
         self.max = [f32::NEG_INFINITY; 3];
     }

@@ -58,9 +58,9 @@ struct PrimitiveLayout {
     coords: Vec<usize>,
     tangents: Option<usize>,
     indices: usize,
-    /// With per-lot features (EXT_mesh_features): the feature id of every
-    /// vertex (the lot's position in the model), written after the indices.
-    feature: Option<u32>,
+    /// With per-lot features (EXT_mesh_features): a feature id per vertex
+    /// (the position of its lot in the model), written after the indices.
+    features: bool,
     min: [f32; 3],
     max: [f32; 3],
 }
@@ -74,6 +74,10 @@ pub const DEFAULT_FLUSH_MIB: usize = 64;
 /// kilobytes; one with thousands of materials may need more, and then the
 /// binary data is moved up).
 const GLB_JSON_ROOM: u64 = 1 << 20;
+
+/// The least room left when the number of lots is known (see
+/// `GltfWriter::estimated_json_room`).
+const MIN_ESTIMATED_ROOM: u64 = 16 << 10;
 
 /// Writes values as the little-endian bytes glTF's binary buffer holds.
 fn write_le<T: bytemuck::Pod>(w: &mut (impl Write + ?Sized), values: &[T]) -> std::io::Result<()> {
@@ -129,18 +133,14 @@ impl Bucket {
             coords: self.coords.iter().map(|c| c.len() * 8).collect(),
             tangents: self.tangents.as_ref().map(|t| t.len() * 16),
             indices: self.indices.len() * 12,
-            feature: None,
+            features: !self.features.is_empty(),
             min: self.min,
             max: self.max,
         }
     }
 
     /// The arrays in the order of the binary layout.
-    fn write_arrays(
-        &self,
-        w: &mut (impl Write + ?Sized),
-        feature: Option<u32>,
-    ) -> std::io::Result<()> {
+    fn write_arrays(&self, w: &mut (impl Write + ?Sized)) -> std::io::Result<()> {
         write_le(w, &self.positions)?;
         write_le(w, &self.normals)?;
         for coords in &self.coords {
@@ -150,11 +150,8 @@ impl Bucket {
             write_le(w, tangents)?;
         }
         write_le(w, &self.indices)?;
-        if let Some(f) = feature {
-            // Feature ids as floats: exact below 2^24 lots per model.
-            write_le(w, &vec![f as f32; self.positions.len()])?;
-        }
-        Ok(())
+        // Feature ids as floats: exact below 2^24 lots per model.
+        write_le(w, &self.features)
     }
 }
 
@@ -552,6 +549,8 @@ pub(crate) struct GltfWriter {
     features: bool,
     /// The property table's bytes, written after everything else.
     tail: Vec<u8>,
+    /// With features: the box of each lot's vertices so far.
+    feature_bounds: Vec<Option<[[f64; 3]; 2]>>,
 }
 
 /// A lot's node: its name and `extras`, and the first of its primitives in
@@ -628,13 +627,14 @@ impl GltfWriter {
             json_room: GLB_JSON_ROOM,
             features: false,
             tail: Vec::new(),
+            feature_bounds: Vec::new(),
         }
     }
 
     /// Gives each lot's vertices its feature id and writes a property
     /// table of the lots (for 3D Tiles viewers that pick buildings).
     pub(crate) fn with_features(&mut self) {
-        self.features = self.per_lot;
+        self.features = true;
     }
 
     /// Says how many lots the model will have.
@@ -649,10 +649,12 @@ impl GltfWriter {
         name: &str,
         extras: Option<serde_json::Value>,
     ) -> Result<(), ExportError> {
-        if !self.per_lot {
+        if !self.per_lot && !self.features {
             return Ok(());
         }
-        if self.buckets.iter().any(|b| !b.indices.is_empty()) {
+        // What was added so far belongs to the lot before.
+        self.sync_features();
+        if self.per_lot && self.buckets.iter().any(|b| !b.indices.is_empty()) {
             self.flush()?;
         }
         self.lots.push(LotNode {
@@ -754,23 +756,52 @@ impl GltfWriter {
             .last()
             .and_then(|l| l.extras.as_ref())
             .map_or(0, |e| e.to_string().len() as u64);
-        let per_lot = primitives * PER_PRIMITIVE + PER_LOT + extras;
+        // Feature ids add an accessor and a view per primitive, and the
+        // property table a few views and the lots' names.
+        let (per_primitive, per_lot) = match self.features {
+            true => (PER_PRIMITIVE + 250, PER_LOT + 64),
+            false => (PER_PRIMITIVE, PER_LOT),
+        };
+        let per_lot = primitives * per_primitive + per_lot + extras;
         let room = (lots as u64).saturating_mul(per_lot) / 4 * 5;
-        room.clamp(GLB_JSON_ROOM, 256 << 20) / 4 * 4
+        // Small models (3D Tiles' tiles) get small room: should the JSON
+        // not fit, moving a small file's data up costs little.
+        room.clamp(MIN_ESTIMATED_ROOM, 256 << 20) / 4 * 4
     }
 
-    /// The feature id of what is added now: the current lot's position,
-    /// when the model has per-lot features.
-    fn feature(&self) -> Option<u32> {
+    /// Gives the vertices added since the last call the current lot's
+    /// feature id (its position in the model) and takes them into the
+    /// lot's box, when the model has per-lot features.
+    fn sync_features(&mut self) {
         if !self.features {
-            return None;
+            return;
         }
-        Some(self.lots.len().saturating_sub(1) as u32)
+        let lot = self.lots.len().saturating_sub(1);
+        let id = lot as f32;
+        let mut bounds: Option<[[f64; 3]; 2]> = self.feature_bounds.get(lot).copied().flatten();
+        for b in &mut self.buckets {
+            let from = b.features.len();
+            for p in &b.positions[from..] {
+                let p = p.map(f64::from);
+                bounds = Some(match bounds {
+                    Some([lo, hi]) => [
+                        std::array::from_fn(|k| lo[k].min(p[k])),
+                        std::array::from_fn(|k| hi[k].max(p[k])),
+                    ],
+                    None => [p, p],
+                });
+            }
+            b.features.resize(b.positions.len(), id);
+        }
+        if self.feature_bounds.len() <= lot {
+            self.feature_bounds.resize(lot + 1, None);
+        }
+        self.feature_bounds[lot] = bounds;
     }
 
     /// Writes every bucket's data as a primitive and empties the buckets.
     fn flush(&mut self) -> Result<(), ExportError> {
-        let feature = self.feature();
+        self.sync_features();
         let path = self.path.clone();
         let io = |e| ExportError::io(&path, e);
         let out: &mut dyn Write = if self.binary {
@@ -792,10 +823,9 @@ impl GltfWriter {
                 continue;
             }
             b.unmerged_coords();
-            b.write_arrays(out, feature).map_err(io)?;
-            let mut p = b.primitive(id as u32);
-            p.feature = feature;
-            self.written_bytes += b.bytes() as u64 + p.feature.map_or(0, |_| p.vertices * 4);
+            b.write_arrays(out).map_err(io)?;
+            let p = b.primitive(id as u32);
+            self.written_bytes += b.bytes() as u64 + b.features.len() as u64 * 4;
             self.written.push(p);
             b.clear();
         }
@@ -837,15 +867,13 @@ impl GltfWriter {
                 b.merge_equal_coords();
             }
         }
+        self.sync_features();
         let held: Vec<PrimitiveLayout> = self
             .buckets
             .iter()
             .enumerate()
             .filter(|(_, b)| !b.indices.is_empty())
-            .map(|(id, b)| PrimitiveLayout {
-                feature: self.feature(),
-                ..b.primitive(id as u32)
-            })
+            .map(|(id, b)| b.primitive(id as u32))
             .collect();
         // Accessors in the order of the binary data, with their material.
         let mut primitives: Vec<(u32, json::mesh::Primitive)> = Vec::new();
@@ -858,7 +886,10 @@ impl GltfWriter {
         }
         let layouts: Vec<&PrimitiveLayout> = self.written.iter().chain(&held).collect();
         stats.bounds = bounds_of(&layouts);
-        if self.per_lot {
+        if self.features {
+            stats.lot_bounds = self.feature_bounds.clone();
+            stats.lot_bounds.resize(self.lots.len(), None);
+        } else if self.per_lot {
             let starts: Vec<usize> = self.lots.iter().map(|l| l.first).collect();
             for (k, &start) in starts.iter().enumerate() {
                 let end = starts.get(k + 1).copied().unwrap_or(layouts.len());
@@ -1009,7 +1040,6 @@ impl GltfWriter {
                 };
                 let held = Held {
                     buckets: &self.buckets,
-                    feature: self.feature(),
                     tail: &self.tail,
                 };
                 write_bin(&mut w, &held, &[], textures, &bin_path)?;
@@ -1044,13 +1074,11 @@ impl GltfWriter {
         }
         let bin_chunk = if bin_len > 0 { 8 + bin_len } else { 0 };
         let total = glb_length(12 + 8 + json.len() as u64 + bin_chunk)?;
-        let feature = self.feature();
         let out = &mut self.out;
         write_glb_head(out, total, &json, bin_len).map_err(io)?;
         if bin_len > 0 {
             let held = Held {
                 buckets: &self.buckets,
-                feature,
                 tail: &self.tail,
             };
             write_bin(out, &held, images, textures, &path)?;
@@ -1073,7 +1101,6 @@ impl GltfWriter {
         let io = |e| ExportError::io(&path, e);
         let held = Held {
             buckets: &self.buckets,
-            feature: self.feature(),
             tail: &self.tail,
         };
         write_bin(&mut self.out, &held, images, textures, &path)?;
@@ -1258,7 +1285,7 @@ fn primitive_accessors(
         ComponentType::U32,
         Some(json::buffer::Target::ElementArrayBuffer),
     );
-    let extensions = p.feature.map(|_| {
+    let extensions = p.features.then(|| {
         let acc = layout.accessor(
             root,
             p.vertices as usize,
@@ -1471,7 +1498,7 @@ fn write_bin(
     // The arrays hold the bytes to write; arrays larger than the output
     // buffer go to the file directly.
     for b in held.buckets.iter().filter(|b| !b.indices.is_empty()) {
-        b.write_arrays(w, held.feature).map_err(io)?;
+        b.write_arrays(w).map_err(io)?;
     }
     for &t in images {
         let tex = textures.get(t);
@@ -1482,11 +1509,10 @@ fn write_bin(
     w.write_all(held.tail).map_err(io)
 }
 
-/// What `finish` writes of the binary data: the buckets held (with their
-/// feature id), then the images, then `tail` (the property table).
+/// What `finish` writes of the binary data: the buckets held, then the
+/// images, then `tail` (the property table).
 struct Held<'a> {
     buckets: &'a [Bucket],
-    feature: Option<u32>,
     tail: &'a [u8],
 }
 

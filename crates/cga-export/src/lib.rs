@@ -471,8 +471,8 @@ impl ModelWriter {
         }
     }
 
-    /// Gives the vertices of each lot begun (with [`Granularity::Lot`]) the
-    /// lot's feature id, and writes a property table of the lots (index,
+    /// Gives the vertices of each lot begun the lot's feature id (also
+    /// when merged by material), and writes a property table of the lots (index,
     /// name, attributes): `EXT_mesh_features` and
     /// `EXT_structural_metadata`, with which 3D Tiles viewers pick a
     /// building and show what it is. glTF and GLB only.
@@ -500,11 +500,11 @@ impl ModelWriter {
         name: &str,
         extras: Option<serde_json::Value>,
     ) -> Result<(), ExportError> {
-        if self.granularity != Granularity::Lot {
-            return Ok(());
-        }
         match &mut self.sink {
-            Sink::Obj(w, ..) => w.begin_group(name),
+            Sink::Obj(w, ..) if self.granularity == Granularity::Lot => w.begin_group(name),
+            Sink::Obj(..) => Ok(()),
+            // Merged by material, a lot still has its feature id when
+            // features are on.
             Sink::Gltf(w, _) => w.begin_lot(name, extras),
         }
     }

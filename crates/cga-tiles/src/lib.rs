@@ -1,8 +1,9 @@
 //! Cities for the web: a generated city as an OGC 3D Tiles 1.1 tileset.
 //!
 //! The lots are put in a quadtree by their centres ([`tree`]); each leaf
-//! tile is a GLB of its lots, generated together (a node per lot, named by
-//! it, with its index and attributes in `extras`), and each parent tile
+//! tile is a GLB of its lots, generated together (merged by material, each
+//! vertex with its lot's feature id and the tile with a property table of
+//! its lots: `EXT_mesh_features`, `EXT_structural_metadata`), and each parent tile
 //! holds a light version of the lots below it, each building as its
 //! massing (the lot extruded to the building's height), so that a
 //! city-wide view loads fast; tiles with more lots than
@@ -46,7 +47,7 @@ pub struct TilesetOptions {
     /// larger tiles only bound their children.
     pub max_massing_lots: usize,
     /// How the tiles' GLBs are written (textures, data held). Tiles are
-    /// always GLB with a node per lot.
+    /// always GLB, merged by material, with per-lot features.
     pub export: ExportOptions,
 }
 
@@ -270,12 +271,16 @@ impl<F: FnMut(LotResult)> Writer<'_, F> {
     fn leaf(&mut self, node: &tree::Node) -> Result<(Option<String>, Option<Bounds>), Error> {
         let name = format!("{}.glb", node.name());
         let path = self.tiles_dir.join(&name);
+        // The tile's lots merged by material, told apart by their feature
+        // ids: a node per lot would cost more JSON than small buildings'
+        // geometry.
         let export = ExportOptions {
-            granularity: Granularity::Lot,
+            granularity: Granularity::Material,
             ..self.tiles.export.clone()
         };
         let mut writer = ModelWriter::create(&path, Format::Glb, export).map_err(Error::Export)?;
         writer.with_features();
+        writer.expect_lots(node.lots.len());
         let part: Vec<Lot> = node.lots.iter().map(|&i| self.lots[i].clone()).collect();
         let indices: Arc<[usize]> = node.lots.clone().into();
         let options = Options {
@@ -309,16 +314,17 @@ impl<F: FnMut(LotResult)> Writer<'_, F> {
     }
 
     /// A parent's GLB of the massing of `lots`: each lot's outline
-    /// extruded from its lowest point to the top of its building.
+    /// extruded from its lowest point to the top of its building, all in
+    /// one mesh.
     fn massing(&mut self, node: &tree::Node, lots: &[usize]) -> Result<Option<String>, Error> {
         let name = format!("{}.glb", node.name());
         let path = self.tiles_dir.join(&name);
+        // One mesh for the tile, the lots told apart by feature ids.
         let export = ExportOptions {
-            granularity: Granularity::Lot,
+            granularity: Granularity::Material,
             ..self.tiles.export.clone()
         };
         let mut writer = ModelWriter::create(&path, Format::Glb, export).map_err(Error::Export)?;
-        writer.expect_lots(lots.len());
         writer.with_features();
         let material = Material {
             color: [0.82, 0.8, 0.76],

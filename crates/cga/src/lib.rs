@@ -60,11 +60,6 @@ pub use rules::{Engine, ProgramSize, RuleInfo, RuleRef, Rules};
 
 /// Default largest asset file read, in MiB ([`Engine::max_asset_mib`]).
 pub use cga_engine::assets::DEFAULT_MAX_ASSET_MIB;
-/// The seed lot `index` of a run with seed `seed` derives with (unless it
-/// has its own): hosts that split one run into parts (the Python
-/// package's Dask partitions) give each lot this seed as its own `seed`,
-/// so that every part generates what the whole run would.
-pub use cga_engine::generate::lot_seed;
 /// Default vertex data a glTF/GLB writer holds before writing it out, in MiB.
 pub use cga_export::DEFAULT_FLUSH_MIB;
 /// The names of a material's ten texture channels, in the order of

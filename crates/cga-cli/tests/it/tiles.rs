@@ -52,10 +52,10 @@ fn strings(json: &Value, bin: &[u8], property: &Value) -> Vec<String> {
         .collect()
 }
 
-/// A tile's lots as its property table has them (EXT_structural_metadata):
-/// index, name and the `height` attribute; and every primitive's feature
-/// ids name the lot of its node.
-fn property_table(path: &Path) -> Vec<(u64, String, String)> {
+/// A tile's property table (EXT_structural_metadata): the lots' indices and
+/// names, and the strings of attribute `attr` if asked; checks that the
+/// primitives' feature ids (EXT_mesh_features) are exactly the table's rows.
+fn property_table(path: &Path, attr: Option<&str>) -> (Vec<u64>, Vec<String>, Vec<String>) {
     let (json, bin) = glb_parts(path);
     let used: Vec<&str> = json["extensionsUsed"]
         .as_array()
@@ -71,35 +71,33 @@ fn property_table(path: &Path) -> Vec<(u64, String, String)> {
         .map(|c| u32::from_le_bytes(c.try_into().unwrap()) as u64)
         .collect();
     let names = strings(&json, &bin, &table["properties"]["name"]);
-    let heights = strings(&json, &bin, &table["properties"]["attr_height"]);
-    assert_eq!(
-        (index.len(), names.len(), heights.len()),
-        (count, count, count)
-    );
-    for (k, node) in json["nodes"].as_array().unwrap().iter().enumerate() {
-        assert_eq!(node["extras"]["lot"].as_u64().unwrap(), index[k]);
-        for p in json["meshes"][node["mesh"].as_u64().unwrap() as usize]["primitives"]
-            .as_array()
-            .unwrap()
-        {
-            let ids = &p["extensions"]["EXT_mesh_features"]["featureIds"][0];
-            assert_eq!(ids["featureCount"].as_u64().unwrap() as usize, count);
+    let attrs = attr.map_or(Vec::new(), |a| {
+        strings(&json, &bin, &table["properties"][a])
+    });
+    assert_eq!((index.len(), names.len()), (count, count));
+    let mut ids = std::collections::BTreeSet::new();
+    for mesh in json["meshes"].as_array().unwrap() {
+        for p in mesh["primitives"].as_array().unwrap() {
+            let feature_ids = &p["extensions"]["EXT_mesh_features"]["featureIds"][0];
+            assert_eq!(
+                feature_ids["featureCount"].as_u64().unwrap() as usize,
+                count
+            );
             let acc =
                 &json["accessors"][p["attributes"]["_FEATURE_ID_0"].as_u64().unwrap() as usize];
             let view = &json["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
             let offset = view["byteOffset"].as_u64().unwrap_or(0) as usize;
             let n = acc["count"].as_u64().unwrap() as usize;
             for c in bin[offset..offset + 4 * n].chunks(4) {
-                assert_eq!(f32::from_le_bytes(c.try_into().unwrap()), k as f32);
+                let id = f32::from_le_bytes(c.try_into().unwrap());
+                assert!(id.fract() == 0.0 && (id as usize) < count, "{id}");
+                ids.insert(id as usize);
             }
         }
     }
-    index
-        .into_iter()
-        .zip(names)
-        .zip(heights)
-        .map(|((i, n), h)| (i, n, h))
-        .collect()
+    // Every lot of the table has vertices (every test building has some).
+    assert_eq!(ids.len(), count);
+    (index, names, attrs)
 }
 
 /// `n` x `n` lots of 20 x 30 m in longitude/latitude around 8.5 E, 47.3 N,
@@ -170,11 +168,9 @@ fn check_tile(dir: &Path, tile: &Value, parent: Option<([[f64; 2]; 3], f64)>, lo
     if let Some(uri) = tile["content"]["uri"].as_str() {
         let glb = dir.join(uri);
         assert_valid_gltf(&glb);
-        let json = glb_json(&glb);
+        let (index, _, _) = property_table(&glb, None);
         if children.is_empty() {
-            for node in json["nodes"].as_array().unwrap() {
-                lots.push(node["extras"]["lot"].as_u64().unwrap());
-            }
+            lots.extend(index);
         }
     }
     if children.is_empty() {
@@ -233,30 +229,35 @@ fn a_georeferenced_city_as_a_tileset() {
     seen.sort();
     assert_eq!(seen, (0..144).collect::<Vec<u64>>());
     assert!(root["children"].as_array().is_some_and(|c| c.len() >= 2));
-    // Per-building metadata in a leaf: feature ids and a property table
-    // with the lot's index, its feature id and its `height` property.
+    // Per-building metadata in a leaf: a property table with the lot's
+    // index, its feature id and its `height` property.
     let leaf = &root["children"][0];
     let leaf = if leaf["children"].is_array() {
         &leaf["children"][0]
     } else {
         leaf
     };
-    let rows = property_table(
+    let (index, names, heights) = property_table(
         &dir.join("out")
             .join(leaf["content"]["uri"].as_str().unwrap()),
+        Some("attr_height"),
     );
-    assert!(!rows.is_empty());
-    for (index, name, height) in &rows {
+    assert!(!index.is_empty());
+    for ((index, name), height) in index.iter().zip(&names).zip(&heights) {
         let (i, j) = (*index as usize / 12, *index as usize % 12);
         assert_eq!(name, &format!("b{i}_{j}"));
         assert_eq!(height, &(8 + (i * 12 + j) % 7 * 3).to_string());
     }
-    // The parent's massing: a node per lot.
+    // The parent's massing: one mesh of every building's box (4 walls,
+    // the top and the base: 12 triangles each).
     let massing = glb_json(
         &dir.join("out")
             .join(root["content"]["uri"].as_str().unwrap()),
     );
-    assert_eq!(massing["nodes"].as_array().unwrap().len(), 144);
+    assert_eq!(massing["nodes"].as_array().unwrap().len(), 1);
+    let primitive = &massing["meshes"][0]["primitives"][0];
+    let indices = &massing["accessors"][primitive["indices"].as_u64().unwrap() as usize];
+    assert_eq!(indices["count"].as_u64().unwrap(), 144 * 12 * 3);
 
     // The same city as one GLB prints the same lines in the same order.
     let glb = dir.join("out/city.glb");

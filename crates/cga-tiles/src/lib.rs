@@ -104,6 +104,11 @@ pub fn write_tileset(
     };
     let tiles_dir = dir.join("tiles");
     std::fs::create_dir_all(&tiles_dir).map_err(|e| io(&tiles_dir, e))?;
+    // Context queries between lots see the whole run, not one tile.
+    let options = &Options {
+        scene: rules.scene(lots, options)?,
+        ..options.clone()
+    };
     let centres: Vec<[f64; 2]> = lots.iter().map(centre).collect();
     let root = tree::build(&centres, tiles.max_lots_per_tile);
     let mut w = Writer {

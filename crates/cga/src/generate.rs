@@ -82,7 +82,9 @@ impl Rules {
         let assets = &self.inner.assets;
         let usage = self.inner.context_use;
         engine_options.context_use = Some(usage);
-        if usage.inter && lots.len() > 1 {
+        if let (true, Some(scene)) = (usage.inter, &options.scene) {
+            engine_options.scene = Some(scene.0.clone());
+        } else if usage.inter && lots.len() > 1 {
             engine_options.scene = Some(Arc::new(self.collect_scene(
                 rule,
                 lots,
@@ -409,6 +411,39 @@ impl Rules {
             error: error.map(|e| Diagnostic::new(&e.to_diagnostic(), sources)),
             shapes,
         }
+    }
+}
+
+/// The scene of a whole run for context queries between lots: what the
+/// first pass recorded of every lot (see [`Options::scene`]).
+#[derive(Clone)]
+pub struct Scene(Arc<SceneContext>);
+
+impl std::fmt::Debug for Scene {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Scene")
+    }
+}
+
+impl Rules {
+    /// The scene of `lots` (a whole run) for parts of it generated apart
+    /// ([`Options::scene`]); `None` when the rules ask no `inter` context
+    /// query, or for a single lot.
+    pub fn scene(&self, lots: &[Lot], options: &Options) -> Result<Option<Scene>, Error> {
+        self.check_usable()?;
+        if !self.inner.context_use.inter || lots.len() < 2 {
+            return Ok(None);
+        }
+        let rule = self.start_rule(options.start_rule.as_deref())?;
+        let mut engine_options = self.engine_options(options)?;
+        engine_options.context_use = Some(self.inner.context_use);
+        let whole = Options {
+            lot_indices: None,
+            ..options.clone()
+        };
+        let jobs = options.threads().min(lots.len());
+        let scene = self.collect_scene(rule, lots, &whole, &engine_options, jobs)?;
+        Ok(Some(Scene(Arc::new(scene))))
     }
 }
 

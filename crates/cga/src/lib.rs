@@ -50,7 +50,7 @@ pub use cga_value::{Array, Value, ValueType};
 pub use cga_world::{decode_text, ConfinedWorld, DiskWorld, MemoryWorld, Metadata, World};
 pub use diagnostics::{Diagnostic, Location, Severity};
 pub use error::{Error, ExportError};
-pub use generate::Target;
+pub use generate::{Scene, Target};
 pub use lots::{Axes, CrsOption, GeoOrigin, InvalidPolicy, Lot, LotOptions, LotSet};
 pub use model::{
     write_plain, LeafOrigin, LotResult, Material, PlainMesh, PlainModel, Provenance, Summary,

@@ -36,6 +36,11 @@ pub struct Options {
     /// parts make the city one call would. `None`: their positions. Must
     /// have one index per lot.
     pub lot_indices: Option<std::sync::Arc<[usize]>>,
+    /// The run's scene for context queries between lots (`inter`), made by
+    /// [`Rules::scene`](crate::Rules::scene) over all its lots, for parts
+    /// given with [`Options::lot_indices`]: each part's lots then see every
+    /// lot of the run, not only the part's. `None`: the lots of the call.
+    pub scene: Option<crate::Scene>,
 }
 
 impl Options {

@@ -301,3 +301,38 @@ fn lots_in_metres_make_a_local_tileset() {
         "{b:?}"
     );
 }
+
+/// Context queries between lots see the whole city, not one tile: on 100
+/// lots (two leaf tiles at least), every part counts the 99 other lots, as
+/// in a single model.
+#[test]
+fn context_queries_see_every_tile() {
+    let dir = temp_dir("tiles-context");
+    let rules = rule_file(
+        &dir,
+        "c.cga",
+        "Lot --> label(\"lot\") print(contextCount(inter, \"lot\")) extrude(3) X.\n",
+    );
+    let generate = |out: &str| {
+        let path = dir.join(out);
+        let o = run(&[
+            "generate",
+            rules.to_str().unwrap(),
+            "--lot",
+            "grid:10x10",
+            "-o",
+            path.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        stdout(&o)
+    };
+    let tiles = generate("t/tileset.json");
+    assert_eq!(tiles, "99\n".repeat(100));
+    assert_eq!(tiles, generate("one.glb"));
+    let t: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("t/tileset.json")).unwrap())
+            .unwrap();
+    assert!(t["root"]["children"]
+        .as_array()
+        .is_some_and(|c| c.len() >= 2));
+}

@@ -329,7 +329,7 @@ impl FileIndex {
             kind,
             name,
             name_span,
-            doc: doc_comment(&self.text, span.start),
+            doc: cga::syntax::doc_comment(&self.text, span.start),
             span,
             params: params.iter().map(|p| p.name.name.clone()).collect(),
             group,
@@ -585,38 +585,6 @@ impl FileIndex {
 pub enum Hit {
     Def(usize),
     Ref(usize),
-}
-
-/// The comment lines right above the line holding `offset` (annotation
-/// lines between them and the declaration skipped), without markers: the
-/// same reading as the attributes' `doc` of the `cga` facade.
-pub fn doc_comment(text: &str, offset: usize) -> Option<String> {
-    let before = &text[..text[..offset.min(text.len())].rfind('\n').map_or(0, |i| i)];
-    let mut lines = Vec::new();
-    if offset.min(text.len()) > 0 && text[..offset.min(text.len())].contains('\n') {
-        for line in before.lines().rev() {
-            let t = line.trim();
-            if t.starts_with('@') {
-                continue;
-            }
-            let stripped = t
-                .strip_prefix("//")
-                .or_else(|| t.strip_prefix('#'))
-                .or_else(|| {
-                    let s = t.strip_prefix("/*").unwrap_or(t);
-                    let s = s.strip_suffix("*/").unwrap_or(s);
-                    (s.len() != t.len()).then_some(s)
-                })
-                .or_else(|| t.strip_prefix('*'));
-            match stripped {
-                Some(s) => lines.push(s.trim().to_string()),
-                None => break,
-            }
-        }
-    }
-    lines.reverse();
-    let doc = lines.join("\n").trim().to_string();
-    (!doc.is_empty()).then_some(doc)
 }
 
 #[cfg(test)]

@@ -58,7 +58,7 @@ pub fn scan(text: &str) -> Vec<Tok> {
                 TokKind::Comment
             }
             b'"' => {
-                i = string_end(b, i).unwrap_or_else(|end| end);
+                i = cga::syntax::string_end(b, i).unwrap_or_else(|end| end);
                 TokKind::Str
             }
             b'@' => {
@@ -96,51 +96,6 @@ pub fn scan(text: &str) -> Vec<Tok> {
         });
     }
     out
-}
-
-/// Where the string opened at `open` ends (after its closing quote), as
-/// the engine's lexer reads strings: a string may go on over a line break
-/// when it closes on a later line and what follows its closing quote can
-/// follow a string; otherwise (`Err`) it ends at its first line break.
-fn string_end(b: &[u8], open: usize) -> Result<usize, usize> {
-    let mut i = open + 1;
-    let mut line_end = None;
-    loop {
-        match b.get(i) {
-            None => return Err(line_end.unwrap_or(i)),
-            Some(b'\n') | Some(b'\r') => {
-                line_end.get_or_insert(i);
-                i += 1;
-            }
-            Some(b'"') => {
-                i += 1;
-                let Some(first_break) = line_end else {
-                    return Ok(i);
-                };
-                let mut j = i;
-                while matches!(b.get(j), Some(b' ' | b'\t')) {
-                    j += 1;
-                }
-                let follows_well = match b.get(j) {
-                    None | Some(b'\n' | b'\r') => true,
-                    Some(&c) => {
-                        !(c.is_ascii_alphanumeric()
-                            || c == b'_'
-                            || c == b'"'
-                            || c == b'.'
-                            || c >= 0x80)
-                    }
-                };
-                return if follows_well {
-                    Ok(i)
-                } else {
-                    Err(first_break)
-                };
-            }
-            Some(b'\\') if matches!(b.get(i + 1), Some(c) if *c != b'\n' && *c != b'\r') => i += 2,
-            Some(_) => i += 1,
-        }
-    }
 }
 
 fn line_end(b: &[u8], i: usize) -> usize {

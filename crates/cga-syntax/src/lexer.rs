@@ -499,7 +499,7 @@ pub(crate) fn lex(file: FileId, text: &str) -> Lexed {
 /// than by a name or another quote. An unclosed string on one line
 /// followed by more code therefore still ends at its line, with an error,
 /// instead of swallowing the code up to the next quote.
-fn string_end(bytes: &[u8], open: usize) -> Result<usize, usize> {
+pub fn string_end(bytes: &[u8], open: usize) -> Result<usize, usize> {
     let mut i = open + 1;
     let mut line_end = None;
     loop {

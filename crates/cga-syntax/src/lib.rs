@@ -40,6 +40,7 @@ pub mod source;
 pub mod span;
 
 pub use diagnostic::{Diagnostic, Severity};
+pub use lexer::string_end;
 pub use source::{SourceFile, SourceMap};
 pub use span::{FileId, Span};
 

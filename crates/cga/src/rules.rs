@@ -433,33 +433,7 @@ impl Rules {
     /// The comment lines right above the line of `span`, without markers.
     fn doc_comment(&self, span: cga_syntax::Span) -> Option<String> {
         let file = self.inner.sources.get(span.file);
-        let (line, _) = file.line_col(span.start);
-        let mut lines = Vec::new();
-        let mut n = line;
-        while n > 1 {
-            n -= 1;
-            let text = file.line_text(n).trim();
-            if text.starts_with('@') {
-                // Annotations stand between a declaration and its comment.
-                continue;
-            }
-            let stripped = text
-                .strip_prefix("//")
-                .or_else(|| text.strip_prefix('#'))
-                .or_else(|| {
-                    let t = text.strip_prefix("/*").unwrap_or(text);
-                    let t = t.strip_suffix("*/").unwrap_or(t);
-                    (t.len() != text.len()).then_some(t)
-                })
-                .or_else(|| text.strip_prefix('*'));
-            match stripped {
-                Some(s) => lines.push(s.trim().to_string()),
-                None => break,
-            }
-        }
-        lines.reverse();
-        let doc = lines.join("\n").trim().to_string();
-        (!doc.is_empty()).then_some(doc)
+        crate::syntax::doc_comment(&file.text, span.start as usize)
     }
 }
 

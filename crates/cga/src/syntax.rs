@@ -11,7 +11,7 @@
 use std::path::{Path, PathBuf};
 
 pub use cga_syntax::ast;
-pub use cga_syntax::{parse, sexpr, FileId, Span};
+pub use cga_syntax::{parse, sexpr, string_end, FileId, Span};
 
 use crate::{Workspaces, World};
 
@@ -52,4 +52,36 @@ mod tests {
         let missing = locate(&world, from, "g.cga", &Workspaces::default()).unwrap_err();
         assert_eq!(missing[0], PathBuf::from("/ws/Main/rules/g.cga"));
     }
+}
+
+/// The comment lines right above the line holding `offset` (annotation
+/// lines between them and the declaration skipped), without markers: an
+/// attribute's or rule's documentation.
+pub fn doc_comment(text: &str, offset: usize) -> Option<String> {
+    let before = &text[..text[..offset.min(text.len())].rfind('\n').map_or(0, |i| i)];
+    let mut lines = Vec::new();
+    if offset.min(text.len()) > 0 && text[..offset.min(text.len())].contains('\n') {
+        for line in before.lines().rev() {
+            let t = line.trim();
+            if t.starts_with('@') {
+                continue;
+            }
+            let stripped = t
+                .strip_prefix("//")
+                .or_else(|| t.strip_prefix('#'))
+                .or_else(|| {
+                    let s = t.strip_prefix("/*").unwrap_or(t);
+                    let s = s.strip_suffix("*/").unwrap_or(s);
+                    (s.len() != t.len()).then_some(s)
+                })
+                .or_else(|| t.strip_prefix('*'));
+            match stripped {
+                Some(s) => lines.push(s.trim().to_string()),
+                None => break,
+            }
+        }
+    }
+    lines.reverse();
+    let doc = lines.join("\n").trim().to_string();
+    (!doc.is_empty()).then_some(doc)
 }

@@ -149,16 +149,9 @@ pub fn write_tileset(
 
 /// The centre of a lot's outline in the ground plane (x, z).
 fn centre(lot: &Lot) -> [f64; 2] {
-    let p = &lot.mesh.positions;
-    if p.is_empty() {
-        return [0.0, 0.0];
-    }
-    let (mut lo, mut hi) = (p[0], p[0]);
-    for q in p {
-        lo = lo.min(*q);
-        hi = hi.max(*q);
-    }
-    [(lo.x + hi.x) / 2.0, (lo.z + hi.z) / 2.0]
+    footprint(lot).map_or([0.0, 0.0], |[lo, hi]| {
+        [(lo[0] + hi[0]) / 2.0, (lo[2] + hi[2]) / 2.0]
+    })
 }
 
 /// The box around a lot's outline (flat).

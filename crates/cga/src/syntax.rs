@@ -29,31 +29,6 @@ pub fn locate(
     cga_engine::locate::locate(world, from, target, workspaces)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::MemoryWorld;
-
-    #[test]
-    fn parses_and_locates_as_the_engine_does() {
-        let text = "import f : \"/Lib/rules/f.cga\"\nLot --> f.Facade";
-        let (module, errors) = parse(FileId(0), text);
-        assert!(errors.is_empty());
-        let ast::Item::Import(import) = &module.items[0] else {
-            panic!("an import");
-        };
-        assert_eq!(import.path, "/Lib/rules/f.cga");
-        assert_eq!(&text[import.path_span.range()], "\"/Lib/rules/f.cga\"");
-
-        let world = MemoryWorld::new().with("/ws/Lib/rules/f.cga", "Facade --> X.");
-        let from = Path::new("/ws/Main/rules/main.cga");
-        let found = locate(&world, from, &import.path, &Workspaces::default());
-        assert_eq!(found, Ok(PathBuf::from("/ws/Lib/rules/f.cga")));
-        let missing = locate(&world, from, "g.cga", &Workspaces::default()).unwrap_err();
-        assert_eq!(missing[0], PathBuf::from("/ws/Main/rules/g.cga"));
-    }
-}
-
 /// The comment lines right above the line holding `offset` (annotation
 /// lines between them and the declaration skipped), without markers: an
 /// attribute's or rule's documentation.
@@ -84,4 +59,29 @@ pub fn doc_comment(text: &str, offset: usize) -> Option<String> {
     lines.reverse();
     let doc = lines.join("\n").trim().to_string();
     (!doc.is_empty()).then_some(doc)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::MemoryWorld;
+
+    #[test]
+    fn parses_and_locates_as_the_engine_does() {
+        let text = "import f : \"/Lib/rules/f.cga\"\nLot --> f.Facade";
+        let (module, errors) = parse(FileId(0), text);
+        assert!(errors.is_empty());
+        let ast::Item::Import(import) = &module.items[0] else {
+            panic!("an import");
+        };
+        assert_eq!(import.path, "/Lib/rules/f.cga");
+        assert_eq!(&text[import.path_span.range()], "\"/Lib/rules/f.cga\"");
+
+        let world = MemoryWorld::new().with("/ws/Lib/rules/f.cga", "Facade --> X.");
+        let from = Path::new("/ws/Main/rules/main.cga");
+        let found = locate(&world, from, &import.path, &Workspaces::default());
+        assert_eq!(found, Ok(PathBuf::from("/ws/Lib/rules/f.cga")));
+        let missing = locate(&world, from, "g.cga", &Workspaces::default()).unwrap_err();
+        assert_eq!(missing[0], PathBuf::from("/ws/Main/rules/g.cga"));
+    }
 }

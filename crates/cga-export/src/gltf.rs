@@ -551,6 +551,8 @@ pub(crate) struct GltfWriter {
     tail: Vec<u8>,
     /// With features: the box of each lot's vertices so far.
     feature_bounds: Vec<Option<[[f64; 3]; 2]>>,
+    /// The point positions are relative to: every node's translation.
+    origin: Option<DVec3>,
 }
 
 /// A lot's node: its name and `extras`, and the first of its primitives in
@@ -628,7 +630,15 @@ impl GltfWriter {
             features: false,
             tail: Vec::new(),
             feature_bounds: Vec::new(),
+            origin: None,
         }
+    }
+
+    /// Positions come relative to `origin` (see
+    /// [`ExportOptions::origin`](crate::ExportOptions::origin)): nodes are
+    /// translated by it, and the bounds in the stats are moved back by it.
+    pub(crate) fn set_origin(&mut self, origin: Option<DVec3>) {
+        self.origin = origin;
     }
 
     /// Gives each lot's vertices its feature id and writes a property
@@ -896,6 +906,19 @@ impl GltfWriter {
                 stats.lot_bounds.push(bounds_of(&layouts[start..end]));
             }
         }
+        // The stats' boxes are in the model's frame.
+        if let Some(o) = self.origin {
+            let o = o.to_array();
+            let moved = |b: &mut [[f64; 3]; 2]| {
+                for corner in b.iter_mut() {
+                    for (c, o) in corner.iter_mut().zip(o) {
+                        *c += o;
+                    }
+                }
+            };
+            stats.bounds.iter_mut().for_each(moved);
+            stats.lot_bounds.iter_mut().flatten().for_each(moved);
+        }
         // The glTF material of each material id that has primitives.
         let mut gltf_materials: Vec<Option<json::Index<json::Material>>> =
             vec![None; self.buckets.len()];
@@ -973,6 +996,10 @@ impl GltfWriter {
                 mesh: Some(mesh),
                 name: Some(name),
                 extras: extras.and_then(|v| serde_json::value::to_raw_value(&v).ok()),
+                // glTF's JSON holds the translation as f32; numbers in
+                // JSON text are doubles, and readers that keep them so
+                // (CesiumJS, three.js) place the model to the millimetre.
+                translation: self.origin.map(|o| o.as_vec3().to_array()),
                 ..Default::default()
             }));
         }

@@ -551,6 +551,16 @@ impl ModelWriter {
         }
     }
 
+    /// Sets `key` of the `extras` of the lot begun last (glTF and GLB: its
+    /// node's `extras` with [`Granularity::Lot`], its row of the property
+    /// table with features; `"reports"` there, an object of numbers or
+    /// strings, becomes a property per key). OBJ ignores it.
+    pub fn annotate_lot(&mut self, key: &str, value: serde_json::Value) {
+        if let Sink::Gltf(w, _) = &mut self.sink {
+            w.annotate_lot(key, value);
+        }
+    }
+
     /// An encoder for this writer's format, for another thread: it does the
     /// work of [`add_placed`](ModelWriter::add_placed) there, and
     /// [`append`](ModelWriter::append) adds its batches. `None` for OBJ,

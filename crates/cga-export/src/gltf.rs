@@ -920,8 +920,16 @@ impl GltfWriter {
             true => (PER_PRIMITIVE + 250, PER_LOT + 64),
             false => (PER_PRIMITIVE, PER_LOT),
         };
-        let per_lot = primitives * per_primitive + per_lot + extras;
-        let room = (lots as u64).saturating_mul(per_lot) / 4 * 5;
+        // Instances: per lot a node per asset seen so far, with its
+        // placements' accessors and views, and each asset's mesh once.
+        const PER_INSTANCE_NODE: u64 = 1000;
+        let groups = self.instances.groups.len() as u64;
+        let per_lot = primitives * per_primitive + per_lot + extras + groups * PER_INSTANCE_NODE;
+        let room = (lots as u64)
+            .saturating_mul(per_lot)
+            .saturating_add(groups * 2 * PER_PRIMITIVE)
+            / 4
+            * 5;
         // Small models (3D Tiles' tiles) get small room: should the JSON
         // not fit, moving a small file's data up costs little.
         room.clamp(MIN_ESTIMATED_ROOM, 256 << 20) / 4 * 4

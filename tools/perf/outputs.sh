@@ -8,7 +8,9 @@
 #
 # Candler (rect:20,30, its footprint, its footprint with Mode=3DPrint), the
 # other oracle rule packages and the example city, as OBJ, GLB and glTF, with
-# one and two workers; prints and reports are kept too.
+# one and two workers; prints and reports are kept too. The speed
+# benchmarks (20 Candler buildings, envelope2002 on 20 lots) as GLB with and
+# without instances.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 cga=$(realpath "$1")
@@ -29,6 +31,14 @@ run() { # name dir args...
     sed -i "s|$out|OUT|g" "$out/$name".*.stderr
 }
 
+# GLB only, with instances (the default) and without, two workers.
+glb() { # name dir args...
+    local name=$1 dir=$2
+    shift 2
+    (cd "$dir" && "$cga" generate "$@" --jobs 2 -o "$out/$name.glb" >"$out/$name.glb.stdout" 2>/dev/null) || echo "$name.glb failed" >&2
+    (cd "$dir" && "$cga" generate "$@" --jobs 2 --no-instances -o "$out/$name.plain.glb" >/dev/null 2>&1) || echo "$name.plain failed" >&2
+}
+
 run candler.rect "$oracle" rules/candler/rules/candler.cga --lot rect:20,30
 run candler.footprint "$oracle" rules/candler/rules/candler.cga --lot lots/candler_footprint.obj
 run candler.3dprint "$oracle" rules/candler/rules/candler.cga --lot lots/candler_footprint.obj --attr Mode=3DPrint
@@ -42,3 +52,7 @@ run extrusion "$oracle/rules/extrusion_rule" rules/extrusion_rule.cga --attr min
 run extrusion.seed "$oracle/rules/extrusion_rule" rules/extrusion_rule.cga --seed 7
 run envelope "$oracle/rules/envelope2002" rules/typology/envelope2002.cga --lot "$oracle/lots/building_parcel.obj" --seed 666
 run city "$root" examples/building.cga --lot grid:6x6
+# The speed benchmarks: 20 Candler buildings, envelope2002 on 20 lots.
+glb candler.grid20 "$oracle" rules/candler/rules/candler.cga --lot grid:5x4:lots/candler_footprint.obj
+glb envelope.grid20 "$oracle/rules/envelope2002" rules/typology/envelope2002.cga --lot "grid:5x4:$oracle/lots/building_parcel.obj" --seed 666
+glb city.grid "$root" examples/building.cga --lot grid:6x6

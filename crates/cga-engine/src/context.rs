@@ -96,29 +96,16 @@ impl ContextUse {
     /// possibility.
     pub fn of(program: &Program) -> ContextUse {
         let mut u = ContextUse::default();
-        for r in &program.rules {
-            for l in &r.locals {
-                u.expr(l);
-            }
-            u.body(&r.body);
+        Walker {
+            query: &mut |f, args| u.query(f, args),
+            op: &mut |_| {},
+            rule: &mut |_| {},
         }
-        for f in &program.functions {
-            for l in &f.locals {
-                u.expr(l);
-            }
-            u.expr(&f.body);
-        }
-        for a in &program.attrs {
-            u.expr(&a.default);
-        }
+        .program(program);
         u
     }
 
     fn query(&mut self, f: ContextFn, args: &[RExpr]) {
-        let constant = |e: Option<&RExpr>| match e.map(|e| &e.kind) {
-            Some(RExprKind::Const(Value::Str(s))) => Some(s.clone()),
-            _ => None,
-        };
         let occlusion = matches!(
             f,
             ContextFn::Inside | ContextFn::Overlaps | ContextFn::Touches
@@ -138,13 +125,49 @@ impl ContextUse {
             self.unlabeled |= !labeled;
         }
     }
+}
+
+/// The text of a constant string argument.
+fn constant(e: Option<&RExpr>) -> Option<Arc<str>> {
+    match e.map(|e| &e.kind) {
+        Some(RExprKind::Const(Value::Str(s))) => Some(s.clone()),
+        _ => None,
+    }
+}
+
+/// Visits every context query, operation and rule call of a program's
+/// rules, functions and attributes.
+struct Walker<'f> {
+    query: &'f mut dyn FnMut(ContextFn, &[RExpr]),
+    op: &'f mut dyn FnMut(&crate::expr::OpCall),
+    rule: &'f mut dyn FnMut(crate::program::RuleId),
+}
+
+impl Walker<'_> {
+    fn program(&mut self, program: &Program) {
+        for r in &program.rules {
+            for l in &r.locals {
+                self.expr(l);
+            }
+            self.body(&r.body);
+        }
+        for f in &program.functions {
+            for l in &f.locals {
+                self.expr(l);
+            }
+            self.expr(&f.body);
+        }
+        for a in &program.attrs {
+            self.expr(&a.default);
+        }
+    }
 
     fn expr(&mut self, e: &RExpr) {
         match &e.kind {
             RExprKind::Const(_) | RExprKind::Local(_) | RExprKind::Attr(_) => {}
             RExprKind::Shape(f, args) => {
                 if let ShapeFn::Context(c) = f {
-                    self.query(*c, args);
+                    (self.query)(*c, args);
                 }
                 args.iter().for_each(|a| self.expr(a));
             }
@@ -191,13 +214,13 @@ impl ContextUse {
             }
             RExprKind::CompFn { args, block } => {
                 args.iter().for_each(|a| self.expr(a));
-                self.block(block, &mut |u, e| u.expr(e));
+                self.block(block, &mut |w, e| w.expr(e));
             }
             RExprKind::CompHead { expr, .. } => self.expr(expr),
         }
     }
 
-    fn block<T>(&mut self, b: &RBlock<T>, f: &mut dyn FnMut(&mut ContextUse, &T)) {
+    fn block<T>(&mut self, b: &RBlock<T>, f: &mut dyn FnMut(&mut Self, &T)) {
         for p in &b.parts {
             match p {
                 RPart::Entry {
@@ -221,13 +244,15 @@ impl ContextUse {
                 for s in stmts {
                     match s {
                         RStmt::Op(call) => {
+                            (self.op)(call);
                             call.args.iter().for_each(|a| self.expr(a));
                             for block in [&call.block, &call.remainder_block].into_iter().flatten()
                             {
-                                self.block(block, &mut |u, b| u.body(b));
+                                self.block(block, &mut |w, b| w.body(b));
                             }
                         }
                         RStmt::Rule(rc) => {
+                            (self.rule)(rc.rule);
                             rc.args.iter().for_each(|a| self.expr(a));
                             rc.attr_overrides.iter().for_each(|(_, e)| self.expr(e));
                         }
@@ -253,6 +278,113 @@ impl ContextUse {
                 }
             }
         }
+    }
+}
+
+/// The rules the first, collecting pass has to apply.
+///
+/// When every occlusion query names a label (so there are no automatic
+/// occluders), the first pass records nothing but shapes given a label
+/// that some query asks about. A rule from which no such `label` can be
+/// reached (through the rules it calls, at any depth) records nothing, nor
+/// do the shapes it creates, so the first pass skips it: a building's
+/// facade details are not derived just to be thrown away. The records stay
+/// exactly the same: a shape's random stream and its address depend only on
+/// its ancestors, and the rules that are applied keep their order.
+///
+/// Rules applied inside `inline` or `modify` are never skipped (their
+/// leaves become the geometry of the shape that runs the operation).
+#[derive(Debug, Default)]
+pub struct FirstPass {
+    /// Per rule, whether the first pass applies it; empty: every rule.
+    applies: Vec<bool>,
+}
+
+impl FirstPass {
+    /// The rules of `program` that can reach a `label` some query asks
+    /// about (every rule when a query's label is not a constant, when some
+    /// occlusion query has no label, or when the program has no queries).
+    pub fn of(program: &Program) -> FirstPass {
+        let usage = ContextUse::of(program);
+        if !usage.any() || usage.unlabeled {
+            return FirstPass::default();
+        }
+        // The labels the queries ask about (`None`: not known).
+        let mut asked: Option<Vec<Arc<str>>> = Some(Vec::new());
+        Walker {
+            query: &mut |_, args| {
+                // An explicit target comes first (as `Interp::context_query`
+                // reads the arguments); `contextCount("x")` has none.
+                let first = args.first().map(|e| &e.kind);
+                let label = match first {
+                    Some(RExprKind::Const(Value::Str(s))) if Target::parse(s).is_some() => {
+                        args.get(1)
+                    }
+                    Some(RExprKind::Const(Value::Str(_))) => args.first(),
+                    _ => None,
+                };
+                match (label.is_some(), constant(label), &mut asked) {
+                    (true, Some(l), Some(list)) => list.push(l),
+                    // No label argument: such a query finds nothing.
+                    (false, _, _) if matches!(first, Some(RExprKind::Const(_))) => {}
+                    _ => asked = None,
+                }
+            },
+            op: &mut |_| {},
+            rule: &mut |_| {},
+        }
+        .program(program);
+        let Some(asked) = asked else {
+            return FirstPass::default();
+        };
+        let n = program.rules.len();
+        // Which rules label directly, and who calls whom.
+        let mut applies = vec![false; n];
+        let mut callers: Vec<Vec<u32>> = vec![Vec::new(); n];
+        for (r, def) in program.rules.iter().enumerate() {
+            let mut labels = false;
+            let mut calls = Vec::new();
+            Walker {
+                query: &mut |_, _| {},
+                op: &mut |call| {
+                    if call.op == crate::ops::Op::Label {
+                        labels |= match constant(call.args.first()) {
+                            Some(l) => asked.contains(&l),
+                            None => true,
+                        };
+                    }
+                },
+                rule: &mut |callee| calls.push(callee),
+            }
+            .body(&def.body);
+            applies[r] = labels;
+            for c in calls {
+                if let Some(list) = callers.get_mut(c as usize) {
+                    list.push(r as u32);
+                }
+            }
+        }
+        // Every caller of a rule that applies applies too.
+        let mut todo: Vec<u32> = (0..n as u32).filter(|&r| applies[r as usize]).collect();
+        while let Some(r) = todo.pop() {
+            for &c in &callers[r as usize] {
+                if !applies[c as usize] {
+                    applies[c as usize] = true;
+                    todo.push(c);
+                }
+            }
+        }
+        FirstPass { applies }
+    }
+
+    /// Whether the first pass applies `rule`.
+    pub fn applies(&self, rule: crate::program::RuleId) -> bool {
+        self.applies.get(rule as usize).copied().unwrap_or(true)
+    }
+
+    /// The first pass of `program` (worked out once per program).
+    pub(crate) fn cached(program: &Program) -> &FirstPass {
+        program.first_pass.get_or_init(|| FirstPass::of(program))
     }
 }
 
@@ -1007,6 +1139,13 @@ impl Interp<'_> {
             Some(c) => c.child_node(parent),
             None => 0,
         }
+    }
+
+    /// Whether the first pass of context queries skips `rule` ([`FirstPass`]).
+    pub(crate) fn context_skips(&self, rule: crate::program::RuleId) -> bool {
+        self.collected.is_none()
+            && self.context_collecting()
+            && !FirstPass::cached(self.program).applies(rule)
     }
 
     /// Whether this is a first, collecting pass (nothing is emitted).

@@ -719,6 +719,11 @@ impl<'a> Interp<'a> {
             generation,
             key,
         } = p;
+        if self.context.is_some() && self.context_skips(rule) {
+            frame.clear();
+            self.frame_pool.push(frame);
+            return Ok(());
+        }
         let program = self.program;
         let def = &program.rules[rule as usize];
         if generation > self.limits.max_depth {

@@ -102,6 +102,9 @@ pub struct Program {
     pub uses_tree_key: bool,
     /// The styles of the main rule file, `Default` first, in file order.
     pub styles: Vec<String>,
+    /// Which rules the first pass of context queries applies (see
+    /// `crate::context::FirstPass`), worked out on first use.
+    pub(crate) first_pass: std::sync::OnceLock<crate::context::FirstPass>,
 }
 
 impl Program {

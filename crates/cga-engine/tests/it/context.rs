@@ -622,3 +622,91 @@ fn addresses_survive_a_diverging_branch() {
         .sum();
     assert!((red_area - 2.0 * 10.0).abs() < 1e-9, "{red_area}");
 }
+
+/// The first pass of `src` on a 10 x 10 lot (start rule `Lot`).
+fn first_pass(src: &str) -> (cga_engine::Program, cga_engine::context::LotContext) {
+    let mut sources = SourceMap::new();
+    let loaded = cga_engine::load_text(
+        &cga_world::DiskWorld,
+        std::path::Path::new("context.cga"),
+        src.to_string(),
+        &mut sources,
+    );
+    assert!(!loaded.has_errors());
+    let program = loaded.program;
+    let rule = program.start_rule(Some("Lot")).unwrap();
+    let assets = Assets::on_disk(&sources);
+    let lot = lot::rect(10.0, 10.0);
+    let records = cga_engine::generate::collect_lot(
+        &program,
+        &assets,
+        rule,
+        &lot,
+        0,
+        &GenerateOptions::default(),
+    );
+    (program, records)
+}
+
+fn rule_id(program: &cga_engine::Program, name: &str) -> u32 {
+    program
+        .main_rules
+        .iter()
+        .find(|(n, _)| n == name)
+        .map(|&(_, id)| id)
+        .unwrap()
+}
+
+/// The first pass skips rules from which no label a query asks about can
+/// be reached: `Detail` (which only labels "other") records nothing, while
+/// `Wall`, two rules away from its label, is applied. The second pass
+/// still derives everything, with the same answers.
+#[test]
+fn first_pass_skips_rules_without_asked_labels() {
+    let src = "Lot --> split(x) { 5 : Left | 5 : Right }\n\
+               Left --> Mid\n\
+               Mid --> extrude(4) Wall\n\
+               Wall --> label(\"wall\") X.\n\
+               Right --> extrude(2) split(y) { 0.5 : Detail }*\n\
+               Detail --> label(\"other\") Tile\n\
+               Tile --> case contextCount(intra, \"wall\") == 1 : color(1, 0, 0) X.\n     \
+               else : color(0, 1, 0) X.\n";
+    let (program, records) = first_pass(src);
+    let pass = cga_engine::context::FirstPass::of(&program);
+    for (name, applies) in [
+        ("Lot", true),
+        ("Left", true),
+        ("Mid", true),
+        ("Wall", true),
+        ("Right", false),
+        ("Detail", false),
+        ("Tile", false),
+    ] {
+        assert_eq!(pass.applies(rule_id(&program, name)), applies, "{name}");
+    }
+    assert_eq!(records.label_count("wall"), 1);
+    assert_eq!(records.label_count("other"), 0);
+    let outs = run(src, &[lot::rect(10.0, 10.0)]);
+    assert_eq!(count(&outs[0], RED), 4);
+    assert_eq!(count(&outs[0], GREEN), 0);
+}
+
+/// A query whose label is not a constant may ask about any label, and an
+/// occlusion query without a label makes every leaf an occluder: then the
+/// first pass applies every rule.
+#[test]
+fn first_pass_applies_every_rule_for_unknown_labels() {
+    let dynamic = "attr which = \"wall\"\n\
+                   Lot --> split(x) { 5 : Left | 5 : Right }\n\
+                   Left --> label(\"wall\") X.\n\
+                   Right --> label(\"other\") print(contextCount(intra, which))\n";
+    let (program, records) = first_pass(dynamic);
+    assert!(cga_engine::context::FirstPass::of(&program).applies(rule_id(&program, "Right")));
+    assert_eq!(records.label_count("other"), 1);
+    let unlabeled = "Lot --> split(x) { 5 : Left | 5 : Right }\n\
+                     Left --> label(\"wall\") X.\n\
+                     Right --> extrude(1) Box\n\
+                     Box --> print(inside(intra)) X.\n";
+    let (program, _) = first_pass(unlabeled);
+    assert!(cga_engine::context::FirstPass::of(&program).applies(rule_id(&program, "Box")));
+}

@@ -135,12 +135,51 @@ fn constant(e: Option<&RExpr>) -> Option<Arc<str>> {
     }
 }
 
+/// Per rule of `program`, whether an operation for which `direct` holds
+/// can be reached from it: in its own body, or in the body of a rule it
+/// calls, at any depth.
+pub(crate) fn rules_reaching(
+    program: &Program,
+    direct: &mut dyn FnMut(&crate::expr::OpCall) -> bool,
+) -> Vec<bool> {
+    let n = program.rules.len();
+    let mut reaches = vec![false; n];
+    let mut callers: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for (r, def) in program.rules.iter().enumerate() {
+        let mut found = false;
+        let mut calls = Vec::new();
+        Walker {
+            query: &mut |_, _| {},
+            op: &mut |call| found |= direct(call),
+            rule: &mut |callee| calls.push(callee),
+        }
+        .body(&def.body);
+        reaches[r] = found;
+        for c in calls {
+            if let Some(list) = callers.get_mut(c as usize) {
+                list.push(r as u32);
+            }
+        }
+    }
+    // Every caller of a rule that reaches one reaches it too.
+    let mut todo: Vec<u32> = (0..n as u32).filter(|&r| reaches[r as usize]).collect();
+    while let Some(r) = todo.pop() {
+        for &c in &callers[r as usize] {
+            if !reaches[c as usize] {
+                reaches[c as usize] = true;
+                todo.push(c);
+            }
+        }
+    }
+    reaches
+}
+
 /// Visits every context query, operation and rule call of a program's
 /// rules, functions and attributes.
-struct Walker<'f> {
-    query: &'f mut dyn FnMut(ContextFn, &[RExpr]),
-    op: &'f mut dyn FnMut(&crate::expr::OpCall),
-    rule: &'f mut dyn FnMut(crate::program::RuleId),
+pub(crate) struct Walker<'f> {
+    pub query: &'f mut dyn FnMut(ContextFn, &[RExpr]),
+    pub op: &'f mut dyn FnMut(&crate::expr::OpCall),
+    pub rule: &'f mut dyn FnMut(crate::program::RuleId),
 }
 
 impl Walker<'_> {
@@ -238,7 +277,7 @@ impl Walker<'_> {
         }
     }
 
-    fn body(&mut self, b: &RBody) {
+    pub fn body(&mut self, b: &RBody) {
         match b {
             RBody::Ops(stmts) => {
                 for s in stmts {
@@ -293,11 +332,26 @@ impl Walker<'_> {
 /// its ancestors, and the rules that are applied keep their order.
 ///
 /// Rules applied inside `inline` or `modify` are never skipped (their
-/// leaves become the geometry of the shape that runs the operation).
+/// leaves become the geometry of the shape that runs the operation). The
+/// entries of a component split that the first pass skips still create
+/// their shapes (which draws from the parent's random stream and numbers
+/// the shape's address) but do not fill them with geometry.
 #[derive(Debug, Default)]
 pub struct FirstPass {
     /// Per rule, whether the first pass applies it; empty: every rule.
     applies: Vec<bool>,
+    /// The labels queries ask about.
+    asked: Vec<Arc<str>>,
+}
+
+/// Whether `call` is a `label` with a label in `asked` (or one not known
+/// before the derivation).
+fn labels_asked(call: &crate::expr::OpCall, asked: &[Arc<str>]) -> bool {
+    call.op == crate::ops::Op::Label
+        && match constant(call.args.first()) {
+            Some(l) => asked.contains(&l),
+            None => true,
+        }
 }
 
 impl FirstPass {
@@ -337,44 +391,25 @@ impl FirstPass {
         let Some(asked) = asked else {
             return FirstPass::default();
         };
-        let n = program.rules.len();
-        // Which rules label directly, and who calls whom.
-        let mut applies = vec![false; n];
-        let mut callers: Vec<Vec<u32>> = vec![Vec::new(); n];
-        for (r, def) in program.rules.iter().enumerate() {
-            let mut labels = false;
-            let mut calls = Vec::new();
-            Walker {
-                query: &mut |_, _| {},
-                op: &mut |call| {
-                    if call.op == crate::ops::Op::Label {
-                        labels |= match constant(call.args.first()) {
-                            Some(l) => asked.contains(&l),
-                            None => true,
-                        };
-                    }
-                },
-                rule: &mut |callee| calls.push(callee),
-            }
-            .body(&def.body);
-            applies[r] = labels;
-            for c in calls {
-                if let Some(list) = callers.get_mut(c as usize) {
-                    list.push(r as u32);
-                }
-            }
+        let applies = rules_reaching(program, &mut |call| labels_asked(call, &asked));
+        FirstPass { applies, asked }
+    }
+
+    /// Whether the first pass has to run `body` (the operations of a
+    /// component split's entry): whether a label some query asks about can
+    /// be reached from it.
+    pub(crate) fn body_applies(&self, body: &RBody) -> bool {
+        if self.applies.is_empty() {
+            return true;
         }
-        // Every caller of a rule that applies applies too.
-        let mut todo: Vec<u32> = (0..n as u32).filter(|&r| applies[r as usize]).collect();
-        while let Some(r) = todo.pop() {
-            for &c in &callers[r as usize] {
-                if !applies[c as usize] {
-                    applies[c as usize] = true;
-                    todo.push(c);
-                }
-            }
+        let (mut labels, mut calls) = (false, false);
+        Walker {
+            query: &mut |_, _| {},
+            op: &mut |call| labels |= labels_asked(call, &self.asked),
+            rule: &mut |r| calls |= self.applies(r),
         }
-        FirstPass { applies }
+        .body(body);
+        labels || calls
     }
 
     /// Whether the first pass applies `rule`.

@@ -105,6 +105,9 @@ pub struct Program {
     /// Which rules the first pass of context queries applies (see
     /// `crate::context::FirstPass`), worked out on first use.
     pub(crate) first_pass: std::sync::OnceLock<crate::context::FirstPass>,
+    /// Per rule, whether it can reach an operation that uses trim planes
+    /// (see `ops::comp::uses_trim_planes`), worked out on first use.
+    pub(crate) trim_rules: std::sync::OnceLock<Vec<bool>>,
 }
 
 impl Program {

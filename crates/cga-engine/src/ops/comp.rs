@@ -1302,6 +1302,34 @@ fn group(comps: &mut Components, op: BlockOp, selected: Vec<u32>) -> Vec<Vec<u32
 
 // ----- the operation -----
 
+/// Whether an operation that uses trim planes (`i()`, the primitives,
+/// `trim()`) can be reached from `body`: in it, or in the rules it calls
+/// at any depth. Only then do face components split with `:` get their
+/// trim planes; finding them needs the mesh's topology, which was most of
+/// the cost of a component split of a building's volumes, and planes no
+/// operation reads change nothing.
+fn uses_trim_planes(program: &crate::program::Program, body: &crate::expr::RBody) -> bool {
+    fn direct(call: &OpCall) -> bool {
+        use super::{CreateOp, Op};
+        matches!(
+            call.op,
+            Op::Trim | Op::Create(CreateOp::Insert) | Op::Create(CreateOp::Primitive(_))
+        )
+    }
+    let rules = program
+        .trim_rules
+        .get_or_init(|| crate::context::rules_reaching(program, &mut direct));
+    let mut op_found = false;
+    let mut rule_found = false;
+    crate::context::Walker {
+        query: &mut |_, _| {},
+        op: &mut |call| op_found |= direct(call),
+        rule: &mut |r| rule_found |= rules.get(r as usize).copied().unwrap_or(true),
+    }
+    .body(body);
+    op_found || rule_found
+}
+
 pub fn exec(
     cx: &mut Interp,
     st: &mut ShapeState,
@@ -1342,11 +1370,21 @@ pub(crate) fn run(
             continue;
         }
         let upward = names_upward_roof_edge(expr);
-        let trim = entry.op == BlockOp::Colon && kind == Kind::Faces;
+        let trim = entry.op == BlockOp::Colon
+            && kind == Kind::Faces
+            && uses_trim_planes(cx.program, entry.body);
         let sets = group(&mut comps, entry.op, selected);
         let total = sets.len() as f64;
+        // The first pass of context queries needs only the shapes on the
+        // way to a label a query asks about.
+        let skip = cx.collected.is_none()
+            && cx.context_collecting()
+            && !crate::context::FirstPass::cached(cx.program).body_applies(entry.body);
         for (i, set) in sets.iter().enumerate() {
             let mut child = cx.child(&st.shape, entry.head.span)?;
+            if skip {
+                continue;
+            }
             comps.fill_shape(&mut child, set, align, trim, upward);
             child.comp = Some(Arc::new(CompInfo {
                 sel: text.clone(),

@@ -158,3 +158,22 @@ fn trim_attributes_read_back() {
     let r = run("trim_attrs", text).ok();
     assert_eq!(r.prints, vec!["true false", "false true"]);
 }
+
+/// Trim planes are only made for components whose operations can reach
+/// `i`, a primitive or `trim()` (finding them needs the mesh's topology);
+/// reached through rule calls and nested blocks, they still cut: the beam
+/// of `beam_on_a_cube_face` placed two rules and a split away from the
+/// component split has the same area, and a sibling component that only
+/// colours itself does not disturb it.
+#[test]
+fn trim_planes_reach_through_rule_calls() {
+    let text = "Start --> s(10,10,10) primitiveCube() comp(f) { 5 : A | 4 : color(1,0,0) Y. }\n\
+                A --> split(y) { '1 : B }\n\
+                B --> Beam\n\
+                Beam --> s(15,'1, 2) center(xyz) primitiveCube()\n";
+    let r = run_on("beam_through_rules", text, &rect(20.0, 30.0), "Start").ok();
+    assert_eq!(r.meshes.len(), 2);
+    // Front 12 x 10, back 8 x 10, top and bottom trapezoids of 20 (as in
+    // `beam_on_a_cube_face`), plus the 10 x 10 face 4.
+    assert!((r.area() - 340.0).abs() < 1e-9, "{}", r.area());
+}

@@ -710,3 +710,22 @@ fn first_pass_applies_every_rule_for_unknown_labels() {
     let (program, _) = first_pass(unlabeled);
     assert!(cga_engine::context::FirstPass::of(&program).applies(rule_id(&program, "Box")));
 }
+
+/// A component split's entries that lead to no asked label are not filled
+/// in the first pass; the entries after them still are, with the same
+/// random streams: the roof is labeled where a random split put it, and
+/// every facade tile of the second pass sees it.
+#[test]
+fn first_pass_skips_component_entries_without_asked_labels() {
+    let src = "Lot --> extrude(10) comp(f) { side : Facade | top : Roof }\n\
+               Facade --> split(x) { 2 : Tile }*\n\
+               Tile --> case contextCount(intra, \"roof\") == 1 : color(1, 0, 0) X.\n     \
+               else : color(0, 1, 0) X.\n\
+               Roof --> split(x) { rand(2, 8) : label(\"roof\") R. | ~1 : X. }\n";
+    let (_, records) = first_pass(src);
+    assert_eq!(records.label_count("roof"), 1);
+    assert_eq!(records.len(), 1);
+    let outs = run(src, &[lot::rect(10.0, 10.0)]);
+    assert_eq!(count(&outs[0], RED), 20);
+    assert_eq!(count(&outs[0], GREEN), 0);
+}

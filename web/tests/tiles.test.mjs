@@ -1,0 +1,340 @@
+// A tileset in a real browser: `cga generate examples/building.cga --lot
+// city.geojson -o out/tileset.json` over a small city made here (150 lots
+// in longitude/latitude, and the same city in local metres), served by a
+// static server of our own, loaded by the viewer page (web/src/tiles.js:
+// 3d-tiles-renderer and three.js) in Debian's Chromium driven by
+// Playwright. Every tile must load without an error, the city must be
+// drawn, and clicking a building must give its lot's index and attributes
+// from the tile's feature ids and property table.
+//
+// SCREENSHOTS: a folder to save screenshots into (docs/images/tileset.png
+// comes from `SCREENSHOTS=../docs/images npm test`).
+
+import { test, before, after, describe } from 'node:test';
+import assert from 'node:assert/strict';
+import { spawnSync } from 'node:child_process';
+import { createServer } from 'node:http';
+import { mkdtempSync, readFileSync, writeFileSync, rmSync, mkdirSync, statSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join, normalize, extname } from 'node:path';
+import { repo, cgaBinary, launchBrowser } from './harness.mjs';
+
+// ------------------------------------------------------------------ city
+
+// 15 x 10 lots of 20 m x 24 m, 10 m apart, around a point of Zurich; the
+// floors vary (2 to 8), one tower has 18, and each lot has an owner (a
+// property that is no rule attribute) and a wall colour (one that is).
+const COLS = 15;
+const ROWS = 10;
+const LOT = [20, 24];
+const PITCH = [30, 34];
+const TOWER = 77;
+const ORIGIN = { lon: 8.5417, lat: 47.3769 };
+const LOCAL_ORIGIN = [1000, 2000]; // metres, for the local city
+const COLOURS = ['#d8cfc4', '#c9b8a6', '#e6dfd2', '#b7a99a', '#d3c2b0'];
+
+const floorsOf = (i) => (i === TOWER ? 18 : 2 + ((i * 5) % 7));
+// examples/building.cga: a 4.5 m ground floor and floors of 3.2 m.
+const heightOf = (i) => 4.5 + floorsOf(i) * 3.2;
+
+// Degrees per metre near the origin (the test only needs them to lay the
+// lots out; expectations use the lots' own coordinates).
+const DEG_LAT = 1 / 111132;
+const DEG_LON = 1 / (111320 * Math.cos((ORIGIN.lat * Math.PI) / 180));
+
+/// The lots as [x0, y0, x1, y1] in metres east and north of the city's corner.
+function lotBoxes() {
+  const boxes = [];
+  for (let i = 0; i < COLS * ROWS; i++) {
+    const c = i % COLS;
+    const r = Math.floor(i / COLS);
+    const x0 = c * PITCH[0] - (COLS * PITCH[0]) / 2;
+    const y0 = r * PITCH[1] - (ROWS * PITCH[1]) / 2;
+    boxes.push([x0, y0, x0 + LOT[0], y0 + LOT[1]]);
+  }
+  return boxes;
+}
+
+/// A GeoJSON FeatureCollection of the lots, `place` turning metres east
+/// and north into the file's coordinates.
+function cityGeojson(place) {
+  return {
+    type: 'FeatureCollection',
+    features: lotBoxes().map(([x0, y0, x1, y1], i) => ({
+      type: 'Feature',
+      id: `B${String(i).padStart(3, '0')}`,
+      properties: { floors: floorsOf(i), wallColor: COLOURS[i % COLOURS.length], owner: `owner ${i}` },
+      geometry: {
+        type: 'Polygon',
+        // Counter-clockwise, as RFC 7946 has exterior rings.
+        coordinates: [[[x0, y0], [x1, y0], [x1, y1], [x0, y1], [x0, y0]].map(([x, y]) => place(x, y))],
+      },
+    })),
+  };
+}
+const geographic = (x, y) => [ORIGIN.lon + x * DEG_LON, ORIGIN.lat + y * DEG_LAT];
+const local = (x, y) => [LOCAL_ORIGIN[0] + x, LOCAL_ORIGIN[1] + y];
+
+/// ECEF (WGS84) of a longitude, latitude (degrees) and height (metres).
+function ecef(lon, lat, h) {
+  const a = 6378137;
+  const f = 1 / 298.257223563;
+  const e2 = f * (2 - f);
+  const [l, p] = [(lon * Math.PI) / 180, (lat * Math.PI) / 180];
+  const n = a / Math.sqrt(1 - e2 * Math.sin(p) ** 2);
+  return [(n + h) * Math.cos(p) * Math.cos(l), (n + h) * Math.cos(p) * Math.sin(l), (n * (1 - e2) + h) * Math.sin(p)];
+}
+
+/// The centre of lot `i`'s outline in the file's coordinates.
+function lotCentre(geojson, i) {
+  const ring = geojson.features[i].geometry.coordinates[0].slice(0, 4);
+  return [0, 1].map((k) => ring.reduce((s, p) => s + p[k], 0) / 4);
+}
+
+// ------------------------------------------------------------------ tileset
+
+/// Tile contents in a tileset.json (URIs relative to it).
+function contents(tile, out = []) {
+  if (tile.content?.uri) out.push(tile.content.uri);
+  (tile.children || []).forEach((c) => contents(c, out));
+  return out;
+}
+
+/// Triangles in a GLB (indexed triangle lists, as the engine writes).
+function glbTriangles(path) {
+  const bytes = readFileSync(path);
+  const len = bytes.readUInt32LE(12);
+  const json = JSON.parse(bytes.subarray(20, 20 + len).toString('utf8'));
+  let triangles = 0;
+  for (const mesh of json.meshes || []) {
+    for (const p of mesh.primitives) {
+      assert.ok(p.mode === undefined || p.mode === 4, 'triangle lists');
+      triangles += json.accessors[p.indices].count / 3;
+    }
+  }
+  return triangles;
+}
+
+/// Leaves: tiles without children (REPLACE refinement draws these alone
+/// once everything is loaded).
+function leaves(tile, out = []) {
+  if (!tile.children?.length) {
+    if (tile.content?.uri) out.push(tile.content.uri);
+  } else tile.children.forEach((c) => leaves(c, out));
+  return out;
+}
+
+function generate(dir, name, geojson, extra = []) {
+  const lots = join(dir, `${name}.geojson`);
+  writeFileSync(lots, JSON.stringify(geojson));
+  const out = join(dir, name, 'tileset.json');
+  const run = spawnSync(
+    cgaBinary(),
+    ['generate', join(repo, 'examples', 'building.cga'), '--lot', lots, ...extra, '-o', out],
+    { encoding: 'utf8' },
+  );
+  assert.equal(run.status, 0, `cga generate failed:\n${run.stdout}\n${run.stderr}`);
+  return JSON.parse(readFileSync(out, 'utf8'));
+}
+
+// ------------------------------------------------------------------ server
+
+const TYPES = {
+  '.html': 'text/html', '.js': 'text/javascript', '.css': 'text/css', '.map': 'application/json',
+  '.json': 'application/json', '.glb': 'model/gltf-binary',
+};
+
+/// A static server: `/viewer/...` is web/dist, `/data/...` the folder of
+/// the tilesets. Every request and its status is kept.
+function serve(data) {
+  const roots = { viewer: join(repo, 'web', 'dist'), data };
+  const log = [];
+  const server = createServer((req, res) => {
+    const path = decodeURIComponent(new URL(req.url, 'http://x').pathname);
+    const [, top, ...rest] = path.split('/');
+    const root = roots[top];
+    const file = root && normalize(join(root, ...rest));
+    let status = 404;
+    if (file && file.startsWith(root) && statSync(file, { throwIfNoEntry: false })?.isFile()) {
+      status = 200;
+      res.writeHead(200, { 'content-type': TYPES[extname(file)] || 'application/octet-stream' });
+      res.end(readFileSync(file));
+    } else {
+      res.writeHead(404).end();
+    }
+    log.push({ path, status });
+  });
+  return new Promise((resolve) => {
+    server.listen(0, '127.0.0.1', () => resolve({ server, log, url: `http://127.0.0.1:${server.address().port}` }));
+  });
+}
+
+// ------------------------------------------------------------------ tests
+
+let dir;
+let http;
+let browser;
+
+before(async () => {
+  dir = mkdtempSync(join(tmpdir(), 'cga-tiles-'));
+  http = await serve(dir);
+  browser = await launchBrowser();
+});
+
+after(async () => {
+  await browser?.close();
+  http?.server.close();
+  if (dir) rmSync(dir, { recursive: true, force: true });
+});
+
+/// Opens the viewer on a tileset with every leaf wanted and waits until
+/// nothing more is loading. Returns the page, the console's errors and the
+/// page's state.
+async function view(name) {
+  const page = await browser.context.newPage();
+  const consoleErrors = [];
+  page.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
+  page.on('pageerror', (e) => consoleErrors.push(`page error: ${e.message}`));
+  await page.goto(`${http.url}/viewer/tiles.html?tileset=/data/${name}/tileset.json&errorTarget=0`);
+  await page.waitForFunction(
+    () => {
+      const s = window.tilesState;
+      return s.ready && !s.loading && s.frames > 2 && s.loaded.length + s.failed.length >= s.requested.length
+        && s.requested.length > 0;
+    },
+    null,
+    { timeout: 120000, polling: 250 },
+  );
+  // A frame after the last load, to draw it.
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  return { page, consoleErrors, state: await page.evaluate(() => ({ ...window.tilesState })) };
+}
+
+/// Clicks the roof of lot `i` (`roof`: that point in the tileset's frame)
+/// and returns what the page picked.
+async function clickRoof(page, roof) {
+  const at = await page.evaluate((p) => window.tilesState.project(p), roof);
+  assert.ok(at.inView, `the roof is in view: ${JSON.stringify(at)}`);
+  const canvas = await page.locator('#canvas').boundingBox();
+  await page.mouse.click(canvas.x + at.x, canvas.y + at.y);
+  await page.waitForFunction(() => window.tilesState.picked !== null, null, { timeout: 10000 });
+  return page.evaluate(() => window.tilesState.picked);
+}
+
+function checkLoaded(tileset, name, state, consoleErrors) {
+  const base = `${http.url}/data/${name}/`;
+  const expected = contents(tileset.root).map((u) => new URL(u, base).href).sort();
+  assert.ok(expected.length >= 5, `a tree of tiles: ${expected.length}`);
+  assert.deepEqual([...state.contents].sort(), expected, 'the page saw every content of tileset.json');
+  assert.deepEqual([...state.requested].sort(), expected, 'every tile was requested');
+  assert.deepEqual([...state.loaded].sort(), expected, 'every tile was loaded');
+  assert.deepEqual(state.failed, []);
+  assert.deepEqual(state.errors, []);
+  assert.deepEqual(consoleErrors, []);
+  // The server agrees: each tile fetched once with 200, nothing missing.
+  const served = http.log.filter((r) => r.path.startsWith(`/data/${name}/`));
+  assert.deepEqual(served.filter((r) => r.status !== 200), []);
+  for (const url of expected) {
+    assert.ok(served.some((r) => `${http.url}${r.path}` === url), `served ${url}`);
+  }
+  // Everything loaded and refined: the leaves are drawn, and only they
+  // (REPLACE), with exactly the triangles their GLBs hold.
+  const leafUris = leaves(tileset.root);
+  const triangles = leafUris.reduce((s, u) => s + glbTriangles(join(dir, name, u)), 0);
+  assert.equal(state.tilesDrawn, leafUris.length);
+  assert.equal(state.triangles, triangles);
+}
+
+async function checkPixels(page) {
+  const pixels = await page.evaluate(() => window.tilesState.cityPixels());
+  // The city covers much of its screen box (not a blank canvas).
+  assert.ok(pixels.total > 100000, JSON.stringify(pixels));
+  assert.ok(pixels.changed / pixels.total > 0.25, JSON.stringify(pixels));
+}
+
+async function screenshot(page, file) {
+  const folder = process.env.SCREENSHOTS;
+  if (!folder) return;
+  mkdirSync(folder, { recursive: true });
+  await page.screenshot({ path: join(folder, file) });
+}
+
+describe('a tileset of lots in longitude/latitude', () => {
+  let geojson;
+  let tileset;
+  let page;
+  let loadedState;
+  let consoleErrors;
+
+  before(async () => {
+    geojson = cityGeojson(geographic);
+    tileset = generate(dir, 'geo', geojson);
+    ({ page, state: loadedState, consoleErrors } = await view('geo'));
+  });
+  after(() => page?.close());
+
+  test('every tile loads, without an error', () => {
+    assert.ok(tileset.root.transform, 'a root transform to ECEF');
+    assert.equal(loadedState.georeferenced, true);
+    checkLoaded(tileset, 'geo', loadedState, consoleErrors);
+  });
+
+  test('the city is drawn', () => checkPixels(page));
+
+  test('clicking a building shows its lot', async () => {
+    const [lon, lat] = lotCentre(geojson, TOWER);
+    const roof = ecef(lon, lat, heightOf(TOWER));
+    const picked = await clickRoof(page, roof);
+    assert.equal(picked.index, TOWER, JSON.stringify(picked));
+    assert.equal(picked.name, 'B077');
+    assert.equal(picked.attributes.floors, '18');
+    assert.equal(picked.attributes.owner, 'owner 77');
+    assert.equal(picked.attributes.wallColor, COLOURS[TOWER % COLOURS.length]);
+    // The hit is on that roof, where the globe has it.
+    const miss = Math.hypot(...picked.point.map((v, k) => v - roof[k]));
+    assert.ok(miss < 1.5, `hit ${miss.toFixed(2)} m from the roof's centre`);
+    const panel = await page.locator('#picked').innerText();
+    assert.match(panel, /lot\s+77 · B077/);
+    assert.match(panel, /owner\s+owner 77/);
+    await screenshot(page, 'tileset.png');
+    // Another lot, far from the first: a low one at a corner of the city.
+    const [lon2, lat2] = lotCentre(geojson, 0);
+    const other = await clickRoof(page, ecef(lon2, lat2, heightOf(0)));
+    assert.equal(other.index, 0, JSON.stringify(other));
+    assert.equal(other.attributes.floors, String(floorsOf(0)));
+    assert.notEqual(other.tile, picked.tile, 'the two lots are in different tiles');
+  });
+});
+
+describe('a tileset of lots in local metres', () => {
+  let geojson;
+  let tileset;
+  let page;
+  let loadedState;
+  let consoleErrors;
+
+  before(async () => {
+    geojson = cityGeojson(local);
+    tileset = generate(dir, 'local', geojson, ['--crs', 'local']);
+    ({ page, state: loadedState, consoleErrors } = await view('local'));
+  });
+  after(() => page?.close());
+
+  test('every tile loads, without an error', () => {
+    assert.equal(loadedState.georeferenced, false);
+    checkLoaded(tileset, 'local', loadedState, consoleErrors);
+  });
+
+  test('the city is drawn', () => checkPixels(page));
+
+  test('clicking a building shows its lot', async () => {
+    const [x, y] = lotCentre(geojson, TOWER);
+    // The tileset's frame: x east, y north, z up, in the file's metres.
+    const roof = [x, y, heightOf(TOWER)];
+    const picked = await clickRoof(page, roof);
+    assert.equal(picked.index, TOWER, JSON.stringify(picked));
+    assert.equal(picked.attributes.owner, 'owner 77');
+    const miss = Math.hypot(...picked.point.map((v, k) => v - roof[k]));
+    assert.ok(miss < 1.5, `hit ${miss.toFixed(2)} m from the roof's centre`);
+  });
+});

@@ -109,6 +109,41 @@ scene.add(tiles.group);
 // Which tile a loaded scene is (for picking).
 const tileOf = new WeakMap();
 
+// The picked lot is drawn highlighted: the tiles' materials compare each
+// vertex's feature id (EXT_mesh_features' attribute) with the picked one,
+// which is set on the materials of the picked tile only (feature ids are
+// rows of each tile's own property table).
+const NONE = -1;
+function highlightable(material) {
+  material.userData.highlight = { value: NONE };
+  material.onBeforeCompile = (shader) => {
+    shader.uniforms.highlightFeature = material.userData.highlight;
+    shader.vertexShader = shader.vertexShader
+      .replace('void main() {', 'attribute float _feature_id_0;\nvarying float vFeature;\nvoid main() {\n\tvFeature = _feature_id_0;');
+    shader.fragmentShader = shader.fragmentShader
+      .replace('void main() {', 'uniform float highlightFeature;\nvarying float vFeature;\nvoid main() {')
+      .replace('#include <color_fragment>', '#include <color_fragment>\n\tif (abs(vFeature - highlightFeature) < 0.5) diffuseColor.rgb = mix(diffuseColor.rgb, vec3(1.0, 0.55, 0.1), 0.65);');
+  };
+  material.customProgramCacheKey = () => 'cga-feature-highlight';
+  material.needsUpdate = true;
+}
+let highlighted = []; // materials with a highlight set
+function highlight(scene, featureId) {
+  for (const m of highlighted) m.userData.highlight.value = NONE;
+  highlighted = [];
+  if (!scene) return;
+  scene.traverse((o) => {
+    if (!o.isMesh || !o.userData.meshFeatures) return;
+    for (const m of Array.isArray(o.material) ? o.material : [o.material]) {
+      if (m.userData.highlight) {
+        m.userData.highlight.value = featureId;
+        highlighted.push(m);
+      }
+    }
+  });
+  requestRender();
+}
+
 tiles.addEventListener('tile-download-start', (e) => {
   requested.add(e.url);
   state.requested = [...requested];
@@ -121,6 +156,9 @@ tiles.addEventListener('load-model', (e) => {
     if (o.isMesh) {
       o.castShadow = shadows;
       o.receiveShadow = shadows;
+      if (o.userData.meshFeatures && o.geometry.getAttribute('_feature_id_0')) {
+        for (const m of Array.isArray(o.material) ? o.material : [o.material]) highlightable(m);
+      }
     }
   });
   counts();
@@ -186,17 +224,36 @@ function fit() {
   const sphere = box.getBoundingSphere(new THREE.Sphere());
   const r = Math.max(sphere.radius, 1);
   const view = east.clone().multiplyScalar(0.55).addScaledVector(north, -0.8).addScaledVector(up, 0.75).normalize();
-  const distance = r / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2)) * 1.02;
-  camera.position.copy(sphere.center).addScaledVector(view, distance);
+  // From the distance at which the bounding sphere fits, come closer
+  // until the box's corners fill the view (a sphere around a flat city
+  // leaves most of the screen empty).
+  resize();
+  const corners = [];
+  for (const x of [box.min.x, box.max.x]) for (const y of [box.min.y, box.max.y]) for (const z of [box.min.z, box.max.z]) {
+    corners.push(new THREE.Vector3(x, y, z));
+  }
+  let distance = r / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2));
   camera.near = Math.max(distance / 1000, 0.1);
   camera.far = distance * 20;
   camera.updateProjectionMatrix();
   controls.target.copy(sphere.center);
+  for (let k = 0; k < 8; k++) {
+    camera.position.copy(sphere.center).addScaledVector(view, distance);
+    camera.lookAt(sphere.center);
+    camera.updateMatrixWorld();
+    const extent = Math.max(...corners.map((c) => {
+      const p = c.clone().project(camera);
+      return Math.max(Math.abs(p.x), Math.abs(p.y));
+    }));
+    distance *= 1 + (extent / 0.92 - 1) * 0.7;
+  }
   controls.update();
+  // The ground fades into the sky far behind the city.
+  scene.fog = new THREE.Fog(BACKGROUND, distance * 1.5, distance * 8);
 
   // The ground: a disc under the city, at its lowest point.
   const bottom = Math.min(...[box.min, box.max].map((p) => p.dot(up)));
-  ground.scale.setScalar(r * 4);
+  ground.scale.setScalar(r * 30);
   ground.position.copy(sphere.center).addScaledVector(up, bottom - sphere.center.dot(up) - 0.05);
   ground.quaternion.setFromUnitVectors(new THREE.Vector3(0, 0, 1), up);
   ground.visible = true;
@@ -297,13 +354,20 @@ function pickAt(x, y) {
   raycaster.setFromCamera(ndc, camera);
   const hits = raycaster.intersectObject(tiles.group, true);
   const hit = hits.find((h) => h.object.userData.meshFeatures);
-  if (!hit) return null;
+  if (!hit) {
+    highlight(null);
+    return null;
+  }
   const features = hit.object.userData.meshFeatures;
   const metadata = hit.object.userData.structuralMetadata;
   const [featureId] = features.getFeatures(hit.faceIndex, hit.barycoord);
   const [info] = features.getFeatureInfo();
   let tile = null;
-  for (let o = hit.object; o && !tile; o = o.parent) tile = tileOf.get(o) || null;
+  let tileScene = null;
+  for (let o = hit.object; o && !tile; o = o.parent) {
+    tile = tileOf.get(o) || null;
+    if (tile) tileScene = o;
+  }
   const picked = {
     tile: tile ? new URL(tile.content.uri, tilesetUrl).href : null,
     featureId,
@@ -331,6 +395,7 @@ function pickAt(x, y) {
       else picked.attributes[properties[id]?.name || id] = value;
     }
   }
+  highlight(tileScene, featureId ?? NONE);
   return picked;
 }
 

@@ -17,7 +17,7 @@ import { createServer } from 'node:http';
 import { mkdtempSync, readFileSync, writeFileSync, rmSync, mkdirSync, statSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, normalize, extname } from 'node:path';
-import { repo, cgaBinary, launchBrowser } from './harness.mjs';
+import { repo, cgaBinary, launchBrowser, startServer } from './harness.mjs';
 
 // ------------------------------------------------------------------ city
 
@@ -190,12 +190,12 @@ after(async () => {
 /// Opens the viewer on a tileset with every leaf wanted and waits until
 /// nothing more is loading. Returns the page, the console's errors and the
 /// page's state.
-async function view(name) {
+async function view(name, url = `${http.url}/viewer/tiles.html?tileset=/data/${name}/tileset.json&errorTarget=0`) {
   const page = await browser.context.newPage();
   const consoleErrors = [];
-  page.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
+  page.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(`${m.text()} (${m.location().url})`); });
   page.on('pageerror', (e) => consoleErrors.push(`page error: ${e.message}`));
-  await page.goto(`${http.url}/viewer/tiles.html?tileset=/data/${name}/tileset.json&errorTarget=0`);
+  await page.goto(url);
   await page.waitForFunction(
     () => {
       const s = window.tilesState;
@@ -336,5 +336,35 @@ describe('a tileset of lots in local metres', () => {
     assert.equal(picked.attributes.owner, 'owner 77');
     const miss = Math.hypot(...picked.point.map((v, k) => v - roof[k]));
     assert.ok(miss < 1.5, `hit ${miss.toFixed(2)} m from the roof's centre`);
+  });
+});
+
+describe('cga serve shows a tileset beside its rules', () => {
+  let serve;
+  let page;
+
+  before(async () => {
+    // `cga serve RULES` serves the viewer page and the files of the rules'
+    // folder (`files/...`): a tileset written there can be opened at once.
+    writeFileSync(join(dir, 'building.cga'), readFileSync(join(repo, 'examples', 'building.cga')));
+    generate(dir, 'served', cityGeojson(geographic));
+    serve = await startServer([join(dir, 'building.cga')]);
+  });
+  after(async () => {
+    await page?.close();
+    serve?.child.kill();
+  });
+
+  test('every tile loads from cga serve, without an error', async () => {
+    const tileset = JSON.parse(readFileSync(join(dir, 'served', 'tileset.json'), 'utf8'));
+    let state;
+    let consoleErrors;
+    ({ page, state, consoleErrors } = await view('served', `${serve.url}tiles.html?tileset=files/served/tileset.json&errorTarget=0`));
+    const expected = contents(tileset.root).map((u) => new URL(u, `${serve.url}files/served/`).href).sort();
+    assert.deepEqual([...state.loaded].sort(), expected);
+    assert.deepEqual(state.failed, []);
+    assert.deepEqual(state.errors, []);
+    assert.deepEqual(consoleErrors, []);
+    await checkPixels(page);
   });
 });

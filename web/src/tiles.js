@@ -64,7 +64,7 @@ const canvas = $('canvas');
 const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
 renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
 renderer.shadowMap.enabled = shadows;
-renderer.shadowMap.type = THREE.PCFSoftShadowMap;
+renderer.shadowMap.type = THREE.PCFShadowMap;
 const scene = new THREE.Scene();
 scene.background = new THREE.Color(BACKGROUND);
 const camera = new THREE.PerspectiveCamera(40, 1, 1, 10000);
@@ -189,6 +189,7 @@ tiles.addEventListener('load-root-tileset', (e) => {
   };
   walk(root);
   state.contents = contents;
+  placeLights();
   $('tileset-name').textContent = decodeURIComponent(new URL(e.url).pathname.split('/').pop());
   fit();
   state.ready = true;
@@ -197,60 +198,37 @@ tiles.addEventListener('load-root-tileset', (e) => {
 
 // ---------------------------------------------------------------- framing
 
-// The tileset's frame in the world: east, north and up (unit vectors) and
-// the box of the root's bounding volume.
-function frame() {
+// The tileset's frame in the world: east, north and up (unit vectors),
+// and the box of `points` (of the tileset's frame, after the root
+// transform) or else of the root's bounding volume.
+function frame(points = null) {
   tiles.group.updateMatrixWorld(true);
   const local = new THREE.Matrix4();
   if (state.rootTransform) local.fromArray(state.rootTransform);
   const toWorld = tiles.group.matrixWorld;
   const axis = (k) => new THREE.Vector3().setFromMatrixColumn(local, k).transformDirection(toWorld);
-  const obb = new THREE.Box3();
-  const obbMatrix = new THREE.Matrix4();
   const box = new THREE.Box3();
-  if (tiles.getOrientedBoundingBox(obb, obbMatrix)) {
-    const m = obbMatrix.clone().premultiply(toWorld);
-    for (const x of [obb.min.x, obb.max.x]) for (const y of [obb.min.y, obb.max.y]) for (const z of [obb.min.z, obb.max.z]) {
-      box.expandByPoint(new THREE.Vector3(x, y, z).applyMatrix4(m));
+  if (points) {
+    for (const p of points) box.expandByPoint(new THREE.Vector3(...p).applyMatrix4(toWorld));
+  } else {
+    const obb = new THREE.Box3();
+    const obbMatrix = new THREE.Matrix4();
+    if (tiles.getOrientedBoundingBox(obb, obbMatrix)) {
+      const m = obbMatrix.clone().premultiply(toWorld);
+      for (const x of [obb.min.x, obb.max.x]) for (const y of [obb.min.y, obb.max.y]) for (const z of [obb.min.z, obb.max.z]) {
+        box.expandByPoint(new THREE.Vector3(x, y, z).applyMatrix4(m));
+      }
     }
   }
   return { east: axis(0), north: axis(1), up: axis(2), box };
 }
 
-// Frames the whole tileset from the south-east, above.
-function fit() {
+// The ground and the sun, for the whole tileset.
+function placeLights() {
   const { east, north, up, box } = frame();
   if (box.isEmpty()) return;
   const sphere = box.getBoundingSphere(new THREE.Sphere());
   const r = Math.max(sphere.radius, 1);
-  const view = east.clone().multiplyScalar(0.55).addScaledVector(north, -0.8).addScaledVector(up, 0.75).normalize();
-  // From the distance at which the bounding sphere fits, come closer
-  // until the box's corners fill the view (a sphere around a flat city
-  // leaves most of the screen empty).
-  resize();
-  const corners = [];
-  for (const x of [box.min.x, box.max.x]) for (const y of [box.min.y, box.max.y]) for (const z of [box.min.z, box.max.z]) {
-    corners.push(new THREE.Vector3(x, y, z));
-  }
-  let distance = r / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2));
-  camera.near = Math.max(distance / 1000, 0.1);
-  camera.far = distance * 20;
-  camera.updateProjectionMatrix();
-  controls.target.copy(sphere.center);
-  for (let k = 0; k < 8; k++) {
-    camera.position.copy(sphere.center).addScaledVector(view, distance);
-    camera.lookAt(sphere.center);
-    camera.updateMatrixWorld();
-    const extent = Math.max(...corners.map((c) => {
-      const p = c.clone().project(camera);
-      return Math.max(Math.abs(p.x), Math.abs(p.y));
-    }));
-    distance *= 1 + (extent / 0.92 - 1) * 0.7;
-  }
-  controls.update();
-  // The ground fades into the sky far behind the city.
-  scene.fog = new THREE.Fog(BACKGROUND, distance * 1.5, distance * 8);
-
   // The ground: a disc under the city, at its lowest point.
   const bottom = Math.min(...[box.min, box.max].map((p) => p.dot(up)));
   ground.scale.setScalar(r * 30);
@@ -269,9 +247,47 @@ function fit() {
   s.near = r * 0.5; s.far = r * 6;
   s.updateProjectionMatrix();
   sun.shadow.normalBias = r / 2000;
+}
+
+// Frames the whole tileset (or `points` of its frame) from the
+// south-east, above.
+function fit(points = null) {
+  const { east, north, up, box } = frame(points);
+  if (box.isEmpty()) return;
+  const sphere = box.getBoundingSphere(new THREE.Sphere());
+  const r = Math.max(sphere.radius, 1);
+  const view = east.clone().multiplyScalar(0.55).addScaledVector(north, -0.8).addScaledVector(up, 0.75).normalize();
+  // From the distance at which the bounding sphere fits, come closer
+  // until the box's corners fill the view (a sphere around a flat city
+  // leaves most of the screen empty).
+  resize();
+  const corners = [];
+  for (const x of [box.min.x, box.max.x]) for (const y of [box.min.y, box.max.y]) for (const z of [box.min.z, box.max.z]) {
+    corners.push(new THREE.Vector3(x, y, z));
+  }
+  let distance = r / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2));
+  const whole = frame().box.getBoundingSphere(new THREE.Sphere());
+  camera.near = Math.max(distance / 1000, 0.1);
+  camera.far = distance + whole.radius * 40;
+  camera.updateProjectionMatrix();
+  controls.target.copy(sphere.center);
+  for (let k = 0; k < 8; k++) {
+    camera.position.copy(sphere.center).addScaledVector(view, distance);
+    camera.lookAt(sphere.center);
+    camera.updateMatrixWorld();
+    const extent = Math.max(...corners.map((c) => {
+      const p = c.clone().project(camera);
+      return Math.max(Math.abs(p.x), Math.abs(p.y));
+    }));
+    distance *= 1 + (extent / 0.92 - 1) * 0.7;
+  }
+  controls.update();
+  // The ground fades into the sky far behind the city.
+  const far = distance + whole.radius;
+  scene.fog = new THREE.Fog(BACKGROUND, far * 1.5, far * 8);
   requestRender();
 }
-$('fit').addEventListener('click', fit);
+$('fit').addEventListener('click', () => fit());
 
 // ---------------------------------------------------------------- drawing
 
@@ -448,9 +464,10 @@ state.project = (p) => {
 };
 
 // Pixels of the city: those that change when the tiles are hidden, over
-// the screen box of the root's bounding volume.
-state.cityPixels = () => {
-  const { box } = frame();
+// the screen box of the root's bounding volume (or of `points` of the
+// tileset's frame).
+state.cityPixels = (points = null) => {
+  const { box } = frame(points);
   if (box.isEmpty()) return { box: null, changed: 0, total: 0 };
   const w = renderer.domElement.width;
   const h = renderer.domElement.height;

@@ -21,14 +21,20 @@ import { repo, cgaBinary, launchBrowser, startServer } from './harness.mjs';
 
 // ------------------------------------------------------------------ city
 
-// 15 x 10 lots of 20 m x 24 m, 10 m apart, around a point of Zurich; the
-// floors vary (2 to 8), one tower has 18, and each lot has an owner (a
-// property that is no rule attribute) and a wall colour (one that is).
-const COLS = 15;
-const ROWS = 10;
+// A centre of 12 x 10 lots of 20 m x 24 m, 10 m apart, and a suburb of
+// 6 x 5 to the north-east, around a point of Zurich: the quadtree splits
+// the centre once more (64 lots a leaf at most), so there are massing
+// tiles at two levels and leaves at two. The floors vary (2 to 8), one
+// tower has 18, and each lot has an owner (a property that is no rule
+// attribute) and a wall colour (one that is).
+const DISTRICTS = [
+  { cols: 12, rows: 10, at: [0, 0] },
+  { cols: 6, rows: 5, at: [560, 560] },
+];
 const LOT = [20, 24];
 const PITCH = [30, 34];
-const TOWER = 77;
+const TOWER = 77; // in the centre
+const SUBURB = 149; // the last lot
 const ORIGIN = { lon: 8.5417, lat: 47.3769 };
 const LOCAL_ORIGIN = [1000, 2000]; // metres, for the local city
 const COLOURS = ['#d8cfc4', '#c9b8a6', '#e6dfd2', '#b7a99a', '#d3c2b0'];
@@ -42,15 +48,16 @@ const heightOf = (i) => 4.5 + floorsOf(i) * 3.2;
 const DEG_LAT = 1 / 111132;
 const DEG_LON = 1 / (111320 * Math.cos((ORIGIN.lat * Math.PI) / 180));
 
-/// The lots as [x0, y0, x1, y1] in metres east and north of the city's corner.
+/// The lots as [x0, y0, x1, y1] in metres east and north of about the
+/// city's middle.
 function lotBoxes() {
   const boxes = [];
-  for (let i = 0; i < COLS * ROWS; i++) {
-    const c = i % COLS;
-    const r = Math.floor(i / COLS);
-    const x0 = c * PITCH[0] - (COLS * PITCH[0]) / 2;
-    const y0 = r * PITCH[1] - (ROWS * PITCH[1]) / 2;
-    boxes.push([x0, y0, x0 + LOT[0], y0 + LOT[1]]);
+  for (const { cols, rows, at } of DISTRICTS) {
+    for (let i = 0; i < cols * rows; i++) {
+      const x0 = at[0] + (i % cols) * PITCH[0] - 365;
+      const y0 = at[1] + Math.floor(i / cols) * PITCH[1] - 360;
+      boxes.push([x0, y0, x0 + LOT[0], y0 + LOT[1]]);
+    }
   }
   return boxes;
 }
@@ -224,7 +231,9 @@ async function clickRoof(page, roof) {
 function checkLoaded(tileset, name, state, consoleErrors) {
   const base = `${http.url}/data/${name}/`;
   const expected = contents(tileset.root).map((u) => new URL(u, base).href).sort();
-  assert.ok(expected.length >= 5, `a tree of tiles: ${expected.length}`);
+  // The root's and the centre's massing, the centre's 4 leaves and the
+  // suburb's leaf.
+  assert.equal(expected.length, 7, `a tree of tiles: ${expected}`);
   assert.deepEqual([...state.contents].sort(), expected, 'the page saw every content of tileset.json');
   assert.deepEqual([...state.requested].sort(), expected, 'every tile was requested');
   assert.deepEqual([...state.loaded].sort(), expected, 'every tile was loaded');
@@ -245,11 +254,28 @@ function checkLoaded(tileset, name, state, consoleErrors) {
   assert.equal(state.triangles, triangles);
 }
 
-async function checkPixels(page) {
-  const pixels = await page.evaluate(() => window.tilesState.cityPixels());
-  // The city covers much of its screen box (not a blank canvas).
-  assert.ok(pixels.total > 100000, JSON.stringify(pixels));
-  assert.ok(pixels.changed / pixels.total > 0.25, JSON.stringify(pixels));
+/// The corners of the box around district `d` (its lots, from the ground
+/// to 30 m), in the tileset's frame: `toFrame([x, y], h)` places a point of
+/// the GeoJSON at a height.
+function districtBox(geojson, d, toFrame) {
+  const first = DISTRICTS.slice(0, d).reduce((n, k) => n + k.cols * k.rows, 0);
+  const count = DISTRICTS[d].cols * DISTRICTS[d].rows;
+  const points = geojson.features.slice(first, first + count).flatMap((f) => f.geometry.coordinates[0]);
+  const [xs, ys] = [0, 1].map((k) => [Math.min, Math.max].map((m) => m(...points.map((p) => p[k]))));
+  const corners = [];
+  for (const x of xs) for (const y of ys) for (const h of [0, 30]) corners.push(toFrame([x, y], h));
+  return corners;
+}
+
+/// The city is drawn: over the screen box of each district, many pixels
+/// change when the tiles are hidden (not a blank canvas, nor the ground).
+async function checkPixels(page, geojson, toFrame) {
+  for (let d = 0; d < DISTRICTS.length; d++) {
+    const box = districtBox(geojson, d, toFrame);
+    const pixels = await page.evaluate((b) => window.tilesState.cityPixels(b), box);
+    assert.ok(pixels.total > 10000, `district ${d}: ${JSON.stringify(pixels)}`);
+    assert.ok(pixels.changed / pixels.total > 0.25, `district ${d}: ${JSON.stringify(pixels)}`);
+  }
 }
 
 async function screenshot(page, file) {
@@ -279,9 +305,22 @@ describe('a tileset of lots in longitude/latitude', () => {
     checkLoaded(tileset, 'geo', loadedState, consoleErrors);
   });
 
-  test('the city is drawn', () => checkPixels(page));
+  const onGlobe = ([lon, lat], h) => ecef(lon, lat, h);
+
+  test('the city is drawn', () => checkPixels(page, geojson, onGlobe));
 
   test('clicking a building shows its lot', async () => {
+    // A lot in the suburb: a leaf one level below the root.
+    const [lon2, lat2] = lotCentre(geojson, SUBURB);
+    const other = await clickRoof(page, ecef(lon2, lat2, heightOf(SUBURB)));
+    assert.equal(other.index, SUBURB, JSON.stringify(other));
+    assert.equal(other.name, `B${SUBURB}`);
+    assert.equal(other.attributes.floors, String(floorsOf(SUBURB)));
+    assert.equal(other.attributes.owner, `owner ${SUBURB}`);
+    assert.match(other.tile, /\/tiles\/1_\d+_\d+\.glb$/);
+
+    // The tower in the centre (a leaf two levels down), seen closer.
+    await page.evaluate((b) => window.tilesState.fit(b), districtBox(geojson, 0, onGlobe));
     const [lon, lat] = lotCentre(geojson, TOWER);
     const roof = ecef(lon, lat, heightOf(TOWER));
     const picked = await clickRoof(page, roof);
@@ -290,19 +329,17 @@ describe('a tileset of lots in longitude/latitude', () => {
     assert.equal(picked.attributes.floors, '18');
     assert.equal(picked.attributes.owner, 'owner 77');
     assert.equal(picked.attributes.wallColor, COLOURS[TOWER % COLOURS.length]);
+    assert.match(picked.tile, /\/tiles\/2_\d+_\d+\.glb$/);
     // The hit is on that roof, where the globe has it.
     const miss = Math.hypot(...picked.point.map((v, k) => v - roof[k]));
     assert.ok(miss < 1.5, `hit ${miss.toFixed(2)} m from the roof's centre`);
     const panel = await page.locator('#picked').innerText();
     assert.match(panel, /lot\s+77 · B077/);
     assert.match(panel, /owner\s+owner 77/);
+    // Nothing failed on the way (the closer view needed no tile it had not).
+    assert.deepEqual(await page.evaluate(() => window.tilesState.errors), []);
+    await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
     await screenshot(page, 'tileset.png');
-    // Another lot, far from the first: a low one at a corner of the city.
-    const [lon2, lat2] = lotCentre(geojson, 0);
-    const other = await clickRoof(page, ecef(lon2, lat2, heightOf(0)));
-    assert.equal(other.index, 0, JSON.stringify(other));
-    assert.equal(other.attributes.floors, String(floorsOf(0)));
-    assert.notEqual(other.tile, picked.tile, 'the two lots are in different tiles');
   });
 });
 
@@ -325,7 +362,9 @@ describe('a tileset of lots in local metres', () => {
     checkLoaded(tileset, 'local', loadedState, consoleErrors);
   });
 
-  test('the city is drawn', () => checkPixels(page));
+  const flat = ([x, y], h) => [x, y, h];
+
+  test('the city is drawn', () => checkPixels(page, geojson, flat));
 
   test('clicking a building shows its lot', async () => {
     const [x, y] = lotCentre(geojson, TOWER);
@@ -365,6 +404,6 @@ describe('cga serve shows a tileset beside its rules', () => {
     assert.deepEqual(state.failed, []);
     assert.deepEqual(state.errors, []);
     assert.deepEqual(consoleErrors, []);
-    await checkPixels(page);
+    await checkPixels(page, cityGeojson(geographic), ([lon, lat], h) => ecef(lon, lat, h));
   });
 });

@@ -291,7 +291,11 @@ impl NativeRules {
             };
             match (&output, format) {
                 (Some(path), Some(format)) => {
-                    let mut writer = ModelWriter::create(path, format, rules.export_options())?;
+                    let export = cga::ExportOptions {
+                        origin: cga::lots::local_origin(&lots),
+                        ..rules.export_options()
+                    };
+                    let mut writer = ModelWriter::create(path, format, export)?;
                     rules.generate_lots(&lots, &options, Target::Writer(&mut writer), send)?;
                     Ok(Some(writer.finish()?))
                 }

@@ -199,6 +199,43 @@ struct GenerateArgs {
     /// glTF JSON large.
     #[arg(long, value_name = "lot|material")]
     granularity: Option<cga::Granularity>,
+    /// glTF/GLB: the point positions are written relative to, kept in
+    /// double precision in the node translation (32-bit floats lose
+    /// millimetres beyond 16 km): `X,Y` in the lots' metres (x east, y
+    /// north), `auto` (the lots' centre, when more than 1 km from 0) or
+    /// `none`. 3D Tiles: each tile is written from its own centre unless
+    /// `none`. OBJ keeps full coordinates.
+    #[arg(long, value_name = "X,Y|auto|none", default_value = "auto")]
+    origin: OriginArg,
+}
+
+/// `--origin`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum OriginArg {
+    Auto,
+    None,
+    At(f64, f64),
+}
+
+impl std::str::FromStr for OriginArg {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<OriginArg, String> {
+        match s.trim() {
+            "auto" => Ok(OriginArg::Auto),
+            "none" => Ok(OriginArg::None),
+            xy => {
+                let parse = |v: &str| v.trim().parse::<f64>().ok().filter(|v| v.is_finite());
+                match xy.split_once(',') {
+                    Some((x, y)) => match (parse(x), parse(y)) {
+                        (Some(x), Some(y)) => Ok(OriginArg::At(x, y)),
+                        _ => Err(format!("expected --origin X,Y with two numbers, found `{xy}`")),
+                    },
+                    None => Err(format!("expected --origin X,Y, auto or none, found `{xy}`")),
+                }
+            }
+        }
+    }
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -423,6 +460,11 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
         })?),
         None => None,
     };
+    if let (Some(_), OriginArg::At(..)) = (tileset, args.origin) {
+        return Err(Failure::Usage(
+            "--origin X,Y is for GLB and glTF: a tileset's tiles are each written from their own centre (--origin none turns that off)".into(),
+        ));
+    }
     let lot_options = cga::LotOptions {
         crs: args.crs.clone(),
         invalid: args.invalid,
@@ -474,6 +516,12 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
                     latitude: o.lat,
                     projection: o.proj_string(),
                 }),
+                // GIS y north is the model's -z.
+                origin: match args.origin {
+                    OriginArg::Auto => cga::lots::local_origin(&lots.lots),
+                    OriginArg::None => None,
+                    OriginArg::At(x, y) => Some(cga::DVec3::new(x, 0.0, -y)),
+                },
                 flush_mib: args.held_mib,
                 granularity: args.granularity.unwrap_or_else(|| {
                     if lots.lots.len() > NODES_PER_LOT_UP_TO {
@@ -535,6 +583,7 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
                     flush_mib: args.held_mib,
                     ..rules.export_options()
                 },
+                tile_origins: args.origin != OriginArg::None,
                 ..Default::default()
             };
             let stats = cga_tiles::write_tileset(&rules, &lots.lots, &options, &tiles, path, each)?;

@@ -79,15 +79,18 @@ pub(crate) struct EncoderShared {
     /// Which textures the writer will find usable: that decides which UV
     /// sets and tangents a material's vertices carry.
     pub probe: TextureProbe,
+    /// What every encoder writes positions relative to.
+    pub origin: Option<DVec3>,
     /// Batches the writer has appended, for encoders to fill again: their
     /// arrays keep their room, so a running model allocates no more.
     pool: Mutex<Vec<Encoded>>,
 }
 
 impl EncoderShared {
-    pub(crate) fn new(probe: TextureProbe) -> EncoderShared {
+    pub(crate) fn new(probe: TextureProbe, origin: Option<DVec3>) -> EncoderShared {
         EncoderShared {
             probe,
+            origin,
             pool: Mutex::new(Vec::new()),
         }
     }
@@ -124,6 +127,9 @@ pub(crate) struct Counts {
 /// Scratch room for encoding meshes, kept from one mesh to the next.
 #[derive(Default)]
 pub(crate) struct MeshEncoder {
+    /// Positions are written relative to this point (see
+    /// [`ExportOptions::origin`](crate::ExportOptions::origin)).
+    pub origin: Option<DVec3>,
     prep: FacePrep,
     slots: SlotIds,
     vertices: VertexSharing,
@@ -143,7 +149,16 @@ impl MeshEncoder {
         store: &mut impl Buckets,
     ) -> Result<Counts, ExportError> {
         check_mesh(mesh, materials.len())?;
+        let shifted;
+        let transform = match self.origin {
+            Some(o) => {
+                shifted = DAffine3::from_translation(-o) * transform.copied().unwrap_or_default();
+                Some(&shifted)
+            }
+            None => transform,
+        };
         let MeshEncoder {
+            origin: _,
             prep,
             slots,
             vertices,
@@ -215,8 +230,11 @@ pub struct Encoder {
 impl Encoder {
     pub(crate) fn new(shared: Arc<EncoderShared>) -> Encoder {
         Encoder {
+            mesh: MeshEncoder {
+                origin: shared.origin,
+                ..MeshEncoder::default()
+            },
             shared,
-            mesh: MeshEncoder::default(),
             table: MaterialTable::default(),
             batch: Encoded::default(),
         }

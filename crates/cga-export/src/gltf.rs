@@ -369,43 +369,50 @@ fn property_table(root: &mut json::Root, layout: &mut Layout, lots: &[LotNode]) 
     let names = lots.iter().map(|l| l.name.clone()).collect();
     table.insert("name".into(), strings(names, root, layout, &mut tail));
     // Attributes by name, in order of first appearance, as text.
-    let mut keys: Vec<String> = Vec::new();
-    for l in lots {
-        if let Some(Value::Object(a)) = l.extras.as_ref().map(|e| &e["attributes"]) {
-            for k in a.keys() {
-                if !keys.contains(k) {
-                    keys.push(k.clone());
-                }
-            }
-        }
-    }
-    for key in keys {
-        let id: String = format!(
-            "attr_{}",
-            key.chars()
-                .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
-                .collect::<String>()
-        );
+    for key in keys_of(lots, "attributes") {
+        let id = property_id("attr_", &key);
         if class.contains_key(&id) {
             continue;
         }
         let values = lots
             .iter()
-            .map(
-                |l| match l.extras.as_ref().map(|e| &e["attributes"][&key]) {
-                    Some(Value::String(s)) => s.clone(),
-                    Some(Value::Null) | None => String::new(),
-                    // Whole numbers without a decimal point, as CGA prints them.
-                    Some(Value::Number(n)) => match n.as_f64() {
-                        Some(x) if x.fract() == 0.0 && x.abs() < 1e15 => format!("{}", x as i64),
-                        _ => n.to_string(),
-                    },
-                    Some(v) => v.to_string(),
-                },
-            )
+            .map(|l| text_of(l.extras.as_ref().map(|e| &e["attributes"][&key])))
             .collect();
         class.insert(id.clone(), json!({"type": "STRING", "name": key}));
         table.insert(id, strings(values, root, layout, &mut tail));
+    }
+    // Reports by key: numbers (the sum of a lot's values) as FLOAT64, 0
+    // where a lot reported nothing; other values as text.
+    for key in keys_of(lots, "reports") {
+        let id = property_id("report_", &key);
+        if class.contains_key(&id) {
+            continue;
+        }
+        let values: Vec<Option<&Value>> = lots
+            .iter()
+            .map(|l| l.extras.as_ref().map(|e| &e["reports"][&key]))
+            .collect();
+        let numbers = values
+            .iter()
+            .all(|v| matches!(v, None | Some(Value::Null) | Some(Value::Number(_))));
+        if numbers {
+            let bytes: Vec<u8> = values
+                .iter()
+                .flat_map(|v| v.and_then(Value::as_f64).unwrap_or(0.0).to_le_bytes())
+                .collect();
+            class.insert(
+                id.clone(),
+                json!({"type": "SCALAR", "componentType": "FLOAT64", "name": key}),
+            );
+            table.insert(
+                id,
+                json!({"values": view(root, layout, &mut tail, &bytes)}),
+            );
+        } else {
+            let values = values.into_iter().map(text_of).collect();
+            class.insert(id.clone(), json!({"type": "STRING", "name": key}));
+            table.insert(id, strings(values, root, layout, &mut tail));
+        }
     }
     root.extensions = Some(json::extensions::Root {
         others: [(
@@ -433,6 +440,47 @@ fn property_table(root: &mut json::Root, layout: &mut Layout, lots: &[LotNode]) 
         }
     }
     tail
+}
+
+/// The keys of the objects under `field` of the lots' extras, in order of
+/// first appearance.
+fn keys_of(lots: &[LotNode], field: &str) -> Vec<String> {
+    let mut keys: Vec<String> = Vec::new();
+    for l in lots {
+        if let Some(serde_json::Value::Object(a)) = l.extras.as_ref().map(|e| &e[field]) {
+            for k in a.keys() {
+                if !keys.contains(k) {
+                    keys.push(k.clone());
+                }
+            }
+        }
+    }
+    keys
+}
+
+/// A property table id: `prefix` and the name with what is not ASCII
+/// alphanumeric as `_` (the name itself goes into the property's `name`).
+fn property_id(prefix: &str, name: &str) -> String {
+    let name: String = name
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .collect();
+    format!("{prefix}{name}")
+}
+
+/// A value of the lots' extras as the text of a STRING property.
+fn text_of(v: Option<&serde_json::Value>) -> String {
+    use serde_json::Value;
+    match v {
+        Some(Value::String(s)) => s.clone(),
+        Some(Value::Null) | None => String::new(),
+        // Whole numbers without a decimal point, as CGA prints them.
+        Some(Value::Number(n)) => match n.as_f64() {
+            Some(x) if x.fract() == 0.0 && x.abs() < 1e15 => format!("{}", x as i64),
+            _ => n.to_string(),
+        },
+        Some(v) => v.to_string(),
+    }
 }
 
 /// The box around primitives (min, max), if there are any.
@@ -551,6 +599,8 @@ pub(crate) struct GltfWriter {
     tail: Vec<u8>,
     /// With features: the box of each lot's vertices so far.
     feature_bounds: Vec<Option<[[f64; 3]; 2]>>,
+    /// The point positions are relative to: every node's translation.
+    origin: Option<DVec3>,
 }
 
 /// A lot's node: its name and `extras`, and the first of its primitives in
@@ -628,7 +678,15 @@ impl GltfWriter {
             features: false,
             tail: Vec::new(),
             feature_bounds: Vec::new(),
+            origin: None,
         }
+    }
+
+    /// Positions come relative to `origin` (see
+    /// [`ExportOptions::origin`](crate::ExportOptions::origin)): nodes are
+    /// translated by it, and the bounds in the stats are moved back by it.
+    pub(crate) fn set_origin(&mut self, origin: Option<DVec3>) {
+        self.origin = origin;
     }
 
     /// Gives each lot's vertices its feature id and writes a property
@@ -640,6 +698,17 @@ impl GltfWriter {
     /// Says how many lots the model will have.
     pub(crate) fn expect_lots(&mut self, lots: usize) {
         self.lots_hint = Some(lots);
+    }
+
+    /// Sets `key` of the last lot's `extras` (its node's, and its row of
+    /// the property table).
+    pub(crate) fn annotate_lot(&mut self, key: &str, value: serde_json::Value) {
+        if let Some(lot) = self.lots.last_mut() {
+            let extras = lot.extras.get_or_insert_with(|| serde_json::json!({}));
+            if let Some(map) = extras.as_object_mut() {
+                map.insert(key.to_string(), value);
+            }
+        }
     }
 
     /// Starts a lot's node (see [`LotNode`]): what is held of the lot
@@ -896,6 +965,19 @@ impl GltfWriter {
                 stats.lot_bounds.push(bounds_of(&layouts[start..end]));
             }
         }
+        // The stats' boxes are in the model's frame.
+        if let Some(o) = self.origin {
+            let o = o.to_array();
+            let moved = |b: &mut [[f64; 3]; 2]| {
+                for corner in b.iter_mut() {
+                    for (c, o) in corner.iter_mut().zip(o) {
+                        *c += o;
+                    }
+                }
+            };
+            stats.bounds.iter_mut().for_each(moved);
+            stats.lot_bounds.iter_mut().flatten().for_each(moved);
+        }
         // The glTF material of each material id that has primitives.
         let mut gltf_materials: Vec<Option<json::Index<json::Material>>> =
             vec![None; self.buckets.len()];
@@ -973,6 +1055,10 @@ impl GltfWriter {
                 mesh: Some(mesh),
                 name: Some(name),
                 extras: extras.and_then(|v| serde_json::value::to_raw_value(&v).ok()),
+                // glTF's JSON holds the translation as f32; numbers in
+                // JSON text are doubles, and readers that keep them so
+                // (CesiumJS, three.js) place the model to the millimetre.
+                translation: self.origin.map(|o| o.as_vec3().to_array()),
                 ..Default::default()
             }));
         }

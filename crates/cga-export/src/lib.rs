@@ -108,6 +108,27 @@ pub struct ExportOptions {
     pub world: Arc<dyn World>,
     /// How lots are kept apart in the model (see [`Granularity`]).
     pub granularity: Granularity,
+    /// glTF and GLB: positions are written relative to this point of the
+    /// model's frame (y up), and every node is translated by it, so that
+    /// far from the frame's origin (a national grid's millions of metres)
+    /// the 32-bit floats of glTF keep their millimetres: the point itself
+    /// stays in double precision in the node's `translation` and in
+    /// `asset.extras.origin`. OBJ writes full coordinates (its numbers are
+    /// text) and ignores it.
+    pub origin: Option<DVec3>,
+}
+
+impl ExportOptions {
+    /// The options with the origin moved to the nearest point whose
+    /// coordinates are 32-bit floats: glTF's node translation is one, and
+    /// positions must be relative to exactly what it says (whole metres are
+    /// such floats up to 16,777 km).
+    fn exact_origin(self) -> ExportOptions {
+        ExportOptions {
+            origin: self.origin.map(|o| o.as_vec3().as_dvec3()),
+            ..self
+        }
+    }
 }
 
 /// How the output keeps lots apart.
@@ -147,6 +168,7 @@ impl Default for ExportOptions {
             flush_mib: gltf::DEFAULT_FLUSH_MIB,
             world: Arc::new(cga_world::DiskWorld),
             granularity: Granularity::Lot,
+            origin: None,
         }
     }
 }
@@ -183,6 +205,20 @@ impl Georeference {
             self.longitude, self.latitude, self.projection
         )
     }
+}
+
+/// glTF's `asset.extras`: the georeference of geographic lots, and the
+/// origin positions are written from (see [`ExportOptions::origin`]).
+fn asset_extras(options: &ExportOptions) -> Option<serde_json::Value> {
+    let mut extras = options.georeference.as_ref().map(Georeference::to_json);
+    if let Some(o) = options.origin {
+        let record = serde_json::json!({
+            "x": o.x, "y": o.y, "z": o.z,
+            "note": "positions are relative to this point of the model frame (y up); nodes are translated by it",
+        });
+        extras.get_or_insert_with(|| serde_json::json!({}))["origin"] = record;
+    }
+    extras
 }
 
 /// What [`ModelWriter::finish`] wrote.
@@ -306,6 +342,7 @@ impl ModelWriter {
         format: Format,
         options: ExportOptions,
     ) -> Result<ModelWriter, ExportError> {
+        let options = options.exact_origin();
         let out_dir = match path.parent() {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
@@ -316,7 +353,7 @@ impl ModelWriter {
                     path,
                     format == Format::Glb,
                     options.embed_textures,
-                    options.georeference.as_ref().map(Georeference::to_json),
+                    asset_extras(&options),
                     options.flush_mib,
                     options.granularity == Granularity::Lot,
                 )?;
@@ -356,12 +393,13 @@ impl ModelWriter {
         name: &str,
         options: ExportOptions,
     ) -> Result<ModelWriter, ExportError> {
+        let options = options.exact_origin();
         let w = gltf::GltfWriter::new(
             Box::new(out),
             Path::new(name),
             true,
             true,
-            options.georeference.as_ref().map(Georeference::to_json),
+            asset_extras(&options),
             options.flush_mib,
             options.granularity == Granularity::Lot,
         );
@@ -375,16 +413,16 @@ impl ModelWriter {
     }
 
     fn with_sink(
-        sink: Sink,
+        mut sink: Sink,
         options: &ExportOptions,
         copy_textures: bool,
         out_dir: &Path,
         reserved: &[&str],
     ) -> ModelWriter {
-        let encoders = Arc::new(EncoderShared::new(TextureProbe::new(
-            options.world.clone(),
-            &options.texture_roots,
-        )));
+        let encoders = Arc::new(EncoderShared::new(
+            TextureProbe::new(options.world.clone(), &options.texture_roots),
+            options.origin,
+        ));
         let textures = Textures::new(
             options.world.clone(),
             &options.texture_roots,
@@ -392,6 +430,10 @@ impl ModelWriter {
             out_dir,
             reserved,
         );
+        if let Sink::Gltf(w, encoder) = &mut sink {
+            w.set_origin(options.origin);
+            encoder.origin = options.origin;
+        }
         ModelWriter {
             table: MaterialTable::default(),
             textures,
@@ -506,6 +548,16 @@ impl ModelWriter {
             // Merged by material, a lot still has its feature id when
             // features are on.
             Sink::Gltf(w, _) => w.begin_lot(name, extras),
+        }
+    }
+
+    /// Sets `key` of the `extras` of the lot begun last (glTF and GLB: its
+    /// node's `extras` with [`Granularity::Lot`], its row of the property
+    /// table with features; `"reports"` there, an object of numbers or
+    /// strings, becomes a property per key). OBJ ignores it.
+    pub fn annotate_lot(&mut self, key: &str, value: serde_json::Value) {
+        if let Sink::Gltf(w, _) = &mut self.sink {
+            w.annotate_lot(key, value);
         }
     }
 
@@ -772,6 +824,52 @@ mod tests {
                 assert!(baked == placed, "transform {k}, {format:?}: outputs differ");
             }
         }
+    }
+
+    #[test]
+    fn an_origin_moves_positions_into_the_node_translation() {
+        // A unit square far away, written from an origin that is not a
+        // 32-bit float: the writer moves the origin to one first.
+        let far = DVec3::new(5_000_000.3, 2.0, -7_000_000.7);
+        let mut mesh = Mesh::polygon(&[
+            far,
+            far + DVec3::X,
+            far + DVec3::new(1.0, 0.0, -1.0),
+            far + DVec3::new(0.0, 0.0, -1.0),
+        ]);
+        mesh.materials = vec![Material::default()].into();
+        let options = ExportOptions {
+            origin: Some(DVec3::new(5_000_000.3, 0.0, -7_000_000.7)),
+            ..ExportOptions::default()
+        };
+        let mut w = ModelWriter::glb_in_memory(options).unwrap();
+        w.begin_lot("far", None).unwrap();
+        w.add_mesh(&mesh).unwrap();
+        let (bytes, stats) = w.finish_bytes().unwrap();
+        let len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+        let json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + len]).unwrap();
+        let t: Vec<f64> = json["nodes"][0]["translation"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        // The translation is exactly the 32-bit float nearest the origin.
+        assert_eq!(t, [5_000_000.5, 0.0, -7_000_000.5]);
+        assert_eq!(json["asset"]["extras"]["origin"]["z"], -7_000_000.5);
+        let min: Vec<f64> = json["accessors"][0]["min"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        assert!((min[0] - -0.2).abs() < 1e-6 && (min[1] - 2.0).abs() < 1e-6, "{min:?}");
+        assert!((min[2] - -1.2).abs() < 1e-6, "{min:?}");
+        // The stats' boxes are in the model's frame.
+        let [lo, hi] = stats.bounds.unwrap();
+        assert!((lo[0] - far.x).abs() < 1e-6 && (hi[2] - far.z).abs() < 1e-6, "{lo:?} {hi:?}");
+        assert_eq!(stats.lot_bounds.len(), 1);
+        assert_eq!(stats.lot_bounds[0], stats.bounds);
     }
 
     #[test]

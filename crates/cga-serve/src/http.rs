@@ -104,7 +104,11 @@ async fn glb(State(app): State<App>) -> Response {
         None => return (StatusCode::CONFLICT, "no model yet\n").into_response(),
     };
     let job = tokio::task::spawn_blocking(move || -> Result<Vec<u8>, cga::Error> {
-        let mut writer = ModelWriter::glb_in_memory(made.rules.export_options())?;
+        let export = cga::ExportOptions {
+            origin: cga::lots::local_origin(&preview.lots),
+            ..made.rules.export_options()
+        };
+        let mut writer = ModelWriter::glb_in_memory(export)?;
         made.rules.generate_lots(
             &preview.lots,
             &made.options,

@@ -49,6 +49,11 @@ pub struct TilesetOptions {
     /// How the tiles' GLBs are written (textures, data held). Tiles are
     /// always GLB, merged by material, with per-lot features.
     pub export: ExportOptions,
+    /// Each tile's positions are written relative to the centre of its
+    /// lots (whole metres), the node of its GLB translated there, so that
+    /// 32-bit floats keep their millimetres wherever the city lies (a
+    /// national grid's millions of metres); `export.origin` is not used.
+    pub tile_origins: bool,
 }
 
 impl Default for TilesetOptions {
@@ -57,6 +62,7 @@ impl Default for TilesetOptions {
             max_lots_per_tile: 64,
             max_massing_lots: 4096,
             export: ExportOptions::default(),
+            tile_origins: true,
         }
     }
 }
@@ -272,10 +278,7 @@ impl<F: FnMut(LotResult)> Writer<'_, F> {
         // The tile's lots merged by material, told apart by their feature
         // ids: a node per lot would cost more JSON than small buildings'
         // geometry.
-        let export = ExportOptions {
-            granularity: Granularity::Material,
-            ..self.tiles.export.clone()
-        };
+        let export = self.tile_export(&node.lots);
         let mut writer = ModelWriter::create(&path, Format::Glb, export).map_err(Error::Export)?;
         writer.with_features();
         writer.expect_lots(node.lots.len());
@@ -318,10 +321,7 @@ impl<F: FnMut(LotResult)> Writer<'_, F> {
         let name = format!("{}.glb", node.name());
         let path = self.tiles_dir.join(&name);
         // One mesh for the tile, the lots told apart by feature ids.
-        let export = ExportOptions {
-            granularity: Granularity::Material,
-            ..self.tiles.export.clone()
-        };
+        let export = self.tile_export(lots);
         let mut writer = ModelWriter::create(&path, Format::Glb, export).map_err(Error::Export)?;
         writer.with_features();
         let material = Material {
@@ -362,6 +362,24 @@ impl<F: FnMut(LotResult)> Writer<'_, F> {
         self.stats.contents += 1;
         self.stats.massing_triangles += stats.triangles;
         Ok(Some(format!("tiles/{name}")))
+    }
+
+    /// How a tile of `lots` is written: merged by material, from the
+    /// centre of the lots when tiles have origins.
+    fn tile_export(&self, lots: &[usize]) -> ExportOptions {
+        let origin = self.tiles.tile_origins.then(|| {
+            let b = lots
+                .iter()
+                .fold(None, |b, &i| union(b, footprint(&self.lots[i])));
+            b.map_or(DVec3::ZERO, |[lo, hi]| {
+                DVec3::new(((lo[0] + hi[0]) / 2.0).round(), 0.0, ((lo[2] + hi[2]) / 2.0).round())
+            })
+        });
+        ExportOptions {
+            granularity: Granularity::Material,
+            origin: origin.filter(|o| o.is_finite()),
+            ..self.tiles.export.clone()
+        }
     }
 
     /// Hands over the results that are next in lot order.

@@ -178,6 +178,9 @@ impl Rules {
                 return Err(Error::Cancelled);
             }
             let mut lot = self.lot_result(options.lot_index(i), &lots[i], done);
+            if let (Some(w), false) = (writer.as_deref_mut(), lot.reports.is_empty()) {
+                w.annotate_lot("reports", reports_json(&lot.reports));
+            }
             let mut warnings = self.annotation_warnings(options, &lots[i]);
             warnings.append(&mut lot.warnings);
             lot.warnings = warnings;
@@ -470,6 +473,23 @@ fn lot_extras(index: usize, lot: &Lot) -> serde_json::Value {
         .map(|(k, v)| (k.to_string(), to_json(v)))
         .collect();
     json!({ "lot": index, "attributes": attributes })
+}
+
+/// A lot's reports as its model's metadata: per key the sum of its
+/// numbers (CityEngine's report sum), or the last value of a key whose
+/// values are strings or booleans.
+fn reports_json(reports: &[(String, Value)]) -> serde_json::Value {
+    use serde_json::{Map, Value as Json};
+    let mut out: Map<String, Json> = Map::new();
+    for (key, v) in reports {
+        let value = match (v, out.get(key).and_then(Json::as_f64)) {
+            (Value::Float(x), Some(sum)) => Json::from(sum + x),
+            (Value::Float(x), None) if !out.contains_key(key) => Json::from(*x),
+            (v, _) => Json::String(crate::value_text(v)),
+        };
+        out.insert(key.clone(), value);
+    }
+    Json::Object(out)
 }
 
 /// What a worker hands over at the end of a lot.

@@ -27,6 +27,25 @@ pub struct LotSet {
     pub warnings: Vec<String>,
 }
 
+/// Where a model of `lots` is best written from
+/// ([`ExportOptions::origin`](crate::ExportOptions::origin)): the centre of
+/// the lots' box in the ground plane, in whole metres, when it lies more
+/// than [`FAR_FROM_ORIGIN`] metres from the frame's origin (lots in a
+/// national grid's metres); `None` nearer, where 32-bit floats keep a
+/// tenth of a millimetre and the model's coordinates stay the lots' own.
+pub fn local_origin(lots: &[Lot]) -> Option<DVec3> {
+    let mut points = lots.iter().flat_map(|l| l.mesh.positions.iter());
+    let first = *points.next()?;
+    let (lo, hi) = points.fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    let centre = (lo + hi) / 2.0;
+    let centre = DVec3::new(centre.x.round(), 0.0, centre.z.round());
+    (centre.is_finite() && centre.x.abs().max(centre.z.abs()) > FAR_FROM_ORIGIN).then_some(centre)
+}
+
+/// How far from the frame's origin (metres) lots must lie for
+/// [`local_origin`] to move the model's origin to them.
+pub const FAR_FROM_ORIGIN: f64 = 1000.0;
+
 /// The lot `(0,0,0) (w,0,0) (w,0,-d) (0,0,-d)`: a `w` × `d` rectangle in
 /// the x–z plane whose first edge (the street front) runs along x.
 pub fn rect(w: f64, d: f64) -> Lot {

@@ -8,6 +8,7 @@ mod cli;
 mod context;
 mod lsp;
 mod oracle;
+mod precision;
 mod texturing;
 mod tiles;
 mod workspace;

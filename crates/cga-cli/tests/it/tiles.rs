@@ -190,8 +190,8 @@ fn a_georeferenced_city_as_a_tileset() {
     let rules = rule_file(
         &dir,
         "city.cga",
-        "attr height = 10\nLot --> extrude(height) comp(f) { top : color(\"#a04030\") Roof. | side : split(y) { ~3 : Floor }* }\n\
-         Floor --> print(\"floor \" + split.index) color(rand(0.5, 1), 0.8, 0.7) X.\n",
+        "attr height = 10\nLot --> report(\"footprint\", geometry.area) report(\"use\", \"housing\") extrude(height) comp(f) { top : color(\"#a04030\") Roof. | side : split(y) { ~3 : Floor }* }\n\
+         Floor --> report(\"floors\", 1) print(\"floor \" + split.index) color(rand(0.5, 1), 0.8, 0.7) X.\n",
     );
     let tileset = dir.join("out/tileset.json");
     let out = run(&[
@@ -248,6 +248,30 @@ fn a_georeferenced_city_as_a_tileset() {
         assert_eq!(name, &format!("b{i}_{j}"));
         assert_eq!(height, &(8 + (i * 12 + j) % 7 * 3).to_string());
     }
+    // The lots' reports: numbers summed per lot (FLOAT64), text as text.
+    let leaf_glb = dir
+        .join("out")
+        .join(leaf["content"]["uri"].as_str().unwrap());
+    let (json, bin) = glb_parts(&leaf_glb);
+    let table = &json["extensions"]["EXT_structural_metadata"]["propertyTables"][0];
+    let class = &json["extensions"]["EXT_structural_metadata"]["schema"]["classes"]["lot"];
+    assert_eq!(class["properties"]["report_floors"]["componentType"], "FLOAT64");
+    assert_eq!(class["properties"]["report_floors"]["name"], "floors");
+    let numbers = |key: &str| -> Vec<f64> {
+        view_bytes(&json, &bin, &table["properties"][key]["values"])
+            .chunks(8)
+            .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+            .collect()
+    };
+    let (floors, footprint) = (numbers("report_floors"), numbers("report_footprint"));
+    let uses = strings(&json, &bin, &table["properties"]["report_use"]);
+    assert_eq!((floors.len(), footprint.len(), uses.len()), (index.len(), index.len(), index.len()));
+    for (k, i) in index.iter().enumerate() {
+        // A height of 8 + 3k metres has 3 + k floors of about 3 m a side.
+        assert_eq!(floors[k], 4.0 * (3 + *i % 7) as f64, "lot {i}");
+        assert!((footprint[k] - 600.0).abs() < 2.0, "lot {i}: {}", footprint[k]);
+        assert_eq!(uses[k], "housing");
+    }
     // The parent's massing: one mesh of every building's box (4 walls,
     // the top and the base: 12 triangles each).
     let massing = glb_json(
@@ -271,6 +295,13 @@ fn a_georeferenced_city_as_a_tileset() {
     ]);
     assert!(one.status.success());
     assert_eq!(stdout(&one), stdout(&out));
+    // Its nodes carry the same reports in their extras.
+    let json = glb_json(&glb);
+    let reports = &json["nodes"][10]["extras"]["reports"];
+    assert_eq!(json["nodes"][10]["extras"]["lot"], 10);
+    assert_eq!(reports["floors"], 4.0 * (3 + 10 % 7) as f64);
+    assert_eq!(reports["use"], "housing");
+    assert!((reports["footprint"].as_f64().unwrap() - 600.0).abs() < 2.0);
 }
 
 #[test]

@@ -41,7 +41,7 @@ const state = {
   triangles: 0, // in the tiles drawn in the last frame
   tilesDrawn: 0, // tiles with content drawn in the last frame
   frames: 0,
-  picked: null, // the lot last clicked: {index, name, attributes, tile, featureId, point, local}
+  picked: null, // the lot last clicked: {index, name, attributes, reports, tile, featureId, point, local}
 };
 window.tilesState = state;
 
@@ -390,6 +390,7 @@ function pickAt(x, y) {
     index: null,
     name: null,
     attributes: {},
+    reports: {},
     // The hit in the tileset's frame (after the root transform: ECEF for
     // a georeferenced tileset) and before the root transform (metres east,
     // north, up).
@@ -405,10 +406,14 @@ function pickAt(x, y) {
     const row = metadata.getPropertyTableData(info.propertyTable, featureId);
     const className = metadata.getPropertyTableInfo([info.propertyTable])[0].className;
     const properties = metadata.schema.classes[className].properties;
+    // The writer's columns (docs/tiles.md): `index`, `name`, `attr_NAME`
+    // and `report_KEY`, with NAME and KEY in the property's `name`.
     for (const [id, value] of Object.entries(row)) {
+      const label = properties[id]?.name || id;
       if (id === 'index') picked.index = Number(value);
       else if (id === 'name') picked.name = value;
-      else picked.attributes[properties[id]?.name || id] = value;
+      else if (id.startsWith('report_')) picked.reports[label] = typeof value === 'bigint' ? Number(value) : value;
+      else picked.attributes[label] = value;
     }
   }
   highlight(tileScene, featureId ?? NONE);
@@ -426,12 +431,22 @@ function showPicked(p) {
   title.innerHTML = '<strong>lot</strong> ';
   title.append(`${p.index ?? '?'}`, p.name !== null ? ` · ${p.name}` : '');
   const table = document.createElement('table');
-  for (const [k, v] of Object.entries(p.attributes)) {
-    const tr = table.insertRow();
-    tr.dataset.attr = k;
-    tr.insertCell().textContent = k;
-    tr.insertCell().textContent = v;
+  const rows = (values, kind) => {
+    for (const [k, v] of Object.entries(values)) {
+      const tr = table.insertRow();
+      tr.dataset[kind] = k;
+      tr.insertCell().textContent = k;
+      tr.insertCell().textContent = typeof v === 'number' ? String(Math.round(v * 1000) / 1000) : v;
+    }
+  };
+  rows(p.attributes, 'attr');
+  if (Object.keys(p.reports).length) {
+    const h = table.insertRow().insertCell();
+    h.colSpan = 2;
+    h.className = 'heading';
+    h.textContent = 'reports';
   }
+  rows(p.reports, 'report');
   const where = document.createElement('div');
   where.className = 'note';
   where.textContent = `feature ${p.featureId} of ${p.tile ? p.tile.split('/').pop() : 'a tile'}`;

@@ -1,5 +1,6 @@
 // A tileset in a real browser: `cga generate examples/building.cga --lot
-// city.geojson -o out/tileset.json` over a small city made here (150 lots
+// city.geojson -o out/tileset.json` (the rules with a report added) over a
+// small city made here (150 lots
 // in longitude/latitude, and the same city in local metres), served by a
 // static server of our own, loaded by the viewer page (web/src/tiles.js:
 // 3d-tiles-renderer and three.js) in Debian's Chromium driven by
@@ -131,13 +132,24 @@ function leaves(tile, out = []) {
   return out;
 }
 
+/// examples/building.cga, with each lot reporting its footprint's area
+/// (a report for the property table's `report_` columns).
+function writeRules(dir) {
+  const original = readFileSync(join(repo, 'examples', 'building.cga'), 'utf8');
+  const rules = original.replace('Lot -->\n', 'Lot -->\n\treport("footprint", geometry.area)\n');
+  assert.notEqual(rules, original);
+  const path = join(dir, 'building.cga');
+  writeFileSync(path, rules);
+  return path;
+}
+
 function generate(dir, name, geojson, extra = []) {
   const lots = join(dir, `${name}.geojson`);
   writeFileSync(lots, JSON.stringify(geojson));
   const out = join(dir, name, 'tileset.json');
   const run = spawnSync(
     cgaBinary(),
-    ['generate', join(repo, 'examples', 'building.cga'), '--lot', lots, ...extra, '-o', out],
+    ['generate', writeRules(dir), '--lot', lots, ...extra, '-o', out],
     { encoding: 'utf8' },
   );
   assert.equal(run.status, 0, `cga generate failed:\n${run.stdout}\n${run.stderr}`);
@@ -329,6 +341,8 @@ describe('a tileset of lots in longitude/latitude', () => {
     assert.equal(picked.attributes.floors, '18');
     assert.equal(picked.attributes.owner, 'owner 77');
     assert.equal(picked.attributes.wallColor, COLOURS[TOWER % COLOURS.length]);
+    // 20 m x 24 m, laid out in degrees with a spherical approximation.
+    assert.ok(Math.abs(picked.reports.footprint - LOT[0] * LOT[1]) < 2, JSON.stringify(picked.reports));
     assert.match(picked.tile, /\/tiles\/2_\d+_\d+\.glb$/);
     // The hit is on that roof, where the globe has it.
     const miss = Math.hypot(...picked.point.map((v, k) => v - roof[k]));
@@ -336,6 +350,7 @@ describe('a tileset of lots in longitude/latitude', () => {
     const panel = await page.locator('#picked').innerText();
     assert.match(panel, /lot\s+77 · B077/);
     assert.match(panel, /owner\s+owner 77/);
+    assert.match(panel, /footprint\s+4\d\d/);
     // Nothing failed on the way (the closer view needed no tile it had not).
     assert.deepEqual(await page.evaluate(() => window.tilesState.errors), []);
     await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
@@ -373,6 +388,7 @@ describe('a tileset of lots in local metres', () => {
     const picked = await clickRoof(page, roof);
     assert.equal(picked.index, TOWER, JSON.stringify(picked));
     assert.equal(picked.attributes.owner, 'owner 77');
+    assert.ok(Math.abs(picked.reports.footprint - LOT[0] * LOT[1]) < 1e-6, JSON.stringify(picked.reports));
     const miss = Math.hypot(...picked.point.map((v, k) => v - roof[k]));
     assert.ok(miss < 1.5, `hit ${miss.toFixed(2)} m from the roof's centre`);
   });
@@ -385,9 +401,8 @@ describe('cga serve shows a tileset beside its rules', () => {
   before(async () => {
     // `cga serve RULES` serves the viewer page and the files of the rules'
     // folder (`files/...`): a tileset written there can be opened at once.
-    writeFileSync(join(dir, 'building.cga'), readFileSync(join(repo, 'examples', 'building.cga')));
     generate(dir, 'served', cityGeojson(geographic));
-    serve = await startServer([join(dir, 'building.cga')]);
+    serve = await startServer([writeRules(dir)]);
   });
   after(async () => {
     await page?.close();

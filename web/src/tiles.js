@@ -98,10 +98,6 @@ tiles.registerPlugin(new GLTFExtensionsPlugin({ metadata: true, rtc: true }));
 // centred.
 tiles.registerPlugin(new ReorientationPlugin({ recenter: true, up: '+z' }));
 tiles.errorTarget = errorTarget;
-// A city of a few hundred tiles stays in memory: no tile is unloaded and
-// loaded again while orbiting.
-tiles.lruCache.minSize = 2000;
-tiles.lruCache.maxSize = 4000;
 tiles.setCamera(camera);
 tiles.setResolutionFromRenderer(camera, renderer);
 scene.add(tiles.group);

@@ -163,7 +163,9 @@ tiles.addEventListener('load-model', (e) => {
 tiles.addEventListener('load-error', (e) => {
   if (e.url) failed.add(e.url);
   state.failed = [...failed];
-  error(`${e.url || tilesetUrl}: ${e.error?.message || e.error}`);
+  // The root tileset itself (no tile): say how to name another one.
+  const hint = e.tile ? '' : ' (open this page as tiles.html?tileset=URL of a tileset.json)';
+  error(`${e.url || tilesetUrl}: ${e.error?.message || e.error}${hint}`);
   counts();
 });
 tiles.addEventListener('tiles-load-start', () => { state.loading = true; setStatus(); });

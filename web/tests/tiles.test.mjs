@@ -15,7 +15,7 @@ import { test, before, after, describe } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawnSync } from 'node:child_process';
 import { createServer } from 'node:http';
-import { mkdtempSync, readFileSync, writeFileSync, rmSync, mkdirSync, statSync } from 'node:fs';
+import { mkdtempSync, readFileSync, writeFileSync, rmSync, mkdirSync, statSync, unlinkSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, normalize, extname } from 'node:path';
 import { repo, cgaBinary, launchBrowser, startServer } from './harness.mjs';
@@ -424,6 +424,27 @@ describe('a coarse view draws the massing', () => {
       assert.equal(picked.index, TOWER, JSON.stringify(picked));
       assert.equal(picked.name, 'B077');
       assert.equal(picked.tile, root);
+    } finally {
+      await page.close();
+    }
+  });
+});
+
+describe('a missing tile is reported', () => {
+  test('the page lists it as failed, with an error, and says so', async () => {
+    const tileset = generate(dir, 'broken', cityGeojson(local), ['--crs', 'local']);
+    const gone = leaves(tileset.root)[0];
+    unlinkSync(join(dir, 'broken', gone));
+    const { page, state, consoleErrors } = await view('broken');
+    try {
+      const url = new URL(gone, `${http.url}/data/broken/`).href;
+      assert.deepEqual(state.failed, [url]);
+      assert.equal(state.loaded.length, contents(tileset.root).length - 1);
+      assert.equal(state.errors.length, 1);
+      assert.match(state.errors[0], /404/);
+      assert.ok(consoleErrors.length > 0);
+      assert.equal(await page.locator('#status').innerText(), '1 failed');
+      assert.ok(await page.locator('#message').isVisible());
     } finally {
       await page.close();
     }

@@ -513,6 +513,15 @@ state.cityPixels = (points = null) => {
   }
   return { box: [x0, y0, x1, y1], changed, total: withCity.length / 4 };
 };
+// The colour drawn at a point of the canvas (CSS pixels), [r, g, b].
+state.pixelAt = (x, y) => {
+  render();
+  const ratio = renderer.getPixelRatio();
+  const c = document.createElement('canvas');
+  c.width = 1; c.height = 1;
+  c.getContext('2d').drawImage(renderer.domElement, Math.floor(x * ratio), Math.floor(y * ratio), 1, 1, 0, 0, 1, 1);
+  return [...c.getContext('2d').getImageData(0, 0, 1, 1).data.slice(0, 3)];
+};
 state.pickAt = pickAt;
 state.fit = fit;
 

@@ -340,7 +340,16 @@ describe('a tileset of lots in longitude/latitude', () => {
     await page.evaluate((b) => window.tilesState.fit(b), districtBox(geojson, 0, onGlobe));
     const [lon, lat] = lotCentre(geojson, TOWER);
     const roof = ecef(lon, lat, heightOf(TOWER));
+    const colour = () => page.evaluate((p) => {
+      const at = window.tilesState.project(p);
+      return window.tilesState.pixelAt(at.x, at.y);
+    }, roof);
+    const grey = await colour();
     const picked = await clickRoof(page, roof);
+    // The picked lot is highlighted in orange: its grey roof turns warm.
+    const warm = await colour();
+    assert.ok(Math.abs(grey[0] - grey[2]) < 30, `roof before: ${grey}`);
+    assert.ok(warm[0] - warm[2] > 60, `roof after: ${warm}`);
     assert.equal(picked.index, TOWER, JSON.stringify(picked));
     assert.equal(picked.name, 'B077');
     assert.equal(picked.attributes.floors, '18');

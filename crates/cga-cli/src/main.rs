@@ -207,6 +207,11 @@ struct GenerateArgs {
     /// `none`. OBJ keeps full coordinates.
     #[arg(long, value_name = "X,Y|auto|none", default_value = "auto")]
     origin: OriginArg,
+    /// glTF/GLB/3D Tiles: write every inserted asset as geometry of its
+    /// own, instead of once per file placed as instances
+    /// (EXT_mesh_gpu_instancing), for viewers without that extension.
+    #[arg(long)]
+    no_instances: bool,
 }
 
 /// `--origin`.
@@ -229,7 +234,9 @@ impl std::str::FromStr for OriginArg {
                 match xy.split_once(',') {
                     Some((x, y)) => match (parse(x), parse(y)) {
                         (Some(x), Some(y)) => Ok(OriginArg::At(x, y)),
-                        _ => Err(format!("expected --origin X,Y with two numbers, found `{xy}`")),
+                        _ => Err(format!(
+                            "expected --origin X,Y with two numbers, found `{xy}`"
+                        )),
                     },
                     None => Err(format!("expected --origin X,Y, auto or none, found `{xy}`")),
                 }
@@ -522,6 +529,7 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
                     OriginArg::None => None,
                     OriginArg::At(x, y) => Some(cga::DVec3::new(x, 0.0, -y)),
                 },
+                instances: !args.no_instances,
                 flush_mib: args.held_mib,
                 granularity: args.granularity.unwrap_or_else(|| {
                     if lots.lots.len() > NODES_PER_LOT_UP_TO {
@@ -580,6 +588,7 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
             let tiles = cga_tiles::TilesetOptions {
                 export: ExportOptions {
                     georeference: cga_tiles::georeference(lots.origin),
+                    instances: !args.no_instances,
                     flush_mib: args.held_mib,
                     ..rules.export_options()
                 },

@@ -106,14 +106,23 @@ impl AssetStore {
             }
         }
         let value = make();
-        lock(cache).insert(
-            key.clone(),
-            Stamped {
-                stamp,
-                value: value.clone(),
-            },
-        );
-        value
+        // Two threads that asked at once made one each: the first one
+        // stored is everyone's, so that all lots share one mesh per asset
+        // (instancing tells assets apart by their mesh).
+        let mut cache = lock(cache);
+        match cache.get(key) {
+            Some(s) if s.stamp == stamp => s.value.clone(),
+            _ => {
+                cache.insert(
+                    key.clone(),
+                    Stamped {
+                        stamp,
+                        value: value.clone(),
+                    },
+                );
+                value
+            }
+        }
     }
 
     /// Refuses files larger than the limit, before reading them.
@@ -211,6 +220,10 @@ pub struct Assets {
     texture_files: Requests<Option<Arc<str>>>,
     /// `fileSearch` answers by rule file and query: a search lists folders.
     searches: Requests<Vec<String>>,
+    /// The addresses of the meshes [`Assets::mesh`] handed out (each kept
+    /// alive by the caches above or the built-ins), to tell a leaf that is
+    /// an asset as inserted from one whose geometry was made or changed.
+    handed_out: Mutex<std::collections::HashSet<usize>>,
 }
 
 /// A cache by rule file and path as written.
@@ -222,11 +235,13 @@ fn cached<T: Clone>(cache: &Requests<T>, from: FileId, path: &str, make: impl Fn
     }
     // Not under the lock: making it may take a while (loading a mesh).
     let v = make();
+    // The first answer stored wins (see `AssetStore::cached`).
     lock(cache)
         .entry(from.0)
         .or_default()
-        .insert(path.into(), v.clone());
-    v
+        .entry(path.into())
+        .or_insert(v)
+        .clone()
 }
 
 impl Assets {
@@ -244,6 +259,7 @@ impl Assets {
             mesh_requests: Default::default(),
             texture_files: Default::default(),
             searches: Default::default(),
+            handed_out: Default::default(),
         }
     }
 
@@ -324,6 +340,19 @@ impl Assets {
     /// The geometry of the asset `path`: a built-in (`builtin:cube`, ...)
     /// or an OBJ, COLLADA or glTF file, loaded once.
     pub fn mesh(&self, from: FileId, path: &str) -> Result<Arc<Mesh>, String> {
+        let mesh = self.find_mesh(from, path)?;
+        lock(&self.handed_out).insert(Arc::as_ptr(&mesh) as usize);
+        Ok(mesh)
+    }
+
+    /// Whether `mesh` is an asset as [`Assets::mesh`] gave it: one mesh
+    /// shared by every shape that inserted the asset and changed nothing
+    /// of its geometry since (writers may write it once, as instances).
+    pub fn is_asset(&self, mesh: &Arc<Mesh>) -> bool {
+        lock(&self.handed_out).contains(&(Arc::as_ptr(mesh) as usize))
+    }
+
+    fn find_mesh(&self, from: FileId, path: &str) -> Result<Arc<Mesh>, String> {
         if let Some(name) = path.strip_prefix("builtin:") {
             return builtin_geometry(name)
                 .ok_or_else(|| format!("there is no built-in asset \"{path}\""));

@@ -236,6 +236,10 @@ pub struct Leaf {
     /// The materials of the mesh's slots: its own with the shape's material
     /// attributes applied and texture paths resolved to files.
     pub materials: SharedVec<Material>,
+    /// The mesh is an inserted asset as loaded (`i()` and nothing that
+    /// changed its geometry since), shared with every other insert of it:
+    /// a writer may write it once and place it as instances.
+    pub asset: bool,
     /// The rule whose application made this leaf (`None`: the initial
     /// shape itself, when no rule ran).
     pub rule: Option<RuleId>,
@@ -897,6 +901,7 @@ impl<'a> Interp<'a> {
         let materials = self.leaf_materials(shape, &mesh.materials);
         if self.keep_leaves {
             let leaf = Leaf {
+                asset: self.assets.is_asset(mesh),
                 mesh: mesh.clone(),
                 transform: shape.object_transform(),
                 materials,

@@ -16,6 +16,7 @@ use cga_geometry::{DAffine3, DVec2, DVec3, Material, Mesh, UV_SETS};
 
 use crate::bucket::{too_many_vertices, Bucket};
 use crate::gltf::{bucket_layout, face_tangent, texture_uses};
+use crate::instances::{decompose, Pending};
 use crate::materials::MaterialTable;
 use crate::prepare::{FacePrep, SlotIds};
 use crate::textures::TextureProbe;
@@ -37,6 +38,8 @@ pub struct Encoded {
     pub(crate) bytes: usize,
     /// The first invalid mesh given, which fails the model.
     pub(crate) error: Option<ExportError>,
+    /// Assets placed as instances, in order (see `instances`).
+    pub(crate) instances: Vec<Pending>,
     /// Emptied buckets of an earlier use of this batch, whose room new
     /// materials take.
     spare: Vec<Bucket>,
@@ -45,7 +48,10 @@ pub struct Encoded {
 impl Encoded {
     /// Whether nothing was encoded (and nothing failed).
     pub fn is_empty(&self) -> bool {
-        self.faces == 0 && self.skipped_non_finite == 0 && self.error.is_none()
+        self.faces == 0
+            && self.skipped_non_finite == 0
+            && self.error.is_none()
+            && self.instances.is_empty()
     }
 
     /// A bucket for a new material of the batch, in the room of an old one
@@ -71,6 +77,7 @@ impl Encoded {
         self.skipped_non_finite = 0;
         self.bytes = 0;
         self.error = None;
+        self.instances.clear();
     }
 }
 
@@ -81,16 +88,23 @@ pub(crate) struct EncoderShared {
     pub probe: TextureProbe,
     /// What every encoder writes positions relative to.
     pub origin: Option<DVec3>,
+    /// Whether assets are placed as instances (`ExportOptions::instances`).
+    pub instancing: bool,
     /// Batches the writer has appended, for encoders to fill again: their
     /// arrays keep their room, so a running model allocates no more.
     pool: Mutex<Vec<Encoded>>,
 }
 
 impl EncoderShared {
-    pub(crate) fn new(probe: TextureProbe, origin: Option<DVec3>) -> EncoderShared {
+    pub(crate) fn new(
+        probe: TextureProbe,
+        origin: Option<DVec3>,
+        instancing: bool,
+    ) -> EncoderShared {
         EncoderShared {
             probe,
             origin,
+            instancing,
             pool: Mutex::new(Vec::new()),
         }
     }
@@ -276,6 +290,26 @@ impl Encoder {
         }
     }
 
+    /// An inserted asset as loaded (the engine's `Leaf::asset`), placed by
+    /// `transform`: kept as an instance of its mesh when the writer writes
+    /// instances and `transform` is a rotation and scale, else encoded as
+    /// [`add_placed`](Encoder::add_placed) does.
+    pub fn add_asset(
+        &mut self,
+        mesh: &Arc<Mesh>,
+        transform: &DAffine3,
+        materials: &SharedVec<Material>,
+    ) {
+        match instance(self.shared.instancing, mesh, transform, materials) {
+            Some(p) => {
+                self.batch.instances.push(p);
+                // A placement is a few dozen bytes on its way.
+                self.batch.bytes += 64;
+            }
+            None => self.add_placed(mesh, Some(transform), materials),
+        }
+    }
+
     /// Bytes of vertex data encoded since the last [`take`](Encoder::take).
     pub fn bytes(&self) -> usize {
         self.batch.bytes
@@ -291,6 +325,26 @@ impl Encoder {
         self.mesh.forget_ids();
         batch
     }
+}
+
+/// The placement of an asset as an instance, if instancing is on and
+/// `transform` is a TRS.
+pub(crate) fn instance(
+    instancing: bool,
+    mesh: &Arc<Mesh>,
+    transform: &DAffine3,
+    materials: &SharedVec<Material>,
+) -> Option<Pending> {
+    if !instancing || mesh.faces.is_empty() {
+        return None;
+    }
+    let trs = decompose(transform)?;
+    Some(Pending {
+        mesh: mesh.clone(),
+        materials: materials.clone(),
+        transform: *transform,
+        trs,
+    })
 }
 
 /// Identifies a vertex at one position of an input mesh that carries its

@@ -38,12 +38,13 @@ use std::path::{Path, PathBuf};
 
 use std::sync::Arc;
 
-use cga_geometry::{DVec3, Material};
+use cga_geometry::{DAffine3, DVec3, Material};
 use gltf_json as json;
 use json::validation::{Checked::Valid, USize64};
 
 use crate::bucket::Bucket;
 use crate::encode::Buckets;
+use crate::instances::{Instances, Pending, Trs};
 use crate::materials::{color_to_linear, MaterialTable};
 use crate::textures::{uri_encode, Textures};
 use crate::{ExportError, ExportStats, FaceData};
@@ -177,6 +178,42 @@ impl Buckets for ModelBuckets<'_> {
 
     fn bucket(&mut self, id: u32) -> &mut Bucket {
         &mut self.writer.buckets[id as usize]
+    }
+}
+
+/// An instanced asset's buckets, for encoding its mesh once: materials
+/// get their model ids (and glTF materials) as for [`ModelBuckets`], and
+/// buckets of their own laid out as the model's of the same material.
+pub(crate) struct GroupBuckets<'a> {
+    pub writer: &'a mut GltfWriter,
+    pub table: &'a mut MaterialTable,
+    pub textures: &'a mut Textures,
+    pub warnings: &'a mut Vec<String>,
+    pub buckets: Vec<(u32, Bucket)>,
+}
+
+impl Buckets for GroupBuckets<'_> {
+    fn id_of(&mut self, m: &Material) -> u32 {
+        let (id, new) = self.table.intern(m);
+        if new {
+            self.writer
+                .new_material(self.table.get(id), self.textures, self.warnings);
+        }
+        if !self.buckets.iter().any(|(i, _)| *i == id) {
+            let model = &self.writer.buckets[id as usize];
+            let bucket = Bucket::with_layout(model.sets.clone(), model.tangents.is_some());
+            self.buckets.push((id, bucket));
+        }
+        id
+    }
+
+    fn bucket(&mut self, id: u32) -> &mut Bucket {
+        let k = self
+            .buckets
+            .iter()
+            .position(|(i, _)| *i == id)
+            .expect("id_of made it");
+        &mut self.buckets[k].1
     }
 }
 
@@ -404,10 +441,7 @@ fn property_table(root: &mut json::Root, layout: &mut Layout, lots: &[LotNode]) 
                 id.clone(),
                 json!({"type": "SCALAR", "componentType": "FLOAT64", "name": key}),
             );
-            table.insert(
-                id,
-                json!({"values": view(root, layout, &mut tail, &bytes)}),
-            );
+            table.insert(id, json!({"values": view(root, layout, &mut tail, &bytes)}));
         } else {
             let values = values.into_iter().map(text_of).collect();
             class.insert(id.clone(), json!({"type": "STRING", "name": key}));
@@ -483,6 +517,27 @@ fn text_of(v: Option<&serde_json::Value>) -> String {
     }
 }
 
+/// The instances' data laid out: each group's primitives (with their
+/// material ids), and per node its lot (if per lot), group and
+/// `EXT_mesh_gpu_instancing` attributes.
+#[derive(Default)]
+struct LaidOutInstances {
+    group_primitives: Vec<Vec<(u32, json::mesh::Primitive)>>,
+    nodes: Vec<(Option<u32>, u32, serde_json::Map<String, serde_json::Value>)>,
+}
+
+/// The box around two boxes.
+fn union_bounds(a: Option<[[f64; 3]; 2]>, b: Option<[[f64; 3]; 2]>) -> Option<[[f64; 3]; 2]> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some([
+            std::array::from_fn(|k| a[0][k].min(b[0][k])),
+            std::array::from_fn(|k| a[1][k].max(b[1][k])),
+        ]),
+        (a, None) => a,
+        (None, b) => b,
+    }
+}
+
 /// The box around primitives (min, max), if there are any.
 fn bounds_of(primitives: &[&PrimitiveLayout]) -> Option<[[f64; 3]; 2]> {
     let first = primitives.first()?;
@@ -499,29 +554,24 @@ fn bounds_of(primitives: &[&PrimitiveLayout]) -> Option<[[f64; 3]; 2]> {
 /// A node to write: its name, extras and primitives (with their material
 /// ids).
 type NodeGroup = (
+    Option<u32>,
     String,
     Option<serde_json::Value>,
     Vec<(u32, json::mesh::Primitive)>,
 );
 
-/// The primitives of each lot (in the order written) with the lot's name
-/// and extras; lots without geometry get no node, primitives added before
-/// the first lot a node `model`.
+/// The primitives of each lot (in the order written) with the lot's
+/// position, name and extras (the caller leaves out lots with neither
+/// geometry nor instances); primitives added before the first lot are a
+/// node `model`.
 #[allow(clippy::type_complexity)]
-fn lot_groups(
-    lots: Vec<LotNode>,
-    primitives: Vec<(u32, json::mesh::Primitive)>,
-) -> Vec<(
-    String,
-    Option<serde_json::Value>,
-    Vec<(u32, json::mesh::Primitive)>,
-)> {
+fn lot_groups(lots: Vec<LotNode>, primitives: Vec<(u32, json::mesh::Primitive)>) -> Vec<NodeGroup> {
     let mut groups = Vec::with_capacity(lots.len() + 1);
     let mut rest = primitives.into_iter();
     let first = lots.first().map_or(0, |l| l.first);
     let before: Vec<_> = rest.by_ref().take(first).collect();
     if !before.is_empty() {
-        groups.push(("model".to_string(), None, before));
+        groups.push((None, "model".to_string(), None, before));
     }
     let ends: Vec<Option<usize>> = lots
         .iter()
@@ -529,14 +579,13 @@ fn lot_groups(
         .map(|l| Some(l.first))
         .chain([None])
         .collect();
-    for (lot, end) in lots.into_iter().zip(ends) {
+    // Lots without primitives too: their instances still need a node.
+    for (k, (lot, end)) in lots.into_iter().zip(ends).enumerate() {
         let prims: Vec<_> = match end {
             Some(end) => rest.by_ref().take(end - lot.first).collect(),
             None => rest.by_ref().collect(),
         };
-        if !prims.is_empty() {
-            groups.push((lot.name, lot.extras, prims));
-        }
+        groups.push((Some(k as u32), lot.name, lot.extras, prims));
     }
     groups
 }
@@ -597,10 +646,17 @@ pub(crate) struct GltfWriter {
     features: bool,
     /// The property table's bytes, written after everything else.
     tail: Vec<u8>,
+    /// The instances' bytes, written after the held primitives.
+    middle: Vec<u8>,
     /// With features: the box of each lot's vertices so far.
     feature_bounds: Vec<Option<[[f64; 3]; 2]>>,
     /// The point positions are relative to: every node's translation.
     origin: Option<DVec3>,
+    /// Assets placed as instances, and the boxes of their placements
+    /// (relative to the origin), over all and per lot.
+    pub(crate) instances: Instances,
+    instance_bounds: Option<[[f64; 3]; 2]>,
+    instance_lot_bounds: Vec<Option<[[f64; 3]; 2]>>,
 }
 
 /// A lot's node: its name and `extras`, and the first of its primitives in
@@ -677,8 +733,41 @@ impl GltfWriter {
             json_room: GLB_JSON_ROOM,
             features: false,
             tail: Vec::new(),
+            middle: Vec::new(),
             feature_bounds: Vec::new(),
             origin: None,
+            instances: Instances::default(),
+            instance_bounds: None,
+            instance_lot_bounds: Vec::new(),
+        }
+    }
+
+    /// Places `group` as `p` says (in the model's frame), in the lot begun
+    /// last.
+    pub(crate) fn place_instance(&mut self, group: u32, p: &Pending) {
+        let lot = if self.per_lot || self.features {
+            self.lots.len().checked_sub(1).map(|l| l as u32)
+        } else {
+            None
+        };
+        let shifted = match self.origin {
+            Some(o) => DAffine3::from_translation(-o) * p.transform,
+            None => p.transform,
+        };
+        let trs = Trs {
+            translation: shifted.translation,
+            ..p.trs
+        };
+        let Some(b) = self.instances.place(group, lot, &trs, &shifted) else {
+            return;
+        };
+        self.instance_bounds = union_bounds(self.instance_bounds, Some(b));
+        if let Some(lot) = lot {
+            let lot = lot as usize;
+            if self.instance_lot_bounds.len() <= lot {
+                self.instance_lot_bounds.resize(lot + 1, None);
+            }
+            self.instance_lot_bounds[lot] = union_bounds(self.instance_lot_bounds[lot], Some(b));
         }
     }
 
@@ -831,8 +920,16 @@ impl GltfWriter {
             true => (PER_PRIMITIVE + 250, PER_LOT + 64),
             false => (PER_PRIMITIVE, PER_LOT),
         };
-        let per_lot = primitives * per_primitive + per_lot + extras;
-        let room = (lots as u64).saturating_mul(per_lot) / 4 * 5;
+        // Instances: per lot a node per asset seen so far, with its
+        // placements' accessors and views, and each asset's mesh once.
+        const PER_INSTANCE_NODE: u64 = 1000;
+        let groups = self.instances.groups.len() as u64;
+        let per_lot = primitives * per_primitive + per_lot + extras + groups * PER_INSTANCE_NODE;
+        let room = (lots as u64)
+            .saturating_mul(per_lot)
+            .saturating_add(groups * 2 * PER_PRIMITIVE)
+            / 4
+            * 5;
         // Small models (3D Tiles' tiles) get small room: should the JSON
         // not fit, moving a small file's data up costs little.
         room.clamp(MIN_ESTIMATED_ROOM, 256 << 20) / 4 * 4
@@ -928,7 +1025,8 @@ impl GltfWriter {
 
         // Once anything was written early, every primitive of a material
         // carries each of its UV sets (the material names the set to read).
-        let early = !self.written.is_empty();
+        // Instances' primitives carry every UV set of their materials too.
+        let early = !self.written.is_empty() || !self.instances.is_empty();
         for b in &mut self.buckets {
             if early {
                 b.unmerged_coords();
@@ -953,6 +1051,7 @@ impl GltfWriter {
             used[p.material as usize] = true;
             stats.vertices += p.vertices;
         }
+        let laid_out = self.lay_out_instances(&mut root, &mut layout, &mut used, stats);
         let layouts: Vec<&PrimitiveLayout> = self.written.iter().chain(&held).collect();
         stats.bounds = bounds_of(&layouts);
         if self.features {
@@ -963,6 +1062,13 @@ impl GltfWriter {
             for (k, &start) in starts.iter().enumerate() {
                 let end = starts.get(k + 1).copied().unwrap_or(layouts.len());
                 stats.lot_bounds.push(bounds_of(&layouts[start..end]));
+            }
+        }
+        stats.bounds = union_bounds(stats.bounds, self.instance_bounds);
+        if self.per_lot || self.features {
+            stats.lot_bounds.resize(self.lots.len(), None);
+            for (b, i) in stats.lot_bounds.iter_mut().zip(&self.instance_lot_bounds) {
+                *b = union_bounds(*b, *i);
             }
         }
         // The stats' boxes are in the model's frame.
@@ -1020,6 +1126,10 @@ impl GltfWriter {
             )));
             stats.materials += 1;
         }
+        // Instances: a mesh per group, a node per lot (or per model) and
+        // group; a lot's are children of its node.
+        let (mut lot_children, root_instances) =
+            self.instance_nodes(&mut root, laid_out, &gltf_materials);
         // Meshes and nodes: one per lot, or one per material.
         let groups: Vec<NodeGroup> = if self.per_lot && !self.lots.is_empty() {
             lot_groups(self.lots.clone(), primitives)
@@ -1033,26 +1143,33 @@ impl GltfWriter {
                 .into_iter()
                 .enumerate()
                 .filter(|(_, prims)| !prims.is_empty())
-                .map(|(id, prims)| (table.name(id as u32).to_string(), None, prims))
+                .map(|(id, prims)| (None, table.name(id as u32).to_string(), None, prims))
                 .collect()
         };
-        for (name, extras, prims) in groups {
-            let primitives = prims
+        for (lot, name, extras, prims) in groups {
+            let children = lot.and_then(|l| lot_children.remove(&l));
+            if prims.is_empty() && children.is_none() {
+                continue;
+            }
+            let primitives: Vec<_> = prims
                 .into_iter()
                 .map(|(id, p)| json::mesh::Primitive {
                     material: gltf_materials[id as usize],
                     ..p
                 })
                 .collect();
-            let mesh = root.push(json::Mesh {
-                extensions: None,
-                extras: Default::default(),
-                name: Some(name.clone()),
-                primitives,
-                weights: None,
+            let mesh = (!primitives.is_empty()).then(|| {
+                root.push(json::Mesh {
+                    extensions: None,
+                    extras: Default::default(),
+                    name: Some(name.clone()),
+                    primitives,
+                    weights: None,
+                })
             });
             nodes.push(root.push(json::Node {
-                mesh: Some(mesh),
+                mesh,
+                children,
                 name: Some(name),
                 extras: extras.and_then(|v| serde_json::value::to_raw_value(&v).ok()),
                 // glTF's JSON holds the translation as f32; numbers in
@@ -1062,6 +1179,7 @@ impl GltfWriter {
                 ..Default::default()
             }));
         }
+        nodes.extend(root_instances);
         stats.textures = images.len() as u64;
         if self.embed_images {
             // Images go after all geometry, in the order `write_bin` writes them.
@@ -1126,6 +1244,7 @@ impl GltfWriter {
                 };
                 let held = Held {
                     buckets: &self.buckets,
+                    middle: &self.middle,
                     tail: &self.tail,
                 };
                 write_bin(&mut w, &held, &[], textures, &bin_path)?;
@@ -1139,6 +1258,154 @@ impl GltfWriter {
         self.out
             .into_inner()
             .map_err(|e| ExportError::io(&path, e.into_error()))
+    }
+
+    /// Lays out the instances' data after the held primitives (its bytes
+    /// go into `self.middle`, written after them): each group's primitives,
+    /// then per node the placements' translations, rotations, scales (and
+    /// feature ids). Marks the groups' materials used.
+    fn lay_out_instances(
+        &mut self,
+        root: &mut json::Root,
+        layout: &mut Layout,
+        used: &mut [bool],
+        stats: &mut ExportStats,
+    ) -> LaidOutInstances {
+        use json::accessor::{ComponentType, Type};
+        let mut out = LaidOutInstances::default();
+        if self.instances.is_empty() {
+            return out;
+        }
+        let bytes = &mut self.middle;
+        for group in &mut self.instances.groups {
+            let mut prims = Vec::new();
+            for (id, b) in group
+                .buckets
+                .iter_mut()
+                .filter(|(_, b)| !b.indices.is_empty())
+            {
+                b.unmerged_coords();
+                b.write_arrays(bytes).expect("writing into memory");
+                let p = b.primitive(*id);
+                prims.push((*id, primitive_accessors(root, layout, &p)));
+                used[*id as usize] = true;
+                stats.vertices += p.vertices;
+            }
+            out.group_primitives.push(prims);
+        }
+        for ((lot, group), placements) in self.instances.nodes(self.per_lot) {
+            let all = &self.instances.placements;
+            let mut accessor = |root: &mut json::Root, data: &[f32], width: usize, type_| {
+                write_le(bytes, data).expect("writing into memory");
+                layout.accessor(
+                    root,
+                    data.len(),
+                    (data.len() / width) as u64,
+                    type_,
+                    ComponentType::F32,
+                    None,
+                )
+            };
+            let of = |f: &dyn Fn(&crate::instances::Placement) -> Vec<f32>| -> Vec<f32> {
+                placements.iter().flat_map(|&k| f(&all[k])).collect()
+            };
+            let mut attributes = serde_json::Map::new();
+            let t = accessor(root, &of(&|p| p.translation.to_vec()), 3, Type::Vec3);
+            attributes.insert("TRANSLATION".into(), t.value().into());
+            let r = accessor(root, &of(&|p| p.rotation.to_vec()), 4, Type::Vec4);
+            attributes.insert("ROTATION".into(), r.value().into());
+            let s = accessor(root, &of(&|p| p.scale.to_vec()), 3, Type::Vec3);
+            attributes.insert("SCALE".into(), s.value().into());
+            if self.features {
+                // Each placement's lot as its feature id (EXT_instance_features).
+                let ids = of(&|p| vec![p.lot.unwrap_or(0) as f32]);
+                let f = accessor(root, &ids, 1, Type::Scalar);
+                attributes.insert("_FEATURE_ID_0".into(), f.value().into());
+            }
+            out.nodes.push((lot, group, attributes));
+        }
+        out
+    }
+
+    /// The instances' meshes and nodes: the nodes of each lot (its
+    /// children) by lot position, and those of the whole model.
+    fn instance_nodes(
+        &self,
+        root: &mut json::Root,
+        laid_out: LaidOutInstances,
+        gltf_materials: &[Option<json::Index<json::Material>>],
+    ) -> (
+        HashMap<u32, Vec<json::Index<json::Node>>>,
+        Vec<json::Index<json::Node>>,
+    ) {
+        let mut by_lot: HashMap<u32, Vec<json::Index<json::Node>>> = HashMap::new();
+        let mut top = Vec::new();
+        if laid_out.nodes.is_empty() {
+            return (by_lot, top);
+        }
+        let meshes: Vec<Option<json::Index<json::Mesh>>> = laid_out
+            .group_primitives
+            .into_iter()
+            .enumerate()
+            .map(|(g, prims)| {
+                (!prims.is_empty()).then(|| {
+                    root.push(json::Mesh {
+                        extensions: None,
+                        extras: Default::default(),
+                        name: Some(format!("asset {g}")),
+                        primitives: prims
+                            .into_iter()
+                            .map(|(id, p)| json::mesh::Primitive {
+                                material: gltf_materials[id as usize],
+                                ..p
+                            })
+                            .collect(),
+                        weights: None,
+                    })
+                })
+            })
+            .collect();
+        for (lot, group, attributes) in laid_out.nodes {
+            let Some(mesh) = meshes[group as usize] else {
+                continue;
+            };
+            let mut others = serde_json::Map::new();
+            others.insert(
+                "EXT_mesh_gpu_instancing".into(),
+                serde_json::json!({ "attributes": attributes }),
+            );
+            if self.features {
+                others.insert(
+                    "EXT_instance_features".into(),
+                    serde_json::json!({"featureIds": [{
+                        "featureCount": self.lots.len(), "attribute": 0, "propertyTable": 0,
+                    }]}),
+                );
+            }
+            let node = root.push(json::Node {
+                mesh: Some(mesh),
+                name: Some(format!("asset {group}")),
+                extensions: Some(json::extensions::scene::Node { others }),
+                // A lot's node carries the origin for its children.
+                translation: match lot {
+                    Some(_) => None,
+                    None => self.origin.map(|o| o.as_vec3().to_array()),
+                },
+                ..Default::default()
+            });
+            match lot {
+                Some(l) => by_lot.entry(l).or_default().push(node),
+                None => top.push(node),
+            }
+        }
+        for name in ["EXT_mesh_gpu_instancing"] {
+            root.extensions_used.push(name.into());
+            root.extensions_required.push(name.into());
+        }
+        if self.features {
+            root.extensions_used.push("EXT_instance_features".into());
+        }
+        (by_lot, top)
     }
 
     fn write_glb(
@@ -1165,6 +1432,7 @@ impl GltfWriter {
         if bin_len > 0 {
             let held = Held {
                 buckets: &self.buckets,
+                middle: &self.middle,
                 tail: &self.tail,
             };
             write_bin(out, &held, images, textures, &path)?;
@@ -1187,6 +1455,7 @@ impl GltfWriter {
         let io = |e| ExportError::io(&path, e);
         let held = Held {
             buckets: &self.buckets,
+            middle: &self.middle,
             tail: &self.tail,
         };
         write_bin(&mut self.out, &held, images, textures, &path)?;
@@ -1586,6 +1855,7 @@ fn write_bin(
     for b in held.buckets.iter().filter(|b| !b.indices.is_empty()) {
         b.write_arrays(w).map_err(io)?;
     }
+    w.write_all(held.middle).map_err(io)?;
     for &t in images {
         let tex = textures.get(t);
         w.write_all(&textures.bytes(t)?).map_err(io)?;
@@ -1599,6 +1869,8 @@ fn write_bin(
 /// images, then `tail` (the property table).
 struct Held<'a> {
     buckets: &'a [Bucket],
+    /// The instances' data.
+    middle: &'a [u8],
     tail: &'a [u8],
 }
 

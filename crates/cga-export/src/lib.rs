@@ -32,6 +32,7 @@ mod encode;
 mod faces;
 mod gltf;
 mod hash;
+mod instances;
 mod materials;
 mod obj;
 mod plain;
@@ -116,6 +117,11 @@ pub struct ExportOptions {
     /// `asset.extras.origin`. OBJ writes full coordinates (its numbers are
     /// text) and ignores it.
     pub origin: Option<DVec3>,
+    /// glTF and GLB: assets inserted with `i()` and left unchanged are
+    /// written once per (mesh, materials) and placed as instances
+    /// (`EXT_mesh_gpu_instancing`, see [`ModelWriter::add_asset`]); off,
+    /// every placement is written as geometry of its own.
+    pub instances: bool,
 }
 
 impl ExportOptions {
@@ -169,6 +175,7 @@ impl Default for ExportOptions {
             world: Arc::new(cga_world::DiskWorld),
             granularity: Granularity::Lot,
             origin: None,
+            instances: true,
         }
     }
 }
@@ -422,6 +429,7 @@ impl ModelWriter {
         let encoders = Arc::new(EncoderShared::new(
             TextureProbe::new(options.world.clone(), &options.texture_roots),
             options.origin,
+            options.instances,
         ));
         let textures = Textures::new(
             options.world.clone(),
@@ -513,6 +521,60 @@ impl ModelWriter {
         }
     }
 
+    /// Adds an inserted asset as loaded (the engine's `Leaf::asset`: a mesh
+    /// shared by every insert of the asset), placed by `transform`, with
+    /// `materials`. glTF and GLB with [`ExportOptions::instances`] write
+    /// the mesh once per (mesh, materials) and each placement that is a
+    /// rotation and scale as an instance (`EXT_mesh_gpu_instancing`); other
+    /// placements, and OBJ, as [`add_placed`](Self::add_placed) does.
+    pub fn add_asset(
+        &mut self,
+        mesh: &Arc<Mesh>,
+        transform: &DAffine3,
+        materials: &SharedVec<Material>,
+    ) -> Result<(), ExportError> {
+        let instancing = matches!(self.sink, Sink::Gltf(..)) && self.encoders.instancing;
+        match encode::instance(instancing, mesh, transform, materials) {
+            Some(p) => self.place(p),
+            None => self.add_placed(mesh, Some(transform), materials),
+        }
+    }
+
+    /// Places an instance: its group found, or made by encoding its mesh.
+    fn place(&mut self, p: instances::Pending) -> Result<(), ExportError> {
+        let Sink::Gltf(w, _) = &mut self.sink else {
+            return self.add_placed(&p.mesh, Some(&p.transform), &p.materials);
+        };
+        let group = match w.instances.find(&p.mesh, &p.materials) {
+            Some(g) => g,
+            None => {
+                check_mesh(&p.mesh, p.materials.len())?;
+                let mut store = gltf::GroupBuckets {
+                    writer: w,
+                    table: &mut self.table,
+                    textures: &mut self.textures,
+                    warnings: &mut self.stats.warnings,
+                    buckets: Vec::new(),
+                };
+                let c = MeshEncoder::default().encode(&p.mesh, None, &p.materials, &mut store)?;
+                let buckets = store.buckets;
+                self.skipped_non_finite += c.skipped_non_finite;
+                w.instances.add_group(
+                    p.mesh.clone(),
+                    p.materials.clone(),
+                    buckets,
+                    c.faces,
+                    c.triangles,
+                )
+            }
+        };
+        let g = &w.instances.groups[group as usize];
+        self.stats.faces += g.faces;
+        self.stats.triangles += g.triangles;
+        w.place_instance(group, &p);
+        Ok(())
+    }
+
     /// Gives the vertices of each lot begun the lot's feature id (also
     /// when merged by material), and writes a property table of the lots (index,
     /// name, attributes): `EXT_mesh_features` and
@@ -601,6 +663,9 @@ impl ModelWriter {
         self.stats.faces += batch.faces;
         self.stats.triangles += batch.triangles;
         self.skipped_non_finite += batch.skipped_non_finite;
+        for p in batch.instances.drain(..) {
+            self.place(p)?;
+        }
         self.encoders.recycle(batch);
         Ok(())
     }
@@ -863,11 +928,17 @@ mod tests {
             .iter()
             .map(|v| v.as_f64().unwrap())
             .collect();
-        assert!((min[0] - -0.2).abs() < 1e-6 && (min[1] - 2.0).abs() < 1e-6, "{min:?}");
+        assert!(
+            (min[0] - -0.2).abs() < 1e-6 && (min[1] - 2.0).abs() < 1e-6,
+            "{min:?}"
+        );
         assert!((min[2] - -1.2).abs() < 1e-6, "{min:?}");
         // The stats' boxes are in the model's frame.
         let [lo, hi] = stats.bounds.unwrap();
-        assert!((lo[0] - far.x).abs() < 1e-6 && (hi[2] - far.z).abs() < 1e-6, "{lo:?} {hi:?}");
+        assert!(
+            (lo[0] - far.x).abs() < 1e-6 && (hi[2] - far.z).abs() < 1e-6,
+            "{lo:?} {hi:?}"
+        );
         assert_eq!(stats.lot_bounds.len(), 1);
         assert_eq!(stats.lot_bounds[0], stats.bounds);
     }

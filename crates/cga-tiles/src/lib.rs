@@ -372,7 +372,11 @@ impl<F: FnMut(LotResult)> Writer<'_, F> {
                 .iter()
                 .fold(None, |b, &i| union(b, footprint(&self.lots[i])));
             b.map_or(DVec3::ZERO, |[lo, hi]| {
-                DVec3::new(((lo[0] + hi[0]) / 2.0).round(), 0.0, ((lo[2] + hi[2]) / 2.0).round())
+                DVec3::new(
+                    ((lo[0] + hi[0]) / 2.0).round(),
+                    0.0,
+                    ((lo[2] + hi[2]) / 2.0).round(),
+                )
             })
         });
         ExportOptions {

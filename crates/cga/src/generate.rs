@@ -504,9 +504,10 @@ struct Done {
 /// Writes a piece of a lot's output.
 fn write_piece(w: &mut ModelWriter, piece: Piece) -> Result<(), cga_export::ExportError> {
     match piece {
-        Piece::Leaves(batch) => batch
-            .iter()
-            .try_for_each(|leaf| w.add_placed(&leaf.mesh, Some(&leaf.transform), &leaf.materials)),
+        Piece::Leaves(batch) => batch.iter().try_for_each(|leaf| match leaf.asset {
+            true => w.add_asset(&leaf.mesh, &leaf.transform, &leaf.materials),
+            false => w.add_placed(&leaf.mesh, Some(&leaf.transform), &leaf.materials),
+        }),
         Piece::Encoded(batch) => w.append(batch),
     }
 }
@@ -550,7 +551,10 @@ impl Batcher {
                 }
             }
             Batcher::Encode(encoder, n) => {
-                encoder.add_placed(&leaf.mesh, Some(&leaf.transform), &leaf.materials);
+                match leaf.asset {
+                    true => encoder.add_asset(&leaf.mesh, &leaf.transform, &leaf.materials),
+                    false => encoder.add_placed(&leaf.mesh, Some(&leaf.transform), &leaf.materials),
+                }
                 *n += 1;
                 if *n == LEAF_BATCH || encoder.bytes() >= ENCODED_BATCH_BYTES {
                     *n = 0;

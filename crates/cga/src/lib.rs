@@ -45,8 +45,8 @@ mod values;
 
 pub use attributes::{Annotation, Attribute, Range};
 pub use cga_engine::Workspaces;
-pub use cga_geometry::DVec3;
 pub use cga_export::{ExportOptions, ExportStats, Format, Georeference, Granularity, ModelWriter};
+pub use cga_geometry::DVec3;
 pub use cga_value::{Array, Value, ValueType};
 pub use cga_world::{decode_text, ConfinedWorld, DiskWorld, MemoryWorld, Metadata, World};
 pub use diagnostics::{Diagnostic, Location, Severity};

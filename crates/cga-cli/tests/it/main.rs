@@ -6,6 +6,7 @@ mod common;
 mod bad_inputs;
 mod cli;
 mod context;
+mod instances;
 mod lsp;
 mod oracle;
 mod precision;

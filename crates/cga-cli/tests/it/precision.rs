@@ -54,7 +54,9 @@ fn lots(dir: &Path) -> PathBuf {
 /// z on the front or back of a lot.
 fn error(p: [f64; 3]) -> f64 {
     let near = |v: f64, candidates: &mut dyn Iterator<Item = f64>| {
-        candidates.map(|c| (v - c).abs()).fold(f64::INFINITY, f64::min)
+        candidates
+            .map(|c| (v - c).abs())
+            .fold(f64::INFINITY, f64::min)
     };
     let ex = near(
         p[0],

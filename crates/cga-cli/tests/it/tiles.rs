@@ -255,7 +255,10 @@ fn a_georeferenced_city_as_a_tileset() {
     let (json, bin) = glb_parts(&leaf_glb);
     let table = &json["extensions"]["EXT_structural_metadata"]["propertyTables"][0];
     let class = &json["extensions"]["EXT_structural_metadata"]["schema"]["classes"]["lot"];
-    assert_eq!(class["properties"]["report_floors"]["componentType"], "FLOAT64");
+    assert_eq!(
+        class["properties"]["report_floors"]["componentType"],
+        "FLOAT64"
+    );
     assert_eq!(class["properties"]["report_floors"]["name"], "floors");
     let numbers = |key: &str| -> Vec<f64> {
         view_bytes(&json, &bin, &table["properties"][key]["values"])
@@ -265,11 +268,18 @@ fn a_georeferenced_city_as_a_tileset() {
     };
     let (floors, footprint) = (numbers("report_floors"), numbers("report_footprint"));
     let uses = strings(&json, &bin, &table["properties"]["report_use"]);
-    assert_eq!((floors.len(), footprint.len(), uses.len()), (index.len(), index.len(), index.len()));
+    assert_eq!(
+        (floors.len(), footprint.len(), uses.len()),
+        (index.len(), index.len(), index.len())
+    );
     for (k, i) in index.iter().enumerate() {
         // A height of 8 + 3k metres has 3 + k floors of about 3 m a side.
         assert_eq!(floors[k], 4.0 * (3 + *i % 7) as f64, "lot {i}");
-        assert!((footprint[k] - 600.0).abs() < 2.0, "lot {i}: {}", footprint[k]);
+        assert!(
+            (footprint[k] - 600.0).abs() < 2.0,
+            "lot {i}: {}",
+            footprint[k]
+        );
         assert_eq!(uses[k], "housing");
     }
     // The parent's massing: one mesh of every building's box (4 walls,

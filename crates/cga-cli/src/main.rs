@@ -212,6 +212,11 @@ struct GenerateArgs {
     /// (EXT_mesh_gpu_instancing), for viewers without that extension.
     #[arg(long)]
     no_instances: bool,
+    /// 3D Tiles: triangles in a tile's content at most (a leaf's lots that
+    /// make more are written as several contents; more only where a lot
+    /// is larger than the average by itself).
+    #[arg(long, value_name = "N", default_value_t = 300_000)]
+    tile_triangles: u64,
 }
 
 /// `--origin`.
@@ -593,6 +598,7 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
                     ..rules.export_options()
                 },
                 tile_origins: args.origin != OriginArg::None,
+                max_triangles_per_tile: args.tile_triangles.max(1),
                 ..Default::default()
             };
             let stats = cga_tiles::write_tileset(&rules, &lots.lots, &options, &tiles, path, each)?;

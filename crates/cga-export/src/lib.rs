@@ -575,6 +575,11 @@ impl ModelWriter {
         Ok(())
     }
 
+    /// Triangles added so far (instances counted per placement).
+    pub fn triangles(&self) -> u64 {
+        self.stats.triangles
+    }
+
     /// Gives the vertices of each lot begun the lot's feature id (also
     /// when merged by material), and writes a property table of the lots (index,
     /// name, attributes): `EXT_mesh_features` and

@@ -34,6 +34,36 @@ impl Node {
     }
 }
 
+/// Orders `lots` along a Z curve (Morton order) over their centres
+/// (`centre` of a lot: x, z), so that consecutive lots lie close together.
+pub fn z_order(lots: &mut [usize], centre: impl Fn(usize) -> [f64; 2]) {
+    let points: Vec<[f64; 2]> = lots.iter().map(|&i| centre(i)).collect();
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in &points {
+        for k in 0..2 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let size = (hi[0] - lo[0]).max(hi[1] - lo[1]).max(1e-9);
+    // 16 bits per axis, interleaved.
+    let code = |p: [f64; 2]| -> u32 {
+        let q = |k: usize| (((p[k] - lo[k]) / size * 65535.0).clamp(0.0, 65535.0)) as u32;
+        let spread = |mut v: u32| {
+            v = (v | (v << 8)) & 0x00ff_00ff;
+            v = (v | (v << 4)) & 0x0f0f_0f0f;
+            v = (v | (v << 2)) & 0x3333_3333;
+            (v | (v << 1)) & 0x5555_5555
+        };
+        spread(q(0)) | (spread(q(1)) << 1)
+    };
+    let mut keyed: Vec<(u32, usize)> = points.into_iter().map(code).zip(lots.iter().copied()).collect();
+    keyed.sort();
+    for (slot, (_, i)) in lots.iter_mut().zip(keyed) {
+        *slot = i;
+    }
+}
+
 /// Deeper than this, lots that share a centre stay in one tile.
 const MAX_LEVEL: u32 = 20;
 

@@ -334,6 +334,8 @@ fn lots_in_metres_make_a_local_tileset() {
     assert!(t["root"].get("children").is_none());
     let mut seen = Vec::new();
     check_tile(&dir, &t["root"], None, &mut seen);
+    // In the tile, lots are ordered along a Z curve.
+    seen.sort();
     assert_eq!(seen, [0, 1, 2, 3, 4, 5]);
     // z up: the box's height is the extrusion (half axis 3 m).
     let b = box_range(&t["root"]["boundingVolume"]);
@@ -376,4 +378,58 @@ fn context_queries_see_every_tile() {
     assert!(t["root"]["children"]
         .as_array()
         .is_some_and(|c| c.len() >= 2));
+}
+
+/// A leaf whose lots make more triangles than a content may hold is
+/// written as several contents, each a child tile of lots close together.
+#[test]
+fn tiles_bound_their_triangles() {
+    let dir = temp_dir("tiles-triangles");
+    // A box of 12 triangles per lot; 16 lots fit one leaf by their number.
+    let rules = rule_file(&dir, "b.cga", "Lot --> extrude(6) X.\n");
+    let tileset = dir.join("tileset.json");
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "--lot",
+        "grid:4x4",
+        "--tile-triangles",
+        "50",
+        "-o",
+        tileset.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let t: Value = serde_json::from_str(&std::fs::read_to_string(&tileset).unwrap()).unwrap();
+    let root = &t["root"];
+    assert!(root.get("content").is_none());
+    let children = root["children"].as_array().unwrap();
+    // Four lots (48 triangles) per content.
+    assert_eq!(children.len(), 4);
+    for c in children {
+        let json = glb_json(&dir.join(c["content"]["uri"].as_str().unwrap()));
+        let triangles: u64 = json["meshes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|m| m["primitives"].as_array().unwrap())
+            .map(|p| json["accessors"][p["indices"].as_u64().unwrap() as usize]["count"].as_u64().unwrap() / 3)
+            .sum();
+        assert_eq!(triangles, 48);
+    }
+    let mut seen = Vec::new();
+    check_tile(&dir, root, None, &mut seen);
+    seen.sort();
+    assert_eq!(seen, (0..16).collect::<Vec<u64>>());
+    // Lots close together: each content's box is a 2 x 2 block of the grid,
+    // a quarter of the lots' footprint and a third of the root's box
+    // (which takes in the streets between).
+    let area = |b: &Value| {
+        let r = box_range(b);
+        (r[0][1] - r[0][0]) * (r[1][1] - r[1][0])
+    };
+    let whole = area(&root["boundingVolume"]);
+    for c in children {
+        let a = area(&c["boundingVolume"]);
+        assert!(a < whole * 0.4, "{a} of {whole}");
+    }
 }

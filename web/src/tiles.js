@@ -41,7 +41,7 @@ const state = {
   triangles: 0, // in the tiles drawn in the last frame
   tilesDrawn: 0, // tiles with content drawn in the last frame
   frames: 0,
-  picked: null, // the lot last clicked: {index, name, attributes, reports, tile, featureId, point, local}
+  picked: null, // the lot last clicked: {index, name, attributes, reports, tile, featureId, instanced, point, local}
 };
 window.tilesState = state;
 
@@ -110,17 +110,24 @@ const tileOf = new WeakMap();
 // which is set on the materials of the picked tile only (feature ids are
 // rows of each tile's own property table).
 const NONE = -1;
-function highlightable(material) {
+// Instanced assets (EXT_mesh_gpu_instancing) carry their lot's feature id
+// per instance (EXT_instance_features), which three.js' GLTFLoader keeps
+// as this instanced attribute; 3d-tiles-renderer does not read that
+// extension, so the page does.
+const INSTANCE_FEATURE = '_FEATURE_ID_0';
+// `attribute`: the feature id's attribute (per vertex, or per instance for
+// instanced assets).
+function highlightable(material, attribute) {
   material.userData.highlight = { value: NONE };
   material.onBeforeCompile = (shader) => {
     shader.uniforms.highlightFeature = material.userData.highlight;
     shader.vertexShader = shader.vertexShader
-      .replace('void main() {', 'attribute float _feature_id_0;\nvarying float vFeature;\nvoid main() {\n\tvFeature = _feature_id_0;');
+      .replace('void main() {', `attribute float ${attribute};\nvarying float vFeature;\nvoid main() {\n\tvFeature = ${attribute};`);
     shader.fragmentShader = shader.fragmentShader
       .replace('void main() {', 'uniform float highlightFeature;\nvarying float vFeature;\nvoid main() {')
       .replace('#include <color_fragment>', '#include <color_fragment>\n\tif (abs(vFeature - highlightFeature) < 0.5) diffuseColor.rgb = mix(diffuseColor.rgb, vec3(1.0, 0.55, 0.1), 0.65);');
   };
-  material.customProgramCacheKey = () => 'cga-feature-highlight';
+  material.customProgramCacheKey = () => `cga-feature-highlight-${attribute}`;
   material.needsUpdate = true;
 }
 let highlighted = []; // materials with a highlight set
@@ -129,7 +136,7 @@ function highlight(scene, featureId) {
   highlighted = [];
   if (!scene) return;
   scene.traverse((o) => {
-    if (!o.isMesh || !o.userData.meshFeatures) return;
+    if (!o.isMesh) return;
     for (const m of Array.isArray(o.material) ? o.material : [o.material]) {
       if (m.userData.highlight) {
         m.userData.highlight.value = featureId;
@@ -153,7 +160,12 @@ tiles.addEventListener('load-model', (e) => {
       o.castShadow = shadows;
       o.receiveShadow = shadows;
       if (o.userData.meshFeatures && o.geometry.getAttribute('_feature_id_0')) {
-        for (const m of Array.isArray(o.material) ? o.material : [o.material]) highlightable(m);
+        for (const m of Array.isArray(o.material) ? o.material : [o.material]) highlightable(m, '_feature_id_0');
+      } else if (o.isInstancedMesh && o.geometry.getAttribute(INSTANCE_FEATURE)) {
+        // Its own material: a shared one may also draw meshes without
+        // instances, whose feature ids are another attribute.
+        o.material = o.material.clone();
+        highlightable(o.material, INSTANCE_FEATURE);
       }
     }
   });
@@ -315,7 +327,7 @@ function render() {
     s.traverse((o) => {
       if (o.isMesh && o.visible) {
         const g = o.geometry;
-        triangles += (g.index ? g.index.count : g.attributes.position.count) / 3;
+        triangles += ((g.index ? g.index.count : g.attributes.position.count) / 3) * (o.isInstancedMesh ? o.count : 1);
       }
     });
   }
@@ -367,24 +379,35 @@ function pickAt(x, y) {
   const ndc = new THREE.Vector2((x / rect.width) * 2 - 1, -(y / rect.height) * 2 + 1);
   raycaster.setFromCamera(ndc, camera);
   const hits = raycaster.intersectObject(tiles.group, true);
-  const hit = hits.find((h) => h.object.userData.meshFeatures);
+  const instanced = (h) => h.object.isInstancedMesh && h.instanceId !== undefined && h.object.geometry.getAttribute(INSTANCE_FEATURE);
+  const hit = hits.find((h) => h.object.userData.meshFeatures || instanced(h));
   if (!hit) {
     highlight(null);
     return null;
   }
-  const features = hit.object.userData.meshFeatures;
-  const metadata = hit.object.userData.structuralMetadata;
-  const [featureId] = features.getFeatures(hit.faceIndex, hit.barycoord);
-  const [info] = features.getFeatureInfo();
   let tile = null;
   let tileScene = null;
   for (let o = hit.object; o && !tile; o = o.parent) {
     tile = tileOf.get(o) || null;
     if (tile) tileScene = o;
   }
+  let featureId;
+  let table;
+  let metadata = hit.object.userData.structuralMetadata;
+  if (hit.object.userData.meshFeatures) {
+    const features = hit.object.userData.meshFeatures;
+    [featureId] = features.getFeatures(hit.faceIndex, hit.barycoord);
+    table = features.getFeatureInfo()[0].propertyTable;
+  } else {
+    featureId = hit.object.geometry.getAttribute(INSTANCE_FEATURE).getX(hit.instanceId);
+    // The tile's one property table (the engine writes one a tile).
+    metadata = metadata || tileScene?.userData.structuralMetadata;
+    table = 0;
+  }
   const picked = {
     tile: tile ? new URL(tile.content.uri, tilesetUrl).href : null,
     featureId,
+    instanced: !hit.object.userData.meshFeatures, // an instanced asset
     index: null,
     name: null,
     attributes: {},
@@ -400,9 +423,9 @@ function pickAt(x, y) {
   picked.local = state.rootTransform
     ? inGroup.clone().applyMatrix4(new THREE.Matrix4().fromArray(state.rootTransform).invert()).toArray()
     : picked.point;
-  if (metadata && featureId !== null && info.propertyTable !== null) {
-    const row = metadata.getPropertyTableData(info.propertyTable, featureId);
-    const className = metadata.getPropertyTableInfo([info.propertyTable])[0].className;
+  if (metadata && featureId !== null && table !== null && table !== undefined) {
+    const row = metadata.getPropertyTableData(table, featureId);
+    const className = metadata.getPropertyTableInfo([table])[0].className;
     const properties = metadata.schema.classes[className].properties;
     // The writer's columns (docs/tiles.md): `index`, `name`, `attr_NAME`
     // and `report_KEY`, with NAME and KEY in the property's `name`.

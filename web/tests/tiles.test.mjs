@@ -108,17 +108,22 @@ function contents(tile, out = []) {
   return out;
 }
 
-/// Triangles in a GLB (indexed triangle lists, as the engine writes).
+/// Triangles a GLB draws (indexed triangle lists, as the engine writes):
+/// each node's mesh, times its instances (EXT_mesh_gpu_instancing).
 function glbTriangles(path) {
   const bytes = readFileSync(path);
   const len = bytes.readUInt32LE(12);
   const json = JSON.parse(bytes.subarray(20, 20 + len).toString('utf8'));
   let triangles = 0;
-  for (const mesh of json.meshes || []) {
-    for (const p of mesh.primitives) {
+  for (const node of json.nodes || []) {
+    if (node.mesh === undefined) continue;
+    let mesh = 0;
+    for (const p of json.meshes[node.mesh].primitives) {
       assert.ok(p.mode === undefined || p.mode === 4, 'triangle lists');
-      triangles += json.accessors[p.indices].count / 3;
+      mesh += json.accessors[p.indices].count / 3;
     }
+    const instancing = node.extensions?.EXT_mesh_gpu_instancing;
+    triangles += mesh * (instancing ? json.accessors[instancing.attributes.TRANSLATION].count : 1);
   }
   return triangles;
 }
@@ -248,9 +253,6 @@ async function clickRoof(page, roof) {
 function checkLoaded(tileset, name, state, consoleErrors) {
   const base = `${http.url}/data/${name}/`;
   const expected = contents(tileset.root).map((u) => new URL(u, base).href).sort();
-  // The root's and the centre's massing, the centre's 4 leaves and the
-  // suburb's leaf.
-  assert.equal(expected.length, 7, `a tree of tiles: ${expected}`);
   assert.deepEqual([...state.contents].sort(), expected, 'the page saw every content of tileset.json');
   assert.deepEqual([...state.requested].sort(), expected, 'every tile was requested');
   assert.deepEqual([...state.loaded].sort(), expected, 'every tile was loaded');
@@ -317,6 +319,9 @@ describe('a tileset of lots in longitude/latitude', () => {
   after(() => page?.close());
 
   test('every tile loads, without an error', () => {
+    // The root's and the centre's massing, the centre's 4 leaves and the
+    // suburb's leaf.
+    assert.equal(contents(tileset.root).length, 7, JSON.stringify(contents(tileset.root)));
     assert.ok(tileset.root.transform, 'a root transform to ECEF');
     assert.equal(loadedState.georeferenced, true);
     checkLoaded(tileset, 'geo', loadedState, consoleErrors);
@@ -372,7 +377,7 @@ describe('a tileset of lots in longitude/latitude', () => {
   });
 });
 
-describe('a tileset of lots in local metres', () => {
+describe('a tileset of lots in local metres, a few lots a content', () => {
   let geojson;
   let tileset;
   let page;
@@ -381,12 +386,22 @@ describe('a tileset of lots in local metres', () => {
 
   before(async () => {
     geojson = cityGeojson(local);
-    tileset = generate(dir, 'local', geojson, ['--crs', 'local']);
+    // Few triangles a content: each leaf's lots fill several contents
+    // under a tile without content of its own.
+    tileset = generate(dir, 'local', geojson, ['--crs', 'local', '--tile-triangles', '40000']);
     ({ page, state: loadedState, consoleErrors } = await view('local'));
   });
   after(() => page?.close());
 
   test('every tile loads, without an error', () => {
+    const split = [];
+    const walk = (t) => {
+      if (!t.content && t.children?.length && t.children.every((c) => c.content && !c.children?.length)) split.push(t);
+      (t.children || []).forEach(walk);
+    };
+    walk(tileset.root);
+    assert.ok(split.length >= 2, `leaves split into several contents: ${split.length}`);
+    assert.ok(contents(tileset.root).length > 7, JSON.stringify(contents(tileset.root)));
     assert.equal(loadedState.georeferenced, false);
     checkLoaded(tileset, 'local', loadedState, consoleErrors);
   });
@@ -433,6 +448,70 @@ describe('a coarse view draws the massing', () => {
       assert.equal(picked.index, TOWER, JSON.stringify(picked));
       assert.equal(picked.name, 'B077');
       assert.equal(picked.tile, root);
+    } finally {
+      await page.close();
+    }
+  });
+});
+
+describe('a street of instanced assets', () => {
+  test('its tiles load and each tree or lamp picked is of the lot it stands on', async () => {
+    // tools/perf/street/street.cga: trees and lamps inserted with i() and
+    // written once a tile (EXT_mesh_gpu_instancing), each placement with
+    // its lot's feature id (EXT_instance_features).
+    const boxes = [];
+    for (let i = 0; i < 6; i++) {
+      const [x0, y0] = [LOCAL_ORIGIN[0] + (i % 3) * 50, LOCAL_ORIGIN[1] + Math.floor(i / 3) * 50];
+      boxes.push([x0, y0, x0 + 40, y0 + 40]);
+    }
+    const geojson = {
+      type: 'FeatureCollection',
+      features: boxes.map(([x0, y0, x1, y1], i) => ({
+        type: 'Feature',
+        id: `S${i}`,
+        properties: { owner: `owner ${i}` },
+        geometry: { type: 'Polygon', coordinates: [[[x0, y0], [x1, y0], [x1, y1], [x0, y1], [x0, y0]]] },
+      })),
+    };
+    const lots = join(dir, 'street.geojson');
+    writeFileSync(lots, JSON.stringify(geojson));
+    const out = join(dir, 'street', 'tileset.json');
+    const run = spawnSync(
+      cgaBinary(),
+      ['generate', join(repo, 'tools', 'perf', 'street', 'street.cga'), '--lot', lots, '--crs', 'local', '-o', out],
+      { encoding: 'utf8' },
+    );
+    assert.equal(run.status, 0, `cga generate failed:\n${run.stdout}\n${run.stderr}`);
+    const tileset = JSON.parse(readFileSync(out, 'utf8'));
+    const { page, state, consoleErrors } = await view('street');
+    try {
+      checkLoaded(tileset, 'street', state, consoleErrors);
+      // Pick over a grid of points of the canvas: every hit on an asset
+      // names the lot it stands on. A tree is turned about its 4 m cell's
+      // corner before it is centred, so a crown (up to 1.75 m wide of its
+      // centre) reaches under 4.8 m beyond the lot; the lots are 10 m
+      // apart, so the nearest lot is unambiguous.
+      const picks = await page.evaluate(() => {
+        const s = window.tilesState;
+        const c = document.getElementById('canvas').getBoundingClientRect();
+        const out = [];
+        for (let y = 0.2; y <= 0.8; y += 0.04) for (let x = 0.2; x <= 0.8; x += 0.04) {
+          const p = s.pickAt(c.width * x, c.height * y);
+          if (p) out.push(p);
+        }
+        return out;
+      });
+      const instanced = picks.filter((p) => p.instanced);
+      assert.ok(instanced.length >= 20, `${instanced.length} assets hit of ${picks.length}`);
+      const away = ([x0, y0, x1, y1], [x, y]) => Math.hypot(Math.max(x0 - x, 0, x - x1), Math.max(y0 - y, 0, y - y1));
+      for (const p of instanced) {
+        const distances = boxes.map((b) => away(b, p.point));
+        assert.ok(distances[p.index] < 4.8, `lot ${p.index} hit at ${p.point}`);
+        assert.equal(distances.indexOf(Math.min(...distances)), p.index, `lot ${p.index} hit at ${p.point}`);
+        assert.equal(p.name, `S${p.index}`);
+        assert.equal(p.attributes.owner, `owner ${p.index}`);
+      }
+      assert.ok(new Set(instanced.map((p) => p.index)).size >= 4, 'assets of several lots');
     } finally {
       await page.close();
     }

@@ -653,6 +653,24 @@ fn write<'py>(
         Some(r) => r.rules.export_options(),
         None => cga::ExportOptions::default(),
     };
+    // Far from the frame's origin (a national grid's metres), glTF's
+    // 32-bit floats need a local origin: the models' centre.
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for item in models.iter() {
+        let (_, meshes): (Bound<'_, Materials>, Vec<MeshIn<'_>>) = item.extract()?;
+        for (_, positions, ..) in &meshes {
+            for row in positions.as_array().rows() {
+                for k in 0..row.len().min(3) {
+                    lo[k] = lo[k].min(row[k]);
+                    hi[k] = hi[k].max(row[k]);
+                }
+            }
+        }
+    }
+    let origin = (lo[0] <= hi[0])
+        .then(|| cga::lots::origin_of_box(cga::DVec3::from(lo), cga::DVec3::from(hi)))
+        .flatten();
+    let options = cga::ExportOptions { origin, ..options };
     let mut writer =
         ModelWriter::create(&path, format, options).map_err(|e| to_py_err(e.into()))?;
     for item in models.iter() {

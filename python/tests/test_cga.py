@@ -258,6 +258,35 @@ def test_write_glb_and_obj(tmp_path, box, building):
         cga.write(models, tmp_path / "city.stl")
 
 
+def _glb_json(path):
+    import json
+    import struct
+    data = path.read_bytes()
+    (n,) = struct.unpack("<I", data[12:16])
+    return json.loads(data[20:20 + n])
+
+
+def test_far_lots_keep_their_millimetres(tmp_path, box):
+    # Lots in a national grid's metres: GLB positions are relative to the
+    # lots' centre, which the nodes' translation holds.
+    far = shapely.box(2683000.0, 1247000.0, 2683020.123, 1247015.5)
+    [model] = box.generate([far])
+    xs = np.concatenate([m.positions[:, 0] for m in model.meshes])
+    assert xs.min() == pytest.approx(2683000.0) and xs.max() == pytest.approx(2683020.123)
+    for out in ("written.glb", "direct.glb"):
+        if out == "written.glb":
+            cga.write([model], tmp_path / out)
+        else:
+            box.generate([far], output=tmp_path / out)
+        j = _glb_json(tmp_path / out)
+        t = j["nodes"][0]["translation"]
+        assert t[0] == 2683010.0
+        acc = j["accessors"][j["meshes"][0]["primitives"][0]["attributes"]["POSITION"]]
+        # Local positions: the box's 20.123 m kept to a tenth of a millimetre.
+        assert acc["max"][0] - acc["min"][0] == pytest.approx(20.123, abs=1e-4)
+        assert abs(acc["min"][0] + t[0] - 2683000.0) < 1e-3
+
+
 def test_to_trimesh(box):
     trimesh = pytest.importorskip("trimesh")
     [m] = box.generate(shapely.box(0, 0, 20, 30))

@@ -526,6 +526,9 @@ struct LaidOutInstances {
     nodes: Vec<(Option<u32>, u32, serde_json::Map<String, serde_json::Value>)>,
 }
 
+/// The instance nodes of each lot (its node's children), by lot position.
+type NodesByLot = HashMap<u32, Vec<json::Index<json::Node>>>;
+
 /// The box around two boxes.
 fn union_bounds(a: Option<[[f64; 3]; 2]>, b: Option<[[f64; 3]; 2]>) -> Option<[[f64; 3]; 2]> {
     match (a, b) {
@@ -1334,11 +1337,8 @@ impl GltfWriter {
         root: &mut json::Root,
         laid_out: LaidOutInstances,
         gltf_materials: &[Option<json::Index<json::Material>>],
-    ) -> (
-        HashMap<u32, Vec<json::Index<json::Node>>>,
-        Vec<json::Index<json::Node>>,
-    ) {
-        let mut by_lot: HashMap<u32, Vec<json::Index<json::Node>>> = HashMap::new();
+    ) -> (NodesByLot, Vec<json::Index<json::Node>>) {
+        let mut by_lot = NodesByLot::new();
         let mut top = Vec::new();
         if laid_out.nodes.is_empty() {
             return (by_lot, top);
@@ -1398,10 +1398,10 @@ impl GltfWriter {
                 None => top.push(node),
             }
         }
-        for name in ["EXT_mesh_gpu_instancing"] {
-            root.extensions_used.push(name.into());
-            root.extensions_required.push(name.into());
-        }
+        // Without the extension a viewer would draw one placement of each.
+        let name = "EXT_mesh_gpu_instancing";
+        root.extensions_used.push(name.into());
+        root.extensions_required.push(name.into());
         if self.features {
             root.extensions_used.push("EXT_instance_features".into());
         }

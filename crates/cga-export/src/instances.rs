@@ -87,6 +87,9 @@ pub(crate) struct Placement {
     pub scale: [f32; 3],
 }
 
+/// An instance node: its lot (when per lot) and group.
+pub(crate) type NodeKey = (Option<u32>, u32);
+
 /// The groups and placements of one model.
 #[derive(Default)]
 pub(crate) struct Instances {
@@ -177,9 +180,8 @@ impl Instances {
 
     /// The placements by node: per lot (when `per_lot`) and group, in
     /// order of lot and group, each with the indices of its placements.
-    pub fn nodes(&self, per_lot: bool) -> Vec<((Option<u32>, u32), Vec<usize>)> {
-        let mut nodes: std::collections::BTreeMap<(Option<u32>, u32), Vec<usize>> =
-            Default::default();
+    pub fn nodes(&self, per_lot: bool) -> Vec<(NodeKey, Vec<usize>)> {
+        let mut nodes: std::collections::BTreeMap<NodeKey, Vec<usize>> = Default::default();
         for (k, p) in self.placements.iter().enumerate() {
             let lot = if per_lot { p.lot } else { None };
             nodes.entry((lot, p.group)).or_default().push(k);

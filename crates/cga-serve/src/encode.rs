@@ -9,9 +9,11 @@
 //!       triangle: "index_bytes"); each array padded to 4 bytes
 //! ```
 //!
-//! The header: `{"lots": [{"index", "name", "meshes": [{"mesh", "vertices",
+//! The header: `{"origin": [x, y, z], "lots": [{"index", "name", "meshes": [{"mesh", "vertices",
 //! "triangles", "positions", "normals", "uvs", "indices", "color",
-//! "opacity", "material", "double_sided", "texture"}]}]}`, offsets in bytes from the start of
+//! "opacity", "material", "double_sided", "texture"}]}]}`, positions
+//! relative to `origin` (the lots' centre when they lie far from the
+//! frame's origin, else zero), offsets in bytes from the start of
 //! the data. `mesh` is the mesh's number in the lot's plain model, which
 //! [`cga::LotResult::provenance`] takes with a triangle number. The page
 //! builds its three.js geometry from these arrays directly, with no glTF
@@ -23,7 +25,12 @@ use serde_json::{json, Value as Json};
 /// The lots' meshes in the binary form above; `texture` gives the URL of
 /// a colour map path as the rules wrote it (`None`: not found, drawn
 /// without).
-pub fn model(results: &[LotResult], texture: &mut dyn FnMut(&str) -> Option<String>) -> Vec<u8> {
+/// Positions are sent relative to `origin` (in the header's `origin`).
+pub fn model(
+    results: &[LotResult],
+    origin: [f64; 3],
+    texture: &mut dyn FnMut(&str) -> Option<String>,
+) -> Vec<u8> {
     let mut data: Vec<u8> = Vec::new();
     let mut lots = Vec::with_capacity(results.len());
     for lot in results {
@@ -35,8 +42,8 @@ pub fn model(results: &[LotResult], texture: &mut dyn FnMut(&str) -> Option<Stri
             let material = lot.model.materials.get(mesh.material);
             let positions = data.len();
             for p in &mesh.positions {
-                for c in p {
-                    data.extend_from_slice(&(*c as f32).to_le_bytes());
+                for (c, o) in p.iter().zip(origin) {
+                    data.extend_from_slice(&((*c - o) as f32).to_le_bytes());
                 }
             }
             let uvs = data.len();
@@ -85,7 +92,8 @@ pub fn model(results: &[LotResult], texture: &mut dyn FnMut(&str) -> Option<Stri
         }
         lots.push(json!({"index": lot.index, "name": lot.name, "meshes": meshes}));
     }
-    let mut header = serde_json::to_vec(&json!({ "lots": lots })).expect("JSON of plain data");
+    let header = json!({ "lots": lots, "origin": origin });
+    let mut header = serde_json::to_vec(&header).expect("JSON of plain data");
     while !header.len().is_multiple_of(4) {
         header.push(b' ');
     }
@@ -160,7 +168,7 @@ mod tests {
         let results = rules
             .generate_all(&[cga::lots::rect(10.0, 20.0)], &cga::Options::default())
             .unwrap();
-        let bytes = model(&results, &mut |_| None);
+        let bytes = model(&results, [0.0; 3], &mut |_| None);
         assert_eq!(&bytes[..4], b"CGAM");
         let h = u32::from_le_bytes(bytes[4..8].try_into().unwrap()) as usize;
         assert_eq!(h % 4, 0);
@@ -199,6 +207,43 @@ mod tests {
             );
         }
         assert_eq!(mesh["texture"], Json::Null);
+    }
+
+    #[test]
+    fn far_lots_are_sent_relative_to_their_origin() {
+        // A lot at 10,000 km: 32-bit floats there are a metre apart.
+        let engine = cga::Engine::new(cga::MemoryWorld::new());
+        let rules = engine.load_text("/p/a.cga", "Lot --> X.\n");
+        let far = cga::DVec3::new(1e7, 0.0, -1e7);
+        let corners = [0.0, 20.123].map(|x| far + cga::DVec3::new(x, 0.0, 0.0));
+        let lot = cga::lots::polygon(
+            "far",
+            &[
+                corners[0],
+                corners[1],
+                corners[1] - cga::DVec3::Z * 15.5,
+                corners[0] - cga::DVec3::Z * 15.5,
+            ],
+        );
+        let origin = cga::lots::local_origin(std::slice::from_ref(&lot)).unwrap();
+        let results = rules
+            .generate_all(&[lot], &cga::Options::default())
+            .unwrap();
+        let bytes = model(&results, origin.to_array(), &mut |_| None);
+        let h = u32::from_le_bytes(bytes[4..8].try_into().unwrap()) as usize;
+        let header: Json = serde_json::from_slice(&bytes[8..8 + h]).unwrap();
+        assert_eq!(header["origin"], json!([1e7 + 10.0, 0.0, -1e7 - 8.0]));
+        let mesh = &header["lots"][0]["meshes"][0];
+        let data = &bytes[8 + h..];
+        let at = mesh["positions"].as_u64().unwrap() as usize;
+        let xs: Vec<f64> = (0..4)
+            .map(|i| {
+                f32::from_le_bytes(data[at + 12 * i..at + 12 * i + 4].try_into().unwrap()) as f64
+            })
+            .collect();
+        let width = xs.iter().cloned().fold(f64::MIN, f64::max)
+            - xs.iter().cloned().fold(f64::MAX, f64::min);
+        assert!((width - 20.123).abs() < 1e-5, "{width}");
     }
 
     #[test]

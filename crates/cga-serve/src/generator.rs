@@ -64,6 +64,10 @@ pub struct Preview {
     pub lots: Vec<Lot>,
     /// The lots' own outlines as meshes (binary, see [`encode`]).
     pub lots_model: Arc<Vec<u8>>,
+    /// The point models are sent relative to: lots far from the frame's
+    /// origin (a national grid's metres) would lose their millimetres in
+    /// the page's 32-bit floats.
+    pub origin: [f64; 3],
     limits: cga::Limits,
     request: Mutex<Request>,
     wake: Condvar,
@@ -107,12 +111,13 @@ impl Preview {
         // Lot files are read from disk: the user named them.
         let lot_set = cga::lots::read(&config.lots).map_err(|e| e.to_string())?;
         let lots = lot_set.lots;
-        let lots_model = Arc::new(lot_outlines(&engine, &roots[0], &lots));
+        let origin = cga::lots::local_origin(&lots).map_or([0.0; 3], |o| o.to_array());
+        let lots_model = Arc::new(lot_outlines(&engine, &roots[0], &lots, origin));
         let (events, _) = tokio::sync::watch::channel(0);
         let empty = Snapshot {
             version: 0,
             state: Arc::new("{}".to_string()),
-            model: Arc::new(encode::model(&[], &mut |_| None)),
+            model: Arc::new(encode::model(&[], origin, &mut |_| None)),
             model_version: 0,
             made_by: None,
         };
@@ -122,6 +127,7 @@ impl Preview {
             roots,
             lots,
             lots_model,
+            origin,
             limits: config.limits,
             request: Mutex::new(Request {
                 params: Params::default(),
@@ -369,7 +375,7 @@ impl Preview {
                         .clone()
                 };
                 (
-                    Arc::new(encode::model(&m.results, &mut texture)),
+                    Arc::new(encode::model(&m.results, self.origin, &mut texture)),
                     version,
                     Some(m),
                 )
@@ -599,14 +605,14 @@ fn relative_to(path: &Path, base: &Path) -> String {
 
 /// The lots themselves as meshes, by a rule that leaves them as they are
 /// (loaded from text: nothing is read).
-fn lot_outlines(engine: &Engine, root: &Path, lots: &[Lot]) -> Vec<u8> {
+fn lot_outlines(engine: &Engine, root: &Path, lots: &[Lot], origin: [f64; 3]) -> Vec<u8> {
     let rules = engine.load_text(
         root.join("cga-serve-lots.cga"),
         "Lot --> color(\"#9a9a92\") Ground.\n",
     );
     match rules.generate_all(lots, &Options::default()) {
-        Ok(results) => encode::model(&results, &mut |_| None),
-        Err(_) => encode::model(&[], &mut |_| None),
+        Ok(results) => encode::model(&results, origin, &mut |_| None),
+        Err(_) => encode::model(&[], origin, &mut |_| None),
     }
 }
 

@@ -57,7 +57,11 @@ pub fn z_order(lots: &mut [usize], centre: impl Fn(usize) -> [f64; 2]) {
         };
         spread(q(0)) | (spread(q(1)) << 1)
     };
-    let mut keyed: Vec<(u32, usize)> = points.into_iter().map(code).zip(lots.iter().copied()).collect();
+    let mut keyed: Vec<(u32, usize)> = points
+        .into_iter()
+        .map(code)
+        .zip(lots.iter().copied())
+        .collect();
     keyed.sort();
     for (slot, (_, i)) in lots.iter_mut().zip(keyed) {
         *slot = i;

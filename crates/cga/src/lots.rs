@@ -37,6 +37,11 @@ pub fn local_origin(lots: &[Lot]) -> Option<DVec3> {
     let mut points = lots.iter().flat_map(|l| l.mesh.positions.iter());
     let first = *points.next()?;
     let (lo, hi) = points.fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    origin_of_box(lo, hi)
+}
+
+/// [`local_origin`] of the box `lo`..`hi` (of models or lots).
+pub fn origin_of_box(lo: DVec3, hi: DVec3) -> Option<DVec3> {
     let centre = (lo + hi) / 2.0;
     let centre = DVec3::new(centre.x.round(), 0.0, centre.z.round());
     (centre.is_finite() && centre.x.abs().max(centre.z.abs()) > FAR_FROM_ORIGIN).then_some(centre)

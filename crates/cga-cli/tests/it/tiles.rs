@@ -412,7 +412,12 @@ fn tiles_bound_their_triangles() {
             .unwrap()
             .iter()
             .flat_map(|m| m["primitives"].as_array().unwrap())
-            .map(|p| json["accessors"][p["indices"].as_u64().unwrap() as usize]["count"].as_u64().unwrap() / 3)
+            .map(|p| {
+                json["accessors"][p["indices"].as_u64().unwrap() as usize]["count"]
+                    .as_u64()
+                    .unwrap()
+                    / 3
+            })
             .sum();
         assert_eq!(triangles, 48);
     }

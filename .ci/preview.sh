@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Browser tests of the live preview (`cga serve`, web/): the page built
-# from npm packages, driven by Playwright (playwright-core) in Debian's
-# Chromium. Playwright's own browser download is not used (and would not
+# Browser tests of the live preview (`cga serve`, web/) and of the 3D
+# Tiles viewer (web/src/tiles.html on tilesets `cga generate` writes): the
+# pages built from npm packages, driven by Playwright (playwright-core) in
+# Debian's Chromium. Playwright's own browser download is not used (and would not
 # work on CI machines without outside network).
 set -euo pipefail
 cd "$(dirname "$0")/.."

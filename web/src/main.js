@@ -31,6 +31,11 @@ const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDraw
 renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
 renderer.shadowMap.enabled = true;
 renderer.shadowMap.type = THREE.PCFSoftShadowMap;
+// The shadow map depends on the model and the sun, not on the camera: it
+// is drawn again only when they change (see `render`), not on every orbit.
+renderer.shadowMap.autoUpdate = false;
+let shadowsStale = true;
+let shadowTimer = 0;
 const scene = new THREE.Scene();
 scene.background = new THREE.Color(BACKGROUND);
 const camera = new THREE.PerspectiveCamera(45, 1, 0.1, 100000);
@@ -64,12 +69,26 @@ function resize() {
   }
 }
 
-function render() {
+// Draws the scene. `newModel`: the model or the sun changed; the frame
+// showing it is drawn with the shadows as they were (a pass over every
+// triangle less, which without a GPU is a large part of a frame), and
+// the shadows follow once the models stop coming (a slider being moved,
+// edits saved one after another) for SHADOW_DELAY_MS.
+const SHADOW_DELAY_MS = 400;
+function render({ newModel = false } = {}) {
   resize();
+  if (newModel) {
+    shadowsStale = true;
+    clearTimeout(shadowTimer);
+    shadowTimer = setTimeout(() => render(), SHADOW_DELAY_MS);
+  } else if (shadowsStale) {
+    renderer.shadowMap.needsUpdate = true;
+    shadowsStale = false;
+  }
   renderer.render(scene, camera);
 }
-controls.addEventListener('change', render);
-window.addEventListener('resize', render);
+controls.addEventListener('change', () => render());
+window.addEventListener('resize', () => render());
 
 // A grid of 1 m cells and one of 10 m cells under the model, sized to it.
 function makeGrids(box) {
@@ -132,7 +151,7 @@ const textures = new Map();
 const textureLoader = new THREE.TextureLoader();
 function texture(url) {
   if (!textures.has(url)) {
-    const t = textureLoader.load(url, render);
+    const t = textureLoader.load(url, () => render());
     t.colorSpace = THREE.SRGBColorSpace;
     t.wrapS = t.wrapT = THREE.RepeatWrapping;
     t.anisotropy = 4;
@@ -217,7 +236,7 @@ async function loadModel(version) {
     fitted = true;
     fit();
   }
-  render();
+  render({ newModel: true });
   // Drawn is when the browser has shown the frame, not when the commands
   // were issued.
   await new Promise((r) => requestAnimationFrame(() => r()));

@@ -1,4 +1,4 @@
 // Copies the page's static files next to the bundle esbuild wrote.
 import { copyFileSync, mkdirSync } from 'node:fs';
 mkdirSync('dist', { recursive: true });
-for (const f of ['index.html', 'style.css']) copyFileSync(`src/${f}`, `dist/${f}`);
+for (const f of ['index.html', 'tiles.html', 'style.css']) copyFileSync(`src/${f}`, `dist/${f}`);

@@ -140,6 +140,7 @@ pub fn write_tileset(
         each,
         stats: TilesetStats::default(),
         generated: 0,
+        metadata: vec![None; lots.len()],
     };
     let (mut tile, _, error) = w.tile(&root)?;
     w.release();
@@ -228,6 +229,9 @@ struct Writer<'a, F: FnMut(LotResult)> {
     /// Lots generated so far (with `stats.triangles`, the triangles per
     /// lot that decide how many lots go into a content at once).
     generated: usize,
+    /// Each lot's index, attributes and reports, once generated: its row
+    /// in the parents' property tables.
+    metadata: Vec<Option<Json>>,
 }
 
 impl<F: FnMut(LotResult)> Writer<'_, F> {
@@ -377,10 +381,16 @@ impl<F: FnMut(LotResult)> Writer<'_, F> {
             lot_indices: Some(lots.to_vec().into()),
             ..self.options.clone()
         };
-        let pending = &mut self.pending;
+        let (pending, metadata, all) = (&mut self.pending, &mut self.metadata, self.lots);
         let summary = self
             .rules
             .generate_lots(&part, &options, Target::Writer(writer), |r| {
+                // The lot's row of the parents' property tables.
+                let mut m = cga::metadata::lot_metadata(r.index, &all[r.index]);
+                if !r.reports.is_empty() {
+                    m["reports"] = cga::metadata::reports_metadata(&r.reports);
+                }
+                metadata[r.index] = Some(m);
                 pending.insert(r.index, r);
             })?;
         let s = &mut self.stats.summary;
@@ -426,8 +436,9 @@ impl<F: FnMut(LotResult)> Writer<'_, F> {
             for f in &mut mesh.faces {
                 f.material = 0;
             }
+            let metadata = self.metadata[i].clone();
             writer
-                .begin_lot(&lot.name, Some(json!({ "lot": i })))
+                .begin_lot(&lot.name, metadata.or_else(|| Some(json!({ "lot": i }))))
                 .map_err(Error::Export)?;
             writer.add_mesh(&mesh).map_err(Error::Export)?;
         }

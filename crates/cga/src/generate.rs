@@ -7,8 +7,7 @@ use cga_engine::context::{LotContext, SceneContext};
 use cga_engine::derive::{Leaf, RtErrorKind};
 use cga_engine::generate::{collect_lot, generate_lot_streaming};
 use cga_engine::{GenerateOptions, LotOutput, RtError};
-use cga_export::{serde_json, ModelWriter, PlainCollector};
-use cga_value::Value;
+use cga_export::{ModelWriter, PlainCollector};
 
 use crate::diagnostics::Diagnostic;
 use crate::lots::Lot;
@@ -140,7 +139,10 @@ impl Rules {
                 if let Some(w) = writer.as_deref_mut() {
                     w.begin_lot(
                         &lots[i].name,
-                        Some(lot_extras(options.lot_index(i), &lots[i])),
+                        Some(crate::metadata::lot_metadata(
+                            options.lot_index(i),
+                            &lots[i],
+                        )),
                     )
                     .map_err(Error::Export)?;
                 }
@@ -179,7 +181,7 @@ impl Rules {
             }
             let mut lot = self.lot_result(options.lot_index(i), &lots[i], done);
             if let (Some(w), false) = (writer.as_deref_mut(), lot.reports.is_empty()) {
-                w.annotate_lot("reports", reports_json(&lot.reports));
+                w.annotate_lot("reports", crate::metadata::reports_metadata(&lot.reports));
             }
             let mut warnings = self.annotation_warnings(options, &lots[i]);
             warnings.append(&mut lot.warnings);
@@ -448,48 +450,6 @@ impl Rules {
         let scene = self.collect_scene(rule, lots, &whole, &engine_options, jobs)?;
         Ok(Some(Scene(Arc::new(scene))))
     }
-}
-
-/// A lot's node `extras` in glTF: its index and its own attributes (a GIS
-/// feature's properties).
-fn lot_extras(index: usize, lot: &Lot) -> serde_json::Value {
-    use serde_json::{json, Map, Value as Json};
-    fn number(x: f64) -> Json {
-        serde_json::Number::from_f64(x).map_or(Json::Null, Json::Number)
-    }
-    fn to_json(v: &Value) -> Json {
-        match v {
-            Value::Float(x) => number(*x),
-            Value::Bool(b) => Json::Bool(*b),
-            Value::Str(s) => Json::String(s.to_string()),
-            Value::FloatArray(a) => a.data.iter().map(|x| number(*x)).collect(),
-            Value::BoolArray(a) => a.data.iter().map(|b| Json::Bool(*b)).collect(),
-            Value::StrArray(a) => a.data.iter().map(|s| Json::String(s.to_string())).collect(),
-        }
-    }
-    let attributes: Map<String, Json> = lot
-        .attrs
-        .iter()
-        .map(|(k, v)| (k.to_string(), to_json(v)))
-        .collect();
-    json!({ "lot": index, "attributes": attributes })
-}
-
-/// A lot's reports as its model's metadata: per key the sum of its
-/// numbers (CityEngine's report sum), or the last value of a key whose
-/// values are strings or booleans.
-fn reports_json(reports: &[(String, Value)]) -> serde_json::Value {
-    use serde_json::{Map, Value as Json};
-    let mut out: Map<String, Json> = Map::new();
-    for (key, v) in reports {
-        let value = match (v, out.get(key).and_then(Json::as_f64)) {
-            (Value::Float(x), Some(sum)) => Json::from(sum + x),
-            (Value::Float(x), None) if !out.contains_key(key) => Json::from(*x),
-            (v, _) => Json::String(crate::value_text(v)),
-        };
-        out.insert(key.clone(), value);
-    }
-    Json::Object(out)
 }
 
 /// What a worker hands over at the end of a lot.

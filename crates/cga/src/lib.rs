@@ -34,6 +34,7 @@ mod diagnostics;
 mod error;
 mod generate;
 pub mod lots;
+pub mod metadata;
 mod model;
 pub mod operations;
 mod options;

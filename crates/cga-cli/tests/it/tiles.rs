@@ -292,6 +292,22 @@ fn a_georeferenced_city_as_a_tileset() {
     let primitive = &massing["meshes"][0]["primitives"][0];
     let indices = &massing["accessors"][primitive["indices"].as_u64().unwrap() as usize];
     assert_eq!(indices["count"].as_u64().unwrap(), 144 * 12 * 3);
+    // Its property table has the lots' attributes and reports as the
+    // leaves' have them.
+    let massing_glb = dir
+        .join("out")
+        .join(root["content"]["uri"].as_str().unwrap());
+    let (index, _, heights) = property_table(&massing_glb, Some("attr_height"));
+    assert_eq!(index.len(), 144);
+    for (i, h) in index.iter().zip(&heights) {
+        assert_eq!(h, &(8 + *i as usize % 7 * 3).to_string());
+    }
+    let (json, _) = glb_parts(&massing_glb);
+    let class = &json["extensions"]["EXT_structural_metadata"]["schema"]["classes"]["lot"];
+    assert_eq!(
+        class["properties"]["report_floors"]["componentType"],
+        "FLOAT64"
+    );
 
     // The same city as one GLB prints the same lines in the same order.
     let glb = dir.join("out/city.glb");

@@ -2,9 +2,11 @@
 """Times CityEngine's runtime (PRT, through PyPRT) on the benchmark of
 tools/perf/measure.sh: the Candler rule package on N copies of its
 footprint, GLB written, on this machine. The reference for the speed goal.
+`--package envelope2002` times that package on copies of
+lots/building_parcel.obj instead.
 
     pip install pyprt           # free for non-commercial use
-    tools/perf/reference.py [--copies 25] [--runs 3] [--oracle ../shared/prt-oracle]
+    tools/perf/reference.py [--copies 25] [--runs 3] [--oracle ../shared/prt-oracle] [--package candler]
 
 Copies are laid out in rows of five, 100 m apart (`--lot grid:5x5:...`
 puts them 10 m apart; the rule does not look at its neighbours). Each run
@@ -42,9 +44,12 @@ def main():
     ap.add_argument("--copies", type=int, default=25)
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--oracle", default=os.path.join(root, "..", "shared", "prt-oracle"))
+    ap.add_argument("--package", default="candler",
+                    help="rule package of the oracle's rpk folder (envelope2002: on lots/building_parcel.obj)")
     args = ap.parse_args()
-    rpk = os.path.abspath(os.path.join(args.oracle, "rpk", "candler.rpk"))
-    lot = footprint(os.path.join(args.oracle, "lots", "candler_footprint.obj"))
+    rpk = os.path.abspath(os.path.join(args.oracle, "rpk", args.package + ".rpk"))
+    lot_file = "candler_footprint.obj" if args.package == "candler" else "building_parcel.obj"
+    lot = footprint(os.path.join(args.oracle, "lots", lot_file))
     shapes = []
     for i in range(args.copies):
         dx, dz = (i % 5) * 100.0, -(i // 5) * 100.0
@@ -58,7 +63,7 @@ def main():
         wall = time.perf_counter() - start
         size = sum(os.path.getsize(os.path.join(out, f)) for f in os.listdir(out))
         shutil.rmtree(out)
-        print(f"run {run + 1}: {args.copies} Candler buildings in {wall:.3f} s, "
+        print(f"run {run + 1}: {args.copies} {args.package} lots in {wall:.3f} s, "
               f"{wall / args.copies * 1000:.1f} ms per building, {size / 1e6:.1f} MB written")
 
 

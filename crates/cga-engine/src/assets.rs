@@ -349,7 +349,11 @@ impl Assets {
     /// shared by every shape that inserted the asset and changed nothing
     /// of its geometry since (writers may write it once, as instances).
     pub fn is_asset(&self, mesh: &Arc<Mesh>) -> bool {
-        lock(&self.handed_out).contains(&(Arc::as_ptr(mesh) as usize))
+        // An asset is held by the caches too: a mesh held once (most
+        // leaves, cut pieces of their own) is not one, and is told without
+        // taking the lock, once per leaf.
+        Arc::strong_count(mesh) > 1
+            && lock(&self.handed_out).contains(&(Arc::as_ptr(mesh) as usize))
     }
 
     fn find_mesh(&self, from: FileId, path: &str) -> Result<Arc<Mesh>, String> {

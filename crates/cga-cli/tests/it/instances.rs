@@ -23,38 +23,6 @@ Plank --> color("#8a6a4a")
 Sign --> t(3, 0, 1) s(-0.5, 2, 0.1) i("builtin:cube")
 "##;
 
-/// A GLB's JSON and binary chunk.
-fn glb(path: &Path) -> (Value, Vec<u8>) {
-    let bytes = std::fs::read(path).unwrap();
-    let len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
-    let json = serde_json::from_slice(&bytes[20..20 + len]).unwrap();
-    let bin_len = u32::from_le_bytes(bytes[20 + len..24 + len].try_into().unwrap()) as usize;
-    (json, bytes[28 + len..28 + len + bin_len].to_vec())
-}
-
-/// The f32 components of accessor `a` (tightly packed, as we write them).
-fn floats(json: &Value, bin: &[u8], a: &Value) -> Vec<f64> {
-    let acc = &json["accessors"][a.as_u64().unwrap() as usize];
-    let view = &json["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
-    let start = view["byteOffset"].as_u64().unwrap_or(0) as usize;
-    let len = view["byteLength"].as_u64().unwrap() as usize;
-    bin[start..start + len]
-        .chunks(4)
-        .map(|c| f32::from_le_bytes(c.try_into().unwrap()) as f64)
-        .collect()
-}
-
-fn indices(json: &Value, bin: &[u8], a: &Value) -> Vec<usize> {
-    let acc = &json["accessors"][a.as_u64().unwrap() as usize];
-    let view = &json["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
-    let start = view["byteOffset"].as_u64().unwrap_or(0) as usize;
-    let len = view["byteLength"].as_u64().unwrap() as usize;
-    bin[start..start + len]
-        .chunks(4)
-        .map(|c| u32::from_le_bytes(c.try_into().unwrap()) as usize)
-        .collect()
-}
-
 type Tri = [[i64; 3]; 3];
 
 /// Rotates `v` by the unit quaternion `q` (x, y, z, w).
@@ -76,7 +44,7 @@ fn rotate(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
 /// tenths of millimetres (each triangle's corners sorted, the list
 /// sorted), with the number of instanced nodes seen.
 fn triangles(path: &Path) -> (Vec<Tri>, usize) {
-    let (json, bin) = glb(path);
+    let (json, bin) = glb_parts(path);
     let mut out = Vec::new();
     let mut instanced = 0;
     let mut stack: Vec<(u64, [f64; 3])> = json["scenes"][0]["nodes"]
@@ -104,9 +72,9 @@ fn triangles(path: &Path) -> (Vec<Tri>, usize) {
                 None => vec![([0.0; 3], [0.0, 0.0, 0.0, 1.0], [1.0; 3])],
                 Some(a) => {
                     instanced += 1;
-                    let t = floats(&json, &bin, &a["TRANSLATION"]);
-                    let r = floats(&json, &bin, &a["ROTATION"]);
-                    let s = floats(&json, &bin, &a["SCALE"]);
+                    let t = accessor_f32(&json, &bin, &a["TRANSLATION"]);
+                    let r = accessor_f32(&json, &bin, &a["ROTATION"]);
+                    let s = accessor_f32(&json, &bin, &a["SCALE"]);
                     (0..t.len() / 3)
                         .map(|i| {
                             (
@@ -120,8 +88,8 @@ fn triangles(path: &Path) -> (Vec<Tri>, usize) {
             };
         let mesh = &json["meshes"][mesh.as_u64().unwrap() as usize];
         for prim in mesh["primitives"].as_array().unwrap() {
-            let p = floats(&json, &bin, &prim["attributes"]["POSITION"]);
-            let idx = indices(&json, &bin, &prim["indices"]);
+            let p = accessor_f32(&json, &bin, &prim["attributes"]["POSITION"]);
+            let idx = accessor_u32(&json, &bin, &prim["indices"]);
             for (tr, rot, sc) in &placements {
                 let place = |v: usize| -> [i64; 3] {
                     let local = [p[3 * v] * sc[0], p[3 * v + 1] * sc[1], p[3 * v + 2] * sc[2]];
@@ -199,7 +167,7 @@ fn instanced_and_plain_files_describe_the_same_triangles() {
             std::fs::metadata(&plain).unwrap().len(),
         );
         assert!(si * 3 < sp * 2, "{granularity}: {si} vs {sp} bytes");
-        let (json, _) = glb(&inst);
+        let (json, _) = glb_parts(&inst);
         assert_eq!(json["extensionsRequired"][0], "EXT_mesh_gpu_instancing");
         // Two assets as loaded (the cylinder and the lamp's cube with
         // their colours); the cut bench and the mirrored sign are plain.
@@ -222,7 +190,7 @@ fn each_lot_keeps_its_instances() {
     // The same file however many threads derive and encode.
     let one = generate(&dir, "one.glb", "grid:3x2", &["--jobs", "1"]);
     assert_eq!(std::fs::read(&inst).unwrap(), std::fs::read(&one).unwrap());
-    let (json, bin) = glb(&inst);
+    let (json, bin) = glb_parts(&inst);
     let lots: Vec<&Value> = json["nodes"]
         .as_array()
         .unwrap()
@@ -236,7 +204,7 @@ fn each_lot_keeps_its_instances() {
         for c in children {
             let node = &json["nodes"][c.as_u64().unwrap() as usize];
             let t = &node["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["TRANSLATION"];
-            assert_eq!(floats(&json, &bin, t).len(), 3 * 5 * 8);
+            assert_eq!(accessor_f32(&json, &bin, t).len(), 3 * 5 * 8);
         }
     }
 }
@@ -250,7 +218,7 @@ fn tiles_place_instances_with_feature_ids() {
         .join("t")
         .join(t["root"]["content"]["uri"].as_str().unwrap());
     assert_valid_gltf(&tile);
-    let (json, bin) = glb(&tile);
+    let (json, bin) = glb_parts(&tile);
     let instanced: Vec<&Value> = json["nodes"]
         .as_array()
         .unwrap()
@@ -261,7 +229,7 @@ fn tiles_place_instances_with_feature_ids() {
     // placement with its lot's feature id.
     assert_eq!(instanced.len(), 2);
     for node in instanced {
-        let ids = floats(
+        let ids = accessor_f32(
             &json,
             &bin,
             &node["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["_FEATURE_ID_0"],

@@ -72,10 +72,7 @@ fn error(p: [f64; 3]) -> f64 {
 /// The positions of a GLB's meshes as placed by their nodes'
 /// translations (read in double precision from the JSON), and how many.
 fn placed_positions(path: &Path) -> Vec<[f64; 3]> {
-    let bytes = std::fs::read(path).unwrap();
-    let len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
-    let json: Value = serde_json::from_slice(&bytes[20..20 + len]).unwrap();
-    let bin = &bytes[28 + len..];
+    let (json, bin) = glb_parts(path);
     let mut out = Vec::new();
     for node in json["nodes"].as_array().unwrap() {
         assert!(node.get("rotation").is_none() && node.get("scale").is_none());
@@ -90,18 +87,8 @@ fn placed_positions(path: &Path) -> Vec<[f64; 3]> {
         };
         let mesh = &json["meshes"][node["mesh"].as_u64().unwrap() as usize];
         for prim in mesh["primitives"].as_array().unwrap() {
-            let acc = &json["accessors"][prim["attributes"]["POSITION"].as_u64().unwrap() as usize];
-            let view = &json["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
-            let start = view["byteOffset"].as_u64().unwrap_or(0) as usize
-                + acc["byteOffset"].as_u64().unwrap_or(0) as usize;
-            let stride = view["byteStride"].as_u64().unwrap_or(12) as usize;
-            for i in 0..acc["count"].as_u64().unwrap() as usize {
-                let at = start + i * stride;
-                let c = |k: usize| {
-                    f32::from_le_bytes(bin[at + 4 * k..at + 4 * k + 4].try_into().unwrap()) as f64
-                };
-                out.push([c(0) + t[0], c(1) + t[1], c(2) + t[2]]);
-            }
+            let p = accessor_f32(&json, &bin, &prim["attributes"]["POSITION"]);
+            out.extend(p.chunks(3).map(|c| [c[0] + t[0], c[1] + t[1], c[2] + t[2]]));
         }
     }
     out

@@ -11,23 +11,7 @@ use crate::common::*;
 
 /// The JSON of a GLB file.
 fn glb_json(path: &Path) -> Value {
-    let bytes = std::fs::read(path).unwrap();
-    assert!(
-        bytes.starts_with(b"glTF"),
-        "{} is not a GLB",
-        path.display()
-    );
-    let len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
-    serde_json::from_slice(&bytes[20..20 + len]).unwrap()
-}
-
-/// The JSON and binary chunk of a GLB file.
-fn glb_parts(path: &Path) -> (Value, Vec<u8>) {
-    let bytes = std::fs::read(path).unwrap();
-    let len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
-    let json = serde_json::from_slice(&bytes[20..20 + len]).unwrap();
-    let bin_len = u32::from_le_bytes(bytes[20 + len..24 + len].try_into().unwrap()) as usize;
-    (json, bytes[28 + len..28 + len + bin_len].to_vec())
+    glb_parts(path).0
 }
 
 /// The bytes of buffer view `v`, checking the 8-byte alignment that

@@ -234,3 +234,48 @@ pub fn assert_valid_gltf(file: &Path) {
         "validator errors: {report:#}"
     );
 }
+
+/// The JSON and binary chunk of a GLB file.
+pub fn glb_parts(path: &Path) -> (serde_json::Value, Vec<u8>) {
+    let bytes = std::fs::read(path).unwrap();
+    assert!(
+        bytes.starts_with(b"glTF"),
+        "{} is not a GLB",
+        path.display()
+    );
+    let len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let json = serde_json::from_slice(&bytes[20..20 + len]).unwrap();
+    let bin_len = u32::from_le_bytes(bytes[20 + len..24 + len].try_into().unwrap()) as usize;
+    (json, bytes[28 + len..28 + len + bin_len].to_vec())
+}
+
+/// The bytes of accessor `a` (its index) of a GLB's `json` and `bin`: its
+/// buffer view, as the engine writes accessors (one per view, packed).
+pub fn accessor_bytes<'a>(
+    json: &serde_json::Value,
+    bin: &'a [u8],
+    a: &serde_json::Value,
+) -> &'a [u8] {
+    let acc = &json["accessors"][a.as_u64().unwrap() as usize];
+    assert!(acc.get("byteOffset").is_none());
+    let view = &json["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
+    assert!(view.get("byteStride").is_none());
+    let start = view["byteOffset"].as_u64().unwrap_or(0) as usize;
+    &bin[start..start + view["byteLength"].as_u64().unwrap() as usize]
+}
+
+/// The 32-bit float components of accessor `a`.
+pub fn accessor_f32(json: &serde_json::Value, bin: &[u8], a: &serde_json::Value) -> Vec<f64> {
+    accessor_bytes(json, bin, a)
+        .chunks(4)
+        .map(|c| f32::from_le_bytes(c.try_into().unwrap()) as f64)
+        .collect()
+}
+
+/// The 32-bit unsigned components of accessor `a` (indices).
+pub fn accessor_u32(json: &serde_json::Value, bin: &[u8], a: &serde_json::Value) -> Vec<usize> {
+    accessor_bytes(json, bin, a)
+        .chunks(4)
+        .map(|c| u32::from_le_bytes(c.try_into().unwrap()) as usize)
+        .collect()
+}

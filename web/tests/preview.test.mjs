@@ -22,6 +22,8 @@ async function screenshot(name) {
   const folder = process.env.SCREENSHOTS;
   if (!folder) return;
   mkdirSync(folder, { recursive: true });
+  // The shadows follow a new model after 400 ms (main.js).
+  await page.waitForTimeout(600);
   await page.screenshot({ path: join(folder, name) });
 }
 

@@ -3,24 +3,138 @@
 //! Binary model (`/api/model.bin`, `/api/lots.bin`), little-endian:
 //!
 //! ```text
-//! "CGAM"  u32 header length H  header (JSON, H bytes, padded with spaces to 4)
-//! data: per mesh, positions (f32 x 3 per vertex), texture coordinates
-//!       (f32 x 2), normals (i8 x 3, x 127), indices (u16 or u32 x 3 per
-//!       triangle: "index_bytes"); each array padded to 4 bytes
+//! "CGAM"  u32 header length H  u32 data length D
+//! data (D bytes): per mesh, positions (u16 x 3 per vertex, quantised: see below),
+//!       texture coordinates (f32 x 2, only for textured meshes), normals
+//!       (i8 x 3, x 127), indices (u16 or u32 x 3 per triangle:
+//!       "index_bytes"); each array padded to 4 bytes
+//! header (JSON, H bytes)
 //! ```
 //!
-//! The header: `{"origin": [x, y, z], "lots": [{"index", "name", "meshes": [{"mesh", "vertices",
-//! "triangles", "positions", "normals", "uvs", "indices", "color",
-//! "opacity", "material", "double_sided", "texture"}]}]}`, positions
-//! relative to `origin` (the lots' centre when they lie far from the
-//! frame's origin, else zero), offsets in bytes from the start of
-//! the data. `mesh` is the mesh's number in the lot's plain model, which
+//! The header: `{"origin": [x, y, z], "bounds": {"min", "max"} | null,
+//! "lots": [{"index", "name", "meshes": [{"mesh", "vertices",
+//! "triangles", "positions", "min", "extent", "normals", "uvs", "indices",
+//! "color", "opacity", "material", "double_sided", "texture"}]}]}`,
+//! coordinates relative to `origin` (the lots' centre when they lie far
+//! from the frame's origin, else zero), offsets in bytes from the start
+//! of the data. A vertex is at `min + q / 65535 * extent` for its three
+//! 16-bit numbers `q`: one scale for all axes (the mesh's largest side),
+//! so that the page can draw the numbers as they are, scaled, without
+//! bending the normals; a step is the largest side / 65535 (1.5 mm for a
+//! building of 100 m). `bounds` are the model's exact bounds. The header
+//! comes last because the boxes are known only once the positions have
+//! been read: each mesh is measured and written in one visit, while its
+//! arrays are in the cache (the plain meshes of a street are hundreds of
+//! megabytes of `f64`; reading them is most of the time). `mesh` is
+//! the mesh's number in the lot's plain model, which
 //! [`cga::LotResult::provenance`] takes with a triangle number. The page
 //! builds its three.js geometry from these arrays directly, with no glTF
 //! parsing, and keeps the numbers a click needs for provenance.
+//!
+//! Bytes are what a model costs on its way to the picture (the browser
+//! takes about 3 ms per megabyte to fetch it), hence the quantised
+//! positions and byte normals (9 bytes a vertex instead of 24) and no
+//! texture coordinates where no texture reads them.
 
 use cga::{LotResult, Value};
 use serde_json::{json, Value as Json};
+
+/// Largest quantised coordinate.
+const STEPS: f64 = 65535.0;
+
+/// Where one mesh's arrays go in the data, and how its positions are
+/// quantised.
+struct Placed<'a> {
+    lot: usize,
+    /// The mesh's number in its lot's plain model.
+    number: usize,
+    mesh: &'a cga::PlainMesh,
+    texture: Option<String>,
+    /// Corner and far corner of the mesh's box, relative to the origin.
+    min: [f64; 3],
+    max: [f64; 3],
+    uvs: bool,
+    normals: bool,
+    short: bool,
+    /// Offsets of positions, uvs, normals and indices, and the end.
+    at: [usize; 5],
+}
+
+impl Placed<'_> {
+    /// The box's largest side (1 for a point, or a box that is not finite).
+    fn extent(&self) -> f64 {
+        let e = (0..3)
+            .map(|a| self.max[a] - self.min[a])
+            .fold(0.0, f64::max);
+        if e > 0.0 && e.is_finite() {
+            e
+        } else {
+            1.0
+        }
+    }
+
+    fn measure(&mut self, origin: [f64; 3]) {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in &self.mesh.positions {
+            for a in 0..3 {
+                let v = p[a] - origin[a];
+                lo[a] = lo[a].min(v);
+                hi[a] = hi[a].max(v);
+            }
+        }
+        (self.min, self.max) = (lo, hi);
+    }
+
+    /// Measures the box, then writes the arrays into `out`, the bytes
+    /// from `at[0]` to `at[4]`.
+    fn write(&mut self, out: &mut [u8], origin: [f64; 3]) {
+        self.measure(origin);
+        let [positions, uvs, normals, indices, end] = self.at;
+        let base = positions;
+        let scale = STEPS / self.extent();
+        let mesh = self.mesh;
+        let offset: [f64; 3] = std::array::from_fn(|a| origin[a] + self.min[a]);
+        let q = out[positions - base..uvs - base].chunks_exact_mut(6);
+        for (p, q) in mesh.positions.iter().zip(q) {
+            for a in 0..3 {
+                // Non-negative by the box: adding a half and cutting off
+                // rounds (without a call to `round`, which this target
+                // does not inline).
+                let v = ((p[a] - offset[a]) * scale + 0.5).clamp(0.0, STEPS) as u16;
+                q[2 * a..2 * a + 2].copy_from_slice(&v.to_le_bytes());
+            }
+        }
+        if self.uvs {
+            let f = out[uvs - base..normals - base].chunks_exact_mut(8);
+            for (uv, b) in mesh.uvs.iter().zip(f) {
+                b[..4].copy_from_slice(&(uv[0] as f32).to_le_bytes());
+                b[4..].copy_from_slice(&(uv[1] as f32).to_le_bytes());
+            }
+        }
+        // Unit normals need no more than a byte per coordinate (the page
+        // reads them as normalised), rounded as the positions are.
+        if self.normals {
+            let bytes = out[normals - base..indices - base].chunks_exact_mut(3);
+            for (n, b) in mesh.normals.iter().zip(bytes) {
+                for a in 0..3 {
+                    let up = (n[a].clamp(-1.0, 1.0) * 127.0 + 127.5) as i32;
+                    b[a] = ((up - 127) as i8) as u8;
+                }
+            }
+        }
+        let out = &mut out[indices - base..end - base];
+        if self.short {
+            for (i, b) in mesh.indices.iter().flatten().zip(out.chunks_exact_mut(2)) {
+                b.copy_from_slice(&(*i as u16).to_le_bytes());
+            }
+        } else {
+            for (i, b) in mesh.indices.iter().flatten().zip(out.chunks_exact_mut(4)) {
+                b.copy_from_slice(&i.to_le_bytes());
+            }
+        }
+    }
+}
 
 /// The lots' meshes in the binary form above; `texture` gives the URL of
 /// a colour map path as the rules wrote it (`None`: not found, drawn
@@ -31,86 +145,125 @@ pub fn model(
     origin: [f64; 3],
     texture: &mut dyn FnMut(&str) -> Option<String>,
 ) -> Vec<u8> {
-    let mut data: Vec<u8> = Vec::new();
-    let mut lots = Vec::with_capacity(results.len());
-    for lot in results {
-        let mut meshes = Vec::new();
-        for (m, mesh) in lot.model.meshes.iter().enumerate() {
+    // Where everything goes, then the boxes, the header, and the arrays:
+    // boxes and arrays on all cores (tens of megabytes for a street).
+    let mut placed: Vec<Placed> = Vec::new();
+    let mut size = 0usize;
+    for (l, lot) in results.iter().enumerate() {
+        for (number, mesh) in lot.model.meshes.iter().enumerate() {
             if mesh.indices.is_empty() {
                 continue;
             }
             let material = lot.model.materials.get(mesh.material);
-            let positions = data.len();
-            for p in &mesh.positions {
-                for (c, o) in p.iter().zip(origin) {
-                    data.extend_from_slice(&((*c - o) as f32).to_le_bytes());
-                }
-            }
-            let uvs = data.len();
-            for uv in &mesh.uvs {
-                for c in uv {
-                    data.extend_from_slice(&(*c as f32).to_le_bytes());
-                }
-            }
-            // Unit normals need no more than a byte per coordinate (the
-            // page reads them as normalised): a quarter of the bytes to
-            // send, which is most of the time a model takes to arrive.
-            let normals = data.len();
-            for n in &mesh.normals {
-                for c in n {
-                    data.push(((c.clamp(-1.0, 1.0) * 127.0).round() as i8) as u8);
-                }
-            }
-            pad(&mut data);
-            let indices = data.len();
-            let short = mesh.positions.len() <= 1 << 16;
-            for t in &mesh.indices {
-                for &i in t {
-                    if short {
-                        data.extend_from_slice(&(i as u16).to_le_bytes());
-                    } else {
-                        data.extend_from_slice(&i.to_le_bytes());
-                    }
-                }
-            }
-            pad(&mut data);
-            meshes.push(json!({
-                "mesh": m,
-                "vertices": mesh.positions.len(),
-                "triangles": mesh.indices.len(),
+            let texture = material
+                .map(|m| m.colormap())
+                .filter(|p| !p.is_empty())
+                .and_then(&mut *texture);
+            let vertices = mesh.positions.len();
+            let uvs = texture.is_some() && mesh.uvs.len() == vertices;
+            let normals = mesh.normals.len() == vertices;
+            let short = vertices <= 1 << 16;
+            let positions = size;
+            let uv_at = positions + (vertices * 6).next_multiple_of(4);
+            let normal_at = uv_at + if uvs { vertices * 8 } else { 0 };
+            let index_at = normal_at
+                + if normals {
+                    (vertices * 3).next_multiple_of(4)
+                } else {
+                    0
+                };
+            size =
+                index_at + (mesh.indices.len() * 3 * if short { 2 } else { 4 }).next_multiple_of(4);
+            placed.push(Placed {
+                lot: l,
+                number,
+                mesh,
+                texture,
+                min: [0.0; 3],
+                max: [0.0; 3],
+                uvs,
+                normals,
+                short,
+                at: [positions, uv_at, normal_at, index_at, size],
+            });
+        }
+    }
+    let mut out = vec![0u8; 12 + size];
+    out[..4].copy_from_slice(b"CGAM");
+    out[8..12].copy_from_slice(&(size as u32).to_le_bytes());
+    // Each mesh's bytes, cut off the data in order, go with the mesh.
+    let mut data = &mut out[12..];
+    let mut jobs: Vec<(&mut Placed, &mut [u8])> = Vec::with_capacity(placed.len());
+    for p in &mut placed {
+        let (mine, rest) = std::mem::take(&mut data).split_at_mut(p.at[4] - p.at[0]);
+        jobs.push((p, mine));
+        data = rest;
+    }
+    on_cores(&mut jobs, |(p, bytes)| p.write(bytes, origin));
+
+    let mut lots: Vec<Json> = results
+        .iter()
+        .map(|lot| json!({"index": lot.index, "name": lot.name, "meshes": []}))
+        .collect();
+    let mut bounds: Option<([f64; 3], [f64; 3])> = None;
+    for p in &placed {
+        let material = results[p.lot].model.materials.get(p.mesh.material);
+        let [positions, uvs, normals, indices, _] = p.at;
+        lots[p.lot]["meshes"]
+            .as_array_mut()
+            .expect("an array above")
+            .push(json!({
+                "mesh": p.number,
+                "vertices": p.mesh.positions.len(),
+                "triangles": p.mesh.indices.len(),
                 "positions": positions,
-                "normals": if mesh.normals.len() == mesh.positions.len() { json!(normals) } else { Json::Null },
-                "uvs": if mesh.uvs.len() == mesh.positions.len() { json!(uvs) } else { Json::Null },
+                "min": p.min,
+                "extent": p.extent(),
+                "normals": if p.normals { json!(normals) } else { Json::Null },
+                "uvs": if p.uvs { json!(uvs) } else { Json::Null },
                 "indices": indices,
-                "index_bytes": if short { 2 } else { 4 },
-                "texture": material.map(|m| m.colormap()).filter(|p| !p.is_empty()).and_then(&mut *texture),
+                "index_bytes": if p.short { 2 } else { 4 },
+                "texture": p.texture,
                 "color": material.map(|m| m.color).unwrap_or([0.8, 0.8, 0.8]),
                 "opacity": material.map(|m| m.opacity).unwrap_or(1.0),
                 "material": material.map(|m| m.name.to_string()).unwrap_or_default(),
                 "double_sided": material.map(|m| m.double_sided).unwrap_or(false),
             }));
-        }
-        lots.push(json!({"index": lot.index, "name": lot.name, "meshes": meshes}));
+        bounds = Some(match bounds {
+            None => (p.min, p.max),
+            Some((l, h)) => (
+                std::array::from_fn(|a| l[a].min(p.min[a])),
+                std::array::from_fn(|a| h[a].max(p.max[a])),
+            ),
+        });
     }
-    let header = json!({ "lots": lots, "origin": origin });
-    let mut header = serde_json::to_vec(&header).expect("JSON of plain data");
-    while !header.len().is_multiple_of(4) {
-        header.push(b' ');
-    }
-    let mut out = Vec::with_capacity(8 + header.len() + data.len());
-    out.extend_from_slice(b"CGAM");
-    out.extend_from_slice(&(header.len() as u32).to_le_bytes());
+    let header = json!({
+        "lots": lots,
+        "origin": origin,
+        "bounds": bounds.map(|(min, max)| json!({"min": min, "max": max})),
+    });
+    let header = serde_json::to_vec(&header).expect("JSON of plain data");
+    out[4..8].copy_from_slice(&(header.len() as u32).to_le_bytes());
     out.extend_from_slice(&header);
-    out.extend_from_slice(&data);
     out
 }
 
-/// Zeros up to a multiple of 4 bytes: typed arrays over the data must
-/// start aligned.
-fn pad(data: &mut Vec<u8>) {
-    while !data.len().is_multiple_of(4) {
-        data.push(0);
-    }
+/// Runs `work` on every item, the items shared among the cores in runs
+/// of about equal length.
+fn on_cores<T: Send>(items: &mut [T], work: impl Fn(&mut T) + Sync) {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let run = items.len().div_ceil(threads).max(1);
+    std::thread::scope(|scope| {
+        let mut runs = items.chunks_mut(run);
+        let first = runs.next();
+        for run in runs {
+            let work = &work;
+            scope.spawn(move || run.iter_mut().for_each(work));
+        }
+        if let Some(run) = first {
+            run.iter_mut().for_each(&work);
+        }
+    });
 }
 
 /// A CGA value as JSON: numbers (non-finite ones as their text), booleans,
@@ -160,6 +313,68 @@ pub fn attr_value(ty: Option<cga::ValueType>, v: &Json) -> Option<Value> {
 mod tests {
     use super::*;
 
+    /// The header and the data of a binary model.
+    fn split(bytes: &[u8]) -> (Json, &[u8]) {
+        assert_eq!(&bytes[..4], b"CGAM");
+        let h = u32::from_le_bytes(bytes[4..8].try_into().unwrap()) as usize;
+        let d = u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize;
+        assert_eq!(bytes.len(), 12 + d + h);
+        (
+            serde_json::from_slice(&bytes[12 + d..]).unwrap(),
+            &bytes[12..12 + d],
+        )
+    }
+
+    /// A mesh's positions as the page computes them.
+    fn decode_positions(mesh: &Json, data: &[u8]) -> Vec<[f64; 3]> {
+        let at = mesh["positions"].as_u64().unwrap() as usize;
+        let min: Vec<f64> = serde_json::from_value(mesh["min"].clone()).unwrap();
+        let extent = mesh["extent"].as_f64().unwrap();
+        (0..mesh["vertices"].as_u64().unwrap() as usize)
+            .map(|i| {
+                std::array::from_fn(|a| {
+                    let o = at + 6 * i + 2 * a;
+                    let q = u16::from_le_bytes([data[o], data[o + 1]]);
+                    min[a] + q as f64 / STEPS * extent
+                })
+            })
+            .collect()
+    }
+
+    #[test]
+    fn quantised_positions_stay_within_half_a_step() {
+        let engine = cga::Engine::new(cga::MemoryWorld::new());
+        let rules = engine.load_text(
+            "/p/a.cga",
+            "Lot --> extrude(37.3) split(y) { 3.17 : X | ~1 : Y }\n",
+        );
+        let results = rules
+            .generate_all(&[cga::lots::rect(23.7, 11.9)], &cga::Options::default())
+            .unwrap();
+        let bytes = model(&results, [0.0; 3], &mut |_| None);
+        let (header, data) = split(&bytes);
+        let mut checked = 0;
+        for (m, mesh) in header["lots"][0]["meshes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .enumerate()
+        {
+            let exact = &results[0].model.meshes[m].positions;
+            let step = mesh["extent"].as_f64().unwrap() / STEPS;
+            for (got, want) in decode_positions(mesh, data).iter().zip(exact) {
+                for a in 0..3 {
+                    assert!(
+                        (got[a] - want[a]).abs() <= step / 2.0 + 1e-12,
+                        "{got:?} {want:?}"
+                    );
+                }
+                checked += 1;
+            }
+        }
+        assert!(checked >= 16, "{checked}");
+    }
+
     #[test]
     fn a_model_reads_back() {
         let engine = cga::Engine::new(cga::MemoryWorld::new());
@@ -169,25 +384,22 @@ mod tests {
             .generate_all(&[cga::lots::rect(10.0, 20.0)], &cga::Options::default())
             .unwrap();
         let bytes = model(&results, [0.0; 3], &mut |_| None);
-        assert_eq!(&bytes[..4], b"CGAM");
-        let h = u32::from_le_bytes(bytes[4..8].try_into().unwrap()) as usize;
-        assert_eq!(h % 4, 0);
-        let header: Json = serde_json::from_slice(&bytes[8..8 + h]).unwrap();
+        let (header, data) = split(&bytes);
         let mesh = &header["lots"][0]["meshes"][0];
         assert_eq!(mesh["color"], json!([1.0, 0.0, 0.0]));
         // A box without its bottom? extrude keeps the lot face: 6 quads.
         assert_eq!(mesh["triangles"], json!(12));
-        let data = &bytes[8 + h..];
         let vertices = mesh["vertices"].as_u64().unwrap() as usize;
-        let at = mesh["positions"].as_u64().unwrap() as usize;
-        let ys: Vec<f32> = (0..vertices)
-            .map(|i| {
-                let o = at + i * 12 + 4;
-                f32::from_le_bytes(data[o..o + 4].try_into().unwrap())
-            })
-            .collect();
-        let top = ys.iter().cloned().fold(f32::MIN, f32::max);
-        assert_eq!(top, 7.0);
+        let ys: Vec<f64> = decode_positions(mesh, data).iter().map(|p| p[1]).collect();
+        let top = ys.iter().cloned().fold(f64::MIN, f64::max);
+        // Within half a step of the largest side (20 m).
+        assert!((top - 7.0).abs() <= 10.0 / STEPS, "{top}");
+        assert_eq!(
+            header["bounds"],
+            json!({"min": [0.0, 0.0, -20.0], "max": [10.0, 7.0, 0.0]})
+        );
+        // No texture: no texture coordinates sent.
+        assert_eq!(mesh["uvs"], Json::Null);
         let indices = mesh["indices"].as_u64().unwrap() as usize;
         // 12 triangles of 16-bit indices.
         assert_eq!(mesh["index_bytes"], 2);
@@ -230,20 +442,14 @@ mod tests {
             .generate_all(&[lot], &cga::Options::default())
             .unwrap();
         let bytes = model(&results, origin.to_array(), &mut |_| None);
-        let h = u32::from_le_bytes(bytes[4..8].try_into().unwrap()) as usize;
-        let header: Json = serde_json::from_slice(&bytes[8..8 + h]).unwrap();
+        let (header, data) = split(&bytes);
         assert_eq!(header["origin"], json!([1e7 + 10.0, 0.0, -1e7 - 8.0]));
         let mesh = &header["lots"][0]["meshes"][0];
-        let data = &bytes[8 + h..];
-        let at = mesh["positions"].as_u64().unwrap() as usize;
-        let xs: Vec<f64> = (0..4)
-            .map(|i| {
-                f32::from_le_bytes(data[at + 12 * i..at + 12 * i + 4].try_into().unwrap()) as f64
-            })
-            .collect();
+        let xs: Vec<f64> = decode_positions(mesh, data).iter().map(|p| p[0]).collect();
         let width = xs.iter().cloned().fold(f64::MIN, f64::max)
             - xs.iter().cloned().fold(f64::MAX, f64::min);
-        assert!((width - 20.123).abs() < 1e-5, "{width}");
+        // The largest side is exact; others within half a step.
+        assert!((width - 20.123).abs() < 1e-9, "{width}");
     }
 
     #[test]

@@ -6,6 +6,8 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Condvar, Mutex, RwLock};
 use std::time::Instant;
 
+use axum::body::Bytes;
+
 use cga::{Cancel, ConfinedWorld, DiskWorld, Engine, Error, Lot, LotResult, Options, Rules};
 use serde_json::{json, Value as Json};
 
@@ -29,7 +31,8 @@ pub struct Snapshot {
     /// The state as JSON (`/api/state`, the `state` event).
     pub state: Arc<String>,
     /// The last good model (binary, see [`encode`]) and its number.
-    pub model: Arc<Vec<u8>>,
+    /// Shared with every request that sends it (no copy).
+    pub model: Bytes,
     pub model_version: u64,
     /// What made the model: for provenance and the GLB download.
     pub made_by: Option<Made>,
@@ -63,7 +66,7 @@ pub struct Preview {
     pub roots: Vec<PathBuf>,
     pub lots: Vec<Lot>,
     /// The lots' own outlines as meshes (binary, see [`encode`]).
-    pub lots_model: Arc<Vec<u8>>,
+    pub lots_model: Bytes,
     /// The point models are sent relative to: lots far from the frame's
     /// origin (a national grid's metres) would lose their millimetres in
     /// the page's 32-bit floats.
@@ -112,12 +115,12 @@ impl Preview {
         let lot_set = cga::lots::read(&config.lots).map_err(|e| e.to_string())?;
         let lots = lot_set.lots;
         let origin = cga::lots::local_origin(&lots).map_or([0.0; 3], |o| o.to_array());
-        let lots_model = Arc::new(lot_outlines(&engine, &roots[0], &lots, origin));
+        let lots_model = Bytes::from(lot_outlines(&engine, &roots[0], &lots, origin));
         let (events, _) = tokio::sync::watch::channel(0);
         let empty = Snapshot {
             version: 0,
             state: Arc::new("{}".to_string()),
-            model: Arc::new(encode::model(&[], origin, &mut |_| None)),
+            model: Bytes::from(encode::model(&[], origin, &mut |_| None)),
             model_version: 0,
             made_by: None,
         };
@@ -365,6 +368,7 @@ impl Preview {
     ) {
         let version = previous.version + 1;
         let fresh = made.is_some();
+        let encoding = Instant::now();
         let (model, model_version, made_by) = match made {
             Some(m) => {
                 let mut found = std::collections::HashMap::new();
@@ -375,7 +379,7 @@ impl Preview {
                         .clone()
                 };
                 (
-                    Arc::new(encode::model(&m.results, self.origin, &mut texture)),
+                    Bytes::from(encode::model(&m.results, self.origin, &mut texture)),
                     version,
                     Some(m),
                 )
@@ -385,6 +389,11 @@ impl Preview {
                 previous.model_version,
                 previous.made_by.clone(),
             ),
+        };
+        let encode_ms = if fresh {
+            encoding.elapsed().as_secs_f64() * 1e3
+        } else {
+            0.0
         };
         let results: &[LotResult] = made_by.as_ref().map(|m| &m.results[..]).unwrap_or(&[]);
         let mut prints = Vec::new();
@@ -406,6 +415,9 @@ impl Preview {
             "triangles": results.iter().map(|l| l.model.triangles()).sum::<usize>(),
             "load_ms": load_ms,
             "generate_ms": made_by.as_ref().map(|m| m.generate_ms).unwrap_or(gen_ms),
+            // Making the bytes the page fetches.
+            "encode_ms": encode_ms,
+            "model_bytes": model.len(),
         });
         let state = json!({
             "version": version,

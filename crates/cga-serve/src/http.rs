@@ -85,14 +85,11 @@ async fn events(
 
 async fn model(State(app): State<App>) -> Response {
     let s = app.preview.snapshot();
-    no_store("application/octet-stream", s.model.as_ref().clone())
+    no_store("application/octet-stream", s.model.clone())
 }
 
 async fn lots(State(app): State<App>) -> Response {
-    no_store(
-        "application/octet-stream",
-        app.preview.lots_model.as_ref().clone(),
-    )
+    no_store("application/octet-stream", app.preview.lots_model.clone())
 }
 
 /// The last good model as a GLB, generated again into a writer with the

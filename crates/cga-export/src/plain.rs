@@ -8,7 +8,6 @@
 use cga_geometry::mesh::SharedVec;
 use cga_geometry::{DAffine3, Material, Mesh};
 
-use crate::hash::FastMap;
 use crate::materials::MaterialTable;
 use crate::prepare::{FacePrep, SlotIds};
 use crate::{check_mesh, ExportError};
@@ -53,6 +52,8 @@ impl PlainModel {
     }
 }
 
+const NO_VERTEX: u32 = u32::MAX;
+
 /// Gathers leaves into a [`PlainModel`].
 #[derive(Default)]
 pub struct PlainCollector {
@@ -60,8 +61,10 @@ pub struct PlainCollector {
     slots: SlotIds,
     table: MaterialTable,
     model: PlainModel,
-    /// The vertex of each corner of the face being added.
-    corner_vertex: FastMap<u32, u32>,
+    /// The vertex of each corner of the mesh being added (`NO_VERTEX` for
+    /// corners of the current face not yet given one): indexed, not
+    /// hashed, since a street's collection visits millions of corners.
+    corner_vertex: Vec<u32>,
 }
 
 impl PlainCollector {
@@ -89,6 +92,8 @@ impl PlainCollector {
             corner_vertex,
         } = self;
         slots.begin(materials);
+        corner_vertex.clear();
+        corner_vertex.resize(mesh.corners.len(), NO_VERTEX);
         let skipped = prep.faces(mesh, transform, |f| {
             let id = slots.id(f.material, || {
                 let (id, new) = table.intern(&materials[f.material as usize]);
@@ -103,19 +108,25 @@ impl PlainCollector {
             });
             let out = &mut model.meshes[id as usize];
             let uvs = f.mesh.uvs[0].as_deref();
-            corner_vertex.clear();
+            // A vertex per corner of the face, in the order the triangles
+            // first use them.
+            for l in f.mesh.face_loops(f.face) {
+                corner_vertex[f.mesh.loop_corners(*l)].fill(NO_VERTEX);
+            }
             for tri in f.triangles {
                 let mut ids = [0u32; 3];
                 for (k, &c) in tri.iter().enumerate() {
-                    ids[k] = *corner_vertex.entry(c).or_insert_with(|| {
+                    let v = &mut corner_vertex[c as usize];
+                    if *v == NO_VERTEX {
                         let p = f.positions[f.mesh.corners[c as usize] as usize];
                         let n = f.normals.map_or(f.normal, |n| n[c as usize]);
                         let uv = uvs.and_then(|u| u.get(c as usize)).copied();
                         out.positions.push(p.to_array());
                         out.normals.push(n.to_array());
                         out.uvs.push(uv.map_or([0.0; 2], |t| t.to_array()));
-                        (out.positions.len() - 1) as u32
-                    });
+                        *v = (out.positions.len() - 1) as u32;
+                    }
+                    ids[k] = *v;
                 }
                 out.indices.push(ids);
                 out.triangle_leaf.push(leaf);

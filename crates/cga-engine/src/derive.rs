@@ -39,6 +39,11 @@ pub struct Limits {
     pub max_faces: usize,
 }
 
+/// Shapes waiting in a derivation's queue above which it goes depth first
+/// (see `derive_all_now`): a shape is about 600 bytes, so 65,536 of them
+/// are some 40 MB.
+const DEPTH_FIRST_ABOVE: usize = 1 << 16;
+
 impl Default for Limits {
     fn default() -> Self {
         Limits {
@@ -691,7 +696,17 @@ impl<'a> Interp<'a> {
         let outer = std::mem::replace(&mut self.queue, pooled_queue());
         let mut result = start(self);
         if result.is_ok() {
-            while let Some(p) = self.queue.pop_front() {
+            // Breadth first (the order of leaves, prints and reports), until
+            // the queue holds more shapes than any building needs: then
+            // depth first, so that rules that multiply shapes without end
+            // (`A --> A A`) meet the depth limit within milliseconds instead
+            // of filling gigabytes on the way to the shape limit, and a huge
+            // lot's tiles are finished one by one.
+            while let Some(p) = if self.queue.len() > DEPTH_FIRST_ABOVE {
+                self.queue.pop_back()
+            } else {
+                self.queue.pop_front()
+            } {
                 if let Err(e) = self.run_rule(p) {
                     result = Err(e);
                     break;

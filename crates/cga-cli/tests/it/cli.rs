@@ -234,6 +234,33 @@ fn shape_explosions_stop_at_the_shape_limit() {
     );
 }
 
+/// With the default limits, shapes that multiply without end are not
+/// kept waiting by the million on the way to the shape limit (5 million:
+/// gigabytes): past 65,536 waiting shapes the derivation goes depth
+/// first and meets the depth limit (2^16 + 2^16 + 1000 shapes or so).
+#[test]
+fn shape_explosions_meet_the_depth_limit_early() {
+    let dir = temp_dir("doubling");
+    let rules = rule_file(&dir, "x.cga", "Lot --> A\nA --> A A\n");
+    let glb = dir.join("x.glb");
+    let out = run(&[
+        "generate",
+        rules.to_str().unwrap(),
+        "-o",
+        glb.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert!(err.contains("depth limit (1000)"), "{err}");
+    // "wrote ...: 1 lots, N shapes, ..."
+    let shapes: u64 = err
+        .split(", ")
+        .find_map(|part| part.strip_suffix(" shapes"))
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no shape count in {err}"));
+    assert!((131_072..140_000).contains(&shapes), "{shapes} shapes");
+}
+
 /// Found by fuzzing: a rule body runs on to the next line, so
 /// `Lot --> extrude(5)` followed by a stray `Lot` makes the rule call
 /// itself; each extrusion extrudes every face of the last one, so the

@@ -84,6 +84,13 @@ try {
       throw e;
     }
     sliderTimes.push(await page.evaluate((t) => window.cgaPreview.drawnAt - t, t0));
+    if (process.env.DEBUG) {
+      console.error('timeline', await page.evaluate((t) => {
+        const p = window.cgaPreview.drawParts;
+        const s = window.cgaPreview.stats;
+        return JSON.stringify({ sent: p.sent - t, state: p.state - t, load: p.loadStart - t, drawn: window.cgaPreview.drawnAt - t, generate: s.generate_ms, encode: s.encode_ms });
+      }, t0));
+    }
     await page.waitForTimeout(150);
   }
   const f = (x) => `${x.toFixed(0)} ms`;

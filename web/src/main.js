@@ -279,7 +279,7 @@ async function loadModel(version) {
   page.drawMs = page.drawnAt - t;
   // Where the time went: fetching, building the meshes, issuing the
   // draw, until the frame was shown (the benchmark reads these).
-  page.drawParts = { fetch: fetched - t, build: built - fetched, render: rendered - built, frame: page.drawnAt - rendered };
+  page.drawParts = { fetch: fetched - t, build: built - fetched, render: rendered - built, frame: page.drawnAt - rendered, sent: page.sentAt, state: page.stateAt, loadStart: t };
   // The exact bounds the server computed (the positions drawn are within
   // a step of 16 bits of the mesh's box).
   page.bounds = modelGroup.userData.bounds ?? null;
@@ -559,6 +559,7 @@ function renderOutputs(state) {
 }
 
 function onState(state) {
+  page.stateAt = performance.now();
   page.stateVersion = state.version;
   page.problems = state.problems;
   page.stale = state.stale;

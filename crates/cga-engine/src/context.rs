@@ -1178,9 +1178,19 @@ impl Interp<'_> {
 
     /// Whether the first pass of context queries skips `rule` ([`FirstPass`]).
     pub(crate) fn context_skips(&self, rule: crate::program::RuleId) -> bool {
-        self.collected.is_none()
-            && self.context_collecting()
-            && !FirstPass::cached(self.program).applies(rule)
+        self.first_pass_runs() && !FirstPass::cached(self.program).applies(rule)
+    }
+
+    /// Whether the first pass of context queries skips `body`, a component
+    /// split's entry ([`FirstPass::body_applies`]).
+    pub(crate) fn context_skips_body(&self, body: &RBody) -> bool {
+        self.first_pass_runs() && !FirstPass::cached(self.program).body_applies(body)
+    }
+
+    /// A first pass outside `inline` and `modify` (whose rules are never
+    /// skipped).
+    fn first_pass_runs(&self) -> bool {
+        self.collected.is_none() && self.context_collecting()
     }
 
     /// Whether this is a first, collecting pass (nothing is emitted).

@@ -49,6 +49,7 @@ struct Placed<'a> {
     /// The mesh's number in its lot's plain model.
     number: usize,
     mesh: &'a cga::PlainMesh,
+    material: Option<&'a cga::Material>,
     texture: Option<String>,
     /// Corner and far corner of the mesh's box, relative to the origin.
     min: [f64; 3],
@@ -178,6 +179,7 @@ pub fn model(
                 lot: l,
                 number,
                 mesh,
+                material,
                 texture,
                 min: [0.0; 3],
                 max: [0.0; 3],
@@ -207,7 +209,7 @@ pub fn model(
         .collect();
     let mut bounds: Option<([f64; 3], [f64; 3])> = None;
     for p in &placed {
-        let material = results[p.lot].model.materials.get(p.mesh.material);
+        let material = p.material;
         let [positions, uvs, normals, indices, _] = p.at;
         lots[p.lot]["meshes"]
             .as_array_mut()

@@ -1377,9 +1377,7 @@ pub(crate) fn run(
         let total = sets.len() as f64;
         // The first pass of context queries needs only the shapes on the
         // way to a label a query asks about.
-        let skip = cx.collected.is_none()
-            && cx.context_collecting()
-            && !crate::context::FirstPass::cached(cx.program).body_applies(entry.body);
+        let skip = cx.context_skips_body(entry.body);
         for (i, set) in sets.iter().enumerate() {
             let mut child = cx.child(&st.shape, entry.head.span)?;
             if skip {

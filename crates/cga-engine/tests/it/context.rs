@@ -20,11 +20,10 @@ fn run(src: &str, lots: &[Lot]) -> Vec<LotOutput> {
     run_with(src, lots, true)
 }
 
-/// [`run`], with or without the scene (without: each lot's first pass is
-/// its own, inter queries find nothing). The start rule is `Lot`, else the
-/// first rule of the text.
+/// `src` loaded as `context.cga`; panics with the diagnostics if it has
+/// errors.
 #[track_caller]
-fn run_with(src: &str, lots: &[Lot], scene: bool) -> Vec<LotOutput> {
+fn load(src: &str) -> (cga_engine::Program, SourceMap) {
     let mut sources = SourceMap::new();
     let loaded = cga_engine::load_text(
         &cga_world::DiskWorld,
@@ -32,15 +31,23 @@ fn run_with(src: &str, lots: &[Lot], scene: bool) -> Vec<LotOutput> {
         src.to_string(),
         &mut sources,
     );
-    let errors = loaded.has_errors();
-    let Some(program) = (!errors).then_some(loaded.program) else {
+    if loaded.has_errors() {
         let text: String = loaded
             .diagnostics
             .iter()
             .map(|d| d.render(&sources))
             .collect();
         panic!("rules do not load:\n{text}");
-    };
+    }
+    (loaded.program, sources)
+}
+
+/// [`run`], with or without the scene (without: each lot's first pass is
+/// its own, inter queries find nothing). The start rule is `Lot`, else the
+/// first rule of the text.
+#[track_caller]
+fn run_with(src: &str, lots: &[Lot], scene: bool) -> Vec<LotOutput> {
+    let (program, sources) = load(src);
     let first = src
         .split("-->")
         .next()
@@ -625,15 +632,7 @@ fn addresses_survive_a_diverging_branch() {
 
 /// The first pass of `src` on a 10 x 10 lot (start rule `Lot`).
 fn first_pass(src: &str) -> (cga_engine::Program, cga_engine::context::LotContext) {
-    let mut sources = SourceMap::new();
-    let loaded = cga_engine::load_text(
-        &cga_world::DiskWorld,
-        std::path::Path::new("context.cga"),
-        src.to_string(),
-        &mut sources,
-    );
-    assert!(!loaded.has_errors());
-    let program = loaded.program;
+    let (program, sources) = load(src);
     let rule = program.start_rule(Some("Lot")).unwrap();
     let assets = Assets::on_disk(&sources);
     let lot = lot::rect(10.0, 10.0);

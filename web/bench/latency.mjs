@@ -88,7 +88,7 @@ try {
       console.error('timeline', await page.evaluate((t) => {
         const p = window.cgaPreview.drawParts;
         const s = window.cgaPreview.stats;
-        return JSON.stringify({ sent: p.sent - t, state: p.state - t, load: p.loadStart - t, drawn: window.cgaPreview.drawnAt - t, generate: s.generate_ms, encode: s.encode_ms });
+        return JSON.stringify({ sent: p.sent - t, state: p.state - t, load: p.loadStart - t, drawn: window.cgaPreview.drawnAt - t, generate: s.generate_ms, encode: s.encode_ms, fetch: p.fetch, build: p.build, render: p.render, frame: p.frame });
       }, t0));
     }
     await page.waitForTimeout(150);

@@ -45,6 +45,21 @@ pub struct PlainModel {
     pub skipped_non_finite: u64,
 }
 
+impl PlainMesh {
+    /// An empty mesh of `material` with room for `vertices` and
+    /// `triangles`.
+    fn with_capacity(material: usize, vertices: usize, triangles: usize) -> PlainMesh {
+        PlainMesh {
+            material,
+            positions: Vec::with_capacity(vertices),
+            normals: Vec::with_capacity(vertices),
+            uvs: Vec::with_capacity(vertices),
+            indices: Vec::with_capacity(triangles),
+            triangle_leaf: Vec::with_capacity(triangles),
+        }
+    }
+}
+
 impl PlainModel {
     /// Triangles over all meshes.
     pub fn triangles(&self) -> usize {
@@ -65,6 +80,9 @@ pub struct PlainCollector {
     /// corners of the current face not yet given one): indexed, not
     /// hashed, since a street's collection visits millions of corners.
     corner_vertex: Vec<u32>,
+    /// Vertices and triangles of each mesh of the model taken last (by
+    /// material number, in order of first use).
+    last_sizes: Vec<(usize, usize)>,
 }
 
 impl PlainCollector {
@@ -90,6 +108,7 @@ impl PlainCollector {
             table,
             model,
             corner_vertex,
+            last_sizes,
         } = self;
         slots.begin(materials);
         corner_vertex.clear();
@@ -99,10 +118,14 @@ impl PlainCollector {
                 let (id, new) = table.intern(&materials[f.material as usize]);
                 if new {
                     model.materials.push(table.get(id).clone());
-                    model.meshes.push(PlainMesh {
-                        material: id as usize,
-                        ..PlainMesh::default()
-                    });
+                    // Room for as much as the same mesh of the lot before
+                    // had: lots of one street are much alike, and arrays
+                    // grown by doubling were copied and faulted in again
+                    // and again.
+                    let (v, t) = last_sizes.get(id as usize).copied().unwrap_or_default();
+                    model
+                        .meshes
+                        .push(PlainMesh::with_capacity(id as usize, v, t));
                 }
                 id
             });
@@ -143,6 +166,13 @@ impl PlainCollector {
     pub fn take(&mut self) -> PlainModel {
         self.table = MaterialTable::default();
         self.slots.clear();
+        self.last_sizes.clear();
+        self.last_sizes.extend(
+            self.model
+                .meshes
+                .iter()
+                .map(|m| (m.positions.len(), m.indices.len())),
+        );
         std::mem::take(&mut self.model)
     }
 }
@@ -188,5 +218,26 @@ mod tests {
             assert!(geometric.dot(n) > 0.0);
         }
         assert!(c.take().meshes.is_empty());
+    }
+
+    #[test]
+    fn room_kept_from_the_lot_before_changes_nothing_collected() {
+        let cube = cga_geometry::primitive::cube(DVec3::new(2.0, 3.0, 4.0));
+        let mut c = PlainCollector::new();
+        c.add_placed(&cube, None, &cube.materials, 0).unwrap();
+        c.add_placed(&cube, None, &cube.materials, 1).unwrap();
+        let first = c.take();
+        // The next lot's mesh starts with room for the first one's.
+        c.add_placed(&cube, None, &cube.materials, 0).unwrap();
+        let second = c.take();
+        assert!(second.meshes[0].positions.capacity() >= 48);
+        assert!(second.meshes[0].indices.capacity() >= 24);
+        assert_eq!(second.meshes[0].positions.len(), 24);
+        assert_eq!(second.meshes[0].indices.len(), 12);
+        // What a lot collects does not depend on the lot before.
+        let mut fresh = PlainCollector::new();
+        fresh.add_placed(&cube, None, &cube.materials, 0).unwrap();
+        assert_eq!(second, fresh.take());
+        assert_eq!(first.meshes[0].indices.len(), 24);
     }
 }

@@ -1,0 +1,58 @@
+//! How long generating lots into plain meshes takes (what the Python
+//! package and the live preview ask the library for), against deriving
+//! them without geometry, best and median of several runs:
+//!
+//!     cargo run --release -p cga --example meshes_bench -- RULES.cga LOTSPEC [RUNS]
+//!
+//! LOTSPEC as the `cga` command's `--lot` takes it (e.g.
+//! `grid:5x4:lots/candler_footprint.obj`).
+
+use std::time::Instant;
+
+use cga::{Engine, Options, Target};
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let [rules, lots, rest @ ..] = &args[..] else {
+        eprintln!("usage: meshes_bench RULES.cga LOTSPEC [RUNS]");
+        std::process::exit(2);
+    };
+    let runs: usize = rest
+        .first()
+        .map_or(5, |r| r.parse().expect("RUNS is a number"));
+    let rules = Engine::new(cga::DiskWorld).load(rules);
+    let lots = cga::lots::read(&[lots]).expect("lots").lots;
+    let options = Options::default();
+    let time = |meshes: bool| {
+        let mut times: Vec<f64> = (0..runs)
+            .map(|_| {
+                let t = Instant::now();
+                if meshes {
+                    let out = rules.generate_all(&lots, &options).expect("generates");
+                    std::hint::black_box(out);
+                } else {
+                    rules
+                        .generate_lots(&lots, &options, Target::Nothing, |r| {
+                            std::hint::black_box(r);
+                        })
+                        .expect("generates");
+                }
+                t.elapsed().as_secs_f64() * 1e3
+            })
+            .collect();
+        times.sort_by(f64::total_cmp);
+        (times[0], times[times.len() / 2])
+    };
+    // MESHES_ONLY=1 skips the derivation-only runs (for a profiler).
+    let meshes_only = std::env::var_os("MESHES_ONLY").is_some();
+    let (best, median) = if meshes_only { (0.0, 0.0) } else { time(false) };
+    println!(
+        "{} lots, derivation only: best {best:.1} ms, median {median:.1} ms",
+        lots.len()
+    );
+    let (best, median) = time(true);
+    println!(
+        "{} lots, plain meshes:    best {best:.1} ms, median {median:.1} ms",
+        lots.len()
+    );
+}

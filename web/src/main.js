@@ -75,6 +75,17 @@ function resize() {
 // the shadows follow once the models stop coming (a slider being moved,
 // edits saved one after another) for SHADOW_DELAY_MS.
 const SHADOW_DELAY_MS = 400;
+// A new model is on its way (values sent, a file saved): the shadows
+// wait for it, so that their pass does not take the cores generating it.
+function holdShadows() {
+  clearTimeout(shadowTimer);
+}
+// Shadows that were held follow after the delay.
+function releaseShadows() {
+  if (!shadowsStale) return;
+  clearTimeout(shadowTimer);
+  shadowTimer = setTimeout(() => render(), SHADOW_DELAY_MS);
+}
 function render({ newModel = false } = {}) {
   resize();
   if (newModel) {
@@ -161,15 +172,44 @@ function decodeModel(buffer) {
 // seen after a reload of the page.
 const textures = new Map();
 const textureLoader = new THREE.TextureLoader();
+// Per-mesh copies of a colour map made before its image arrived: told
+// when it does.
+const waitingCopies = new Map();
 function texture(url) {
   if (!textures.has(url)) {
-    const t = textureLoader.load(url, () => render());
+    waitingCopies.set(url, []);
+    const t = textureLoader.load(url, () => {
+      // The map keeps its image on the GPU while meshes come and go
+      // (their copies share it).
+      renderer.initTexture(t);
+      for (const copy of waitingCopies.get(url)) copy.version = t.version;
+      waitingCopies.delete(url);
+      render();
+    });
     t.colorSpace = THREE.SRGBColorSpace;
     t.wrapS = t.wrapT = THREE.RepeatWrapping;
     t.anisotropy = 4;
     textures.set(url, t);
   }
   return textures.get(url);
+}
+
+// A colour map for texture coordinates sent as 16-bit steps across their
+// box (see the server's encode.rs): a texture sharing the map's image (on
+// the GPU too) whose offset and repeat move the steps back into the box.
+// Not `clone()`: a copy marks the image for another upload.
+const sharedSettings = ['wrapS', 'wrapT', 'magFilter', 'minFilter', 'anisotropy', 'format', 'internalFormat', 'type', 'generateMipmaps', 'premultiplyAlpha', 'flipY', 'unpackAlignment', 'colorSpace'];
+function steppedTexture(url, min, extent) {
+  const map = texture(url);
+  const copy = new THREE.Texture();
+  for (const k of sharedSettings) copy[k] = map[k];
+  copy.source = map.source;
+  copy.version = map.version;
+  copy.offset.set(min[0], min[1]);
+  copy.repeat.set(extent[0], extent[1]);
+  copy.userData.copy = true;
+  waitingCopies.get(url)?.push(copy);
+  return copy;
 }
 
 function srgb(c) {
@@ -189,6 +229,7 @@ function buildMeshes(buffer, group, { lots = false } = {}) {
   // and materials are freed.
   for (const child of group.children) {
     child.geometry.dispose();
+    if (child.material.map?.userData.copy) child.material.map.dispose();
     child.material.dispose();
   }
   group.clear();
@@ -205,8 +246,15 @@ function buildMeshes(buffer, group, { lots = false } = {}) {
       } else {
         geometry.computeVertexNormals();
       }
-      if (m.uvs !== null) {
+      let map = null;
+      if (m.uvs !== null && m.uv_bytes === 2) {
+        // 16-bit steps across the box, read as normalised; the map's
+        // offset and repeat put them back.
+        geometry.setAttribute('uv', new THREE.BufferAttribute(new Uint16Array(buffer, data + m.uvs, m.vertices * 2), 2, true));
+        if (!lots && m.texture) map = steppedTexture(m.texture, m.uv_min, m.uv_extent);
+      } else if (m.uvs !== null) {
         geometry.setAttribute('uv', new THREE.BufferAttribute(new Float32Array(buffer, data + m.uvs, m.vertices * 2), 2));
+        if (!lots && m.texture) map = texture(m.texture);
       }
       // Every quantised position lies in the unit cube: bounds known
       // without a pass over the vertices (three.js would make one for
@@ -217,7 +265,7 @@ function buildMeshes(buffer, group, { lots = false } = {}) {
       geometry.setIndex(new THREE.BufferAttribute(new Indices(buffer, data + m.indices, m.triangles * 3), 1));
       const material = new THREE.MeshStandardMaterial({
         color: lots ? 0xa8a89e : srgb(m.color),
-        map: !lots && m.texture && m.uvs !== null ? texture(m.texture) : null,
+        map,
         roughness: 0.85,
         metalness: 0,
         transparent: m.opacity < 1,
@@ -335,6 +383,7 @@ function sendParams() {
   sendTimer = requestAnimationFrame(async () => {
     sendTimer = null;
     page.sentAt = performance.now();
+    holdShadows();
     setStatus('generating…', 'busy');
     await fetch('api/params', {
       method: 'POST',
@@ -579,6 +628,7 @@ function onState(state) {
   if (errors) setStatus(`${errors} error${errors > 1 ? 's' : ''}`, 'error');
   else setStatus('up to date');
   if (state.model_version !== page.modelVersion && state.model_version > 0) loadModel(state.model_version);
+  else releaseShadows();
 }
 
 // ------------------------------------------------------------- provenance
@@ -616,6 +666,10 @@ canvas.addEventListener('pointerup', async (e) => {
 function connect() {
   const events = new EventSource('api/events');
   events.addEventListener('state', (e) => onState(JSON.parse(e.data)));
+  events.addEventListener('generating', () => {
+    holdShadows();
+    setStatus('generating…', 'busy');
+  });
   events.onerror = () => setStatus('disconnected: is cga serve running?', 'error');
   events.onopen = () => setStatus('connected');
 }

@@ -79,6 +79,10 @@ pub struct Preview {
     running: Mutex<Option<(u64, Cancel)>>,
     published: RwLock<Arc<Snapshot>>,
     events: tokio::sync::watch::Sender<u64>,
+    /// The number of the latest request, sent as it is made: pages learn
+    /// that a new model is on its way (a saved file, another page's
+    /// values) before it comes.
+    requests: tokio::sync::watch::Sender<u64>,
     watcher: Mutex<Option<notify::RecommendedWatcher>>,
     lot_notes: Vec<String>,
 }
@@ -117,6 +121,7 @@ impl Preview {
         let origin = cga::lots::local_origin(&lots).map_or([0.0; 3], |o| o.to_array());
         let lots_model = Bytes::from(lot_outlines(&engine, &roots[0], &lots, origin));
         let (events, _) = tokio::sync::watch::channel(0);
+        let (requests, _) = tokio::sync::watch::channel(0);
         let empty = Snapshot {
             version: 0,
             state: Arc::new("{}".to_string()),
@@ -143,6 +148,7 @@ impl Preview {
             running: Mutex::new(None),
             published: RwLock::new(Arc::new(empty)),
             events,
+            requests,
             watcher: Mutex::new(None),
             lot_notes: lot_set.warnings,
         });
@@ -199,6 +205,7 @@ impl Preview {
             r.number
         };
         self.wake.notify_all();
+        self.requests.send_replace(number);
         // Only an older request's generation: the worker may already have
         // taken this very request.
         let mut running = self.running.lock().unwrap();
@@ -229,6 +236,11 @@ impl Preview {
 
     pub fn subscribe(&self) -> tokio::sync::watch::Receiver<u64> {
         self.events.subscribe()
+    }
+
+    /// The number of each request as it is made (see `requests`).
+    pub fn subscribe_requests(&self) -> tokio::sync::watch::Receiver<u64> {
+        self.requests.subscribe()
     }
 
     /// Blocks until a state of at least `version` is published (tests,

@@ -76,10 +76,15 @@ async fn events(
     let preview = app.preview.clone();
     // The current state at once, then each newer one; states published
     // while a client was busy are skipped, only the latest counts.
-    let stream = tokio_stream::wrappers::WatchStream::new(app.preview.subscribe()).map(move |_| {
+    let states = tokio_stream::wrappers::WatchStream::new(app.preview.subscribe()).map(move |_| {
         let s = preview.snapshot();
         Ok(Event::default().event("state").data(s.state.as_str()))
     });
+    // And a `generating` event as each request is made, before its model.
+    let requests =
+        tokio_stream::wrappers::WatchStream::from_changes(app.preview.subscribe_requests())
+            .map(|n| Ok(Event::default().event("generating").data(n.to_string())));
+    let stream = states.merge(requests);
     Sse::new(stream).keep_alive(KeepAlive::default())
 }
 

@@ -9,7 +9,7 @@
 //! | --- | --- |
 //! | `GET /` and `GET /NAME` | the page (`web/dist`: `index.html`, `main.js`, ...) |
 //! | `GET /api/state` | JSON: attributes with annotations, values, diagnostics, prints, reports, statistics |
-//! | `GET /api/events` | server-sent events: a `state` event (the same JSON) after every change |
+//! | `GET /api/events` | server-sent events: a `state` event (the same JSON) after every change, a `generating` event (the request's number) as each regeneration is asked for |
 //! | `GET /api/model.bin` | the last good model: meshes per lot and material (see [`encode`]) |
 //! | `GET /api/lots.bin` | the lots, in the same form, to draw under the buildings |
 //! | `GET /api/model.glb` | the model as a GLB file (download) |

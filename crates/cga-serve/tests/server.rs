@@ -408,3 +408,45 @@ fn every_request_is_served_however_it_meets_the_generation() {
         }
     }
 }
+
+#[test]
+fn a_saved_file_is_announced_before_its_model() {
+    let (dir, server) = workspace("Lot --> extrude(4) A.\n");
+    let addr = server.addr;
+    let version = state(addr)["version"].as_u64().unwrap();
+    let mut events = TcpStream::connect(addr).unwrap();
+    events
+        .write_all(b"GET /api/events HTTP/1.1\r\nHost: x\r\n\r\n")
+        .unwrap();
+    events
+        .set_read_timeout(Some(Duration::from_secs(30)))
+        .unwrap();
+    // Reads the stream until `until` holds of what came so far.
+    let mut seen = String::new();
+    let mut read_until = |until: &dyn Fn(&str) -> bool| {
+        let mut buf = [0u8; 4096];
+        while !until(&seen) {
+            let n = events.read(&mut buf).unwrap();
+            assert!(n > 0, "the stream ended: {seen}");
+            seen.push_str(&String::from_utf8_lossy(&buf[..n]));
+        }
+        seen.clone()
+    };
+    // The current state comes first, and no request is announced yet.
+    let start = read_until(&|s| s.contains("event: state"));
+    assert!(!start.contains("event: generating"), "{start}");
+    let before = start.len();
+    write(
+        &dir.path().join("project/rules/a.cga"),
+        "Lot --> extrude(9) split(y) { 3 : A }*\n",
+    );
+    let after = read_until(&|s| s[before..].contains("event: state"));
+    let fresh = &after[before..];
+    let generating = fresh.find("event: generating").expect("announced");
+    assert!(generating < fresh.find("event: state").unwrap(), "{fresh}");
+    assert!(server
+        .preview
+        .wait_for_version(version + 1, Duration::from_secs(30)));
+    // Three boxes of 12 triangles.
+    assert_eq!(state(addr)["stats"]["triangles"], 36);
+}

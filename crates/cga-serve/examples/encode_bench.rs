@@ -1,0 +1,41 @@
+//! How long making the page's model bytes takes (`encode::model`) for a
+//! set of lots, best and median of several runs, after generating them
+//! once into plain meshes:
+//!
+//!     cargo run --release -p cga-serve --example encode_bench -- RULES.cga LOTSPEC [RUNS]
+
+use std::time::Instant;
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let [rules, lots, rest @ ..] = &args[..] else {
+        eprintln!("usage: encode_bench RULES.cga LOTSPEC [RUNS]");
+        std::process::exit(2);
+    };
+    let runs: usize = rest
+        .first()
+        .map_or(9, |r| r.parse().expect("RUNS is a number"));
+    let rules = cga::Engine::new(cga::DiskWorld).load(rules);
+    let lots = cga::lots::read(&[lots]).expect("lots").lots;
+    let results = rules
+        .generate_all(&lots, &cga::Options::default())
+        .expect("generates");
+    let mut bytes = 0;
+    let mut times: Vec<f64> = (0..runs)
+        .map(|_| {
+            let t = Instant::now();
+            let model = cga_serve::encode::model(&results, [0.0; 3], &mut |p| Some(p.to_string()));
+            bytes = model.len();
+            std::hint::black_box(model);
+            t.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    println!(
+        "{} lots, {:.1} MB: best {:.1} ms, median {:.1} ms",
+        lots.len(),
+        bytes as f64 / 1e6,
+        times[0],
+        times[times.len() / 2]
+    );
+}

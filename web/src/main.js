@@ -90,8 +90,7 @@ function render({ newModel = false } = {}) {
   resize();
   if (newModel) {
     shadowsStale = true;
-    clearTimeout(shadowTimer);
-    shadowTimer = setTimeout(() => render(), SHADOW_DELAY_MS);
+    releaseShadows();
   } else if (shadowsStale) {
     placeSun();
     renderer.shadowMap.needsUpdate = true;
@@ -247,14 +246,13 @@ function buildMeshes(buffer, group, { lots = false } = {}) {
         geometry.computeVertexNormals();
       }
       let map = null;
-      if (m.uvs !== null && m.uv_bytes === 2) {
-        // 16-bit steps across the box, read as normalised; the map's
-        // offset and repeat put them back.
-        geometry.setAttribute('uv', new THREE.BufferAttribute(new Uint16Array(buffer, data + m.uvs, m.vertices * 2), 2, true));
-        if (!lots && m.texture) map = steppedTexture(m.texture, m.uv_min, m.uv_extent);
-      } else if (m.uvs !== null) {
-        geometry.setAttribute('uv', new THREE.BufferAttribute(new Float32Array(buffer, data + m.uvs, m.vertices * 2), 2));
-        if (!lots && m.texture) map = texture(m.texture);
+      if (m.uvs !== null) {
+        // 16-bit steps across the box are read as normalised, and the
+        // map's offset and repeat put them back; else 32-bit floats.
+        const steps = m.uv_bytes === 2;
+        const Coords = steps ? Uint16Array : Float32Array;
+        geometry.setAttribute('uv', new THREE.BufferAttribute(new Coords(buffer, data + m.uvs, m.vertices * 2), 2, steps));
+        if (!lots && m.texture) map = steps ? steppedTexture(m.texture, m.uv_min, m.uv_extent) : texture(m.texture);
       }
       // Every quantised position lies in the unit cube: bounds known
       // without a pass over the vertices (three.js would make one for

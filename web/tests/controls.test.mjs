@@ -5,7 +5,7 @@ import assert from 'node:assert/strict';
 import { mkdtempSync, writeFileSync, rmSync, mkdirSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { startServer, launchBrowser } from './harness.mjs';
+import { openPreview } from './harness.mjs';
 
 const RULES = `
 @Group("Roof", 2) @Order(1) @Enum("flat", "tall")
@@ -38,11 +38,7 @@ before(async () => {
   writeFileSync(join(dir, 'assets', 'a.obj'), 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n');
   writeFileSync(join(dir, 'assets', 'b.obj'), 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n');
   writeFileSync(join(dir, 'rules.cga'), RULES);
-  server = await startServer([join(dir, 'rules.cga'), '--lot', 'rect:10,10', '--lot', 'rect:20,10']);
-  browser = await launchBrowser();
-  page = await browser.context.newPage();
-  await page.goto(server.url);
-  await page.waitForFunction(() => window.cgaPreview.modelVersion > 0, null, { timeout: 30000 });
+  ({ server, browser, page } = await openPreview([join(dir, 'rules.cga'), '--lot', 'rect:10,10', '--lot', 'rect:20,10']));
 });
 
 after(async () => {

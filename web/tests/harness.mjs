@@ -73,3 +73,22 @@ export async function launchBrowser() {
     },
   };
 }
+
+/// `cga serve ARGS` and a page of it in Debian's Chromium, once the page
+/// has drawn its first model. On failure nothing is left running.
+export async function openPreview(args) {
+  const server = await startServer(args);
+  let browser;
+  try {
+    browser = await launchBrowser();
+    const page = await browser.context.newPage();
+    page.on('pageerror', (e) => console.error('page error:', e));
+    await page.goto(server.url);
+    await page.waitForFunction(() => window.cgaPreview.modelVersion > 0, null, { timeout: 30000 });
+    return { server, browser, page };
+  } catch (e) {
+    await browser?.close();
+    server.child.kill();
+    throw e;
+  }
+}

@@ -9,7 +9,7 @@ import assert from 'node:assert/strict';
 import { mkdtempSync, readFileSync, writeFileSync, rmSync, mkdirSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { repo, startServer, launchBrowser } from './harness.mjs';
+import { repo, openPreview } from './harness.mjs';
 
 const original = readFileSync(join(repo, 'examples', 'building.cga'), 'utf8');
 let dir;
@@ -41,12 +41,7 @@ before(async () => {
   dir = mkdtempSync(join(tmpdir(), 'cga-preview-'));
   rules = join(dir, 'building.cga');
   writeFileSync(rules, original);
-  server = await startServer([rules]);
-  browser = await launchBrowser();
-  page = await browser.context.newPage();
-  page.on('pageerror', (e) => console.error('page error:', e));
-  await page.goto(server.url);
-  await page.waitForFunction(() => window.cgaPreview.modelVersion > 0, null, { timeout: 30000 });
+  ({ server, browser, page } = await openPreview([rules]));
 });
 
 after(async () => {

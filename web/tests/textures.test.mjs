@@ -8,7 +8,7 @@ import { mkdtempSync, writeFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { deflateSync } from 'node:zlib';
-import { startServer, launchBrowser } from './harness.mjs';
+import { openPreview } from './harness.mjs';
 
 /// CRC-32 of PNG chunks.
 function crc32(bytes) {
@@ -68,12 +68,7 @@ before(async () => {
     '        color("#ffffff") texture("halves.png") Top.',
     '',
   ].join('\n'));
-  server = await startServer([join(dir, 'lot.cga'), '--lot', 'rect:30,30']);
-  browser = await launchBrowser();
-  page = await browser.context.newPage();
-  page.on('pageerror', (e) => console.error('page error:', e));
-  await page.goto(server.url);
-  await page.waitForFunction(() => window.cgaPreview.modelVersion > 0, null, { timeout: 30000 });
+  ({ server, browser, page } = await openPreview([join(dir, 'lot.cga'), '--lot', 'rect:30,30']));
 });
 
 after(async () => {

@@ -56,6 +56,20 @@ const STEPS: f64 = 65535.0;
 /// are sent as 16-bit steps.
 const UV_SPAN: f64 = 64.0;
 
+/// The corner and far corner of the box around `points` (infinite and
+/// inverted for none).
+fn bounds<const N: usize>(points: impl Iterator<Item = [f64; N]>) -> ([f64; N], [f64; N]) {
+    let mut lo = [f64::INFINITY; N];
+    let mut hi = [f64::NEG_INFINITY; N];
+    for p in points {
+        for a in 0..N {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    (lo, hi)
+}
+
 /// How a mesh's texture coordinates are sent.
 #[derive(Clone, Copy, PartialEq)]
 enum Uvs {
@@ -70,14 +84,7 @@ enum Uvs {
 impl Uvs {
     /// How `uvs` are sent: as steps where their box is small.
     fn of(uvs: &[[f64; 2]]) -> Uvs {
-        let mut lo = [f64::INFINITY; 2];
-        let mut hi = [f64::NEG_INFINITY; 2];
-        for uv in uvs {
-            for a in 0..2 {
-                lo[a] = lo[a].min(uv[a]);
-                hi[a] = hi[a].max(uv[a]);
-            }
-        }
+        let (lo, hi) = bounds(uvs.iter().copied());
         let extent: [f64; 2] = std::array::from_fn(|a| hi[a] - lo[a]);
         if extent.iter().all(|e| e.is_finite() && *e <= UV_SPAN) {
             Uvs::Steps {
@@ -133,16 +140,12 @@ impl Placed<'_> {
     }
 
     fn measure(&mut self, origin: [f64; 3]) {
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for p in &self.mesh.positions {
-            for a in 0..3 {
-                let v = p[a] - origin[a];
-                lo[a] = lo[a].min(v);
-                hi[a] = hi[a].max(v);
-            }
-        }
-        (self.min, self.max) = (lo, hi);
+        let relative = self
+            .mesh
+            .positions
+            .iter()
+            .map(|p| std::array::from_fn(|a| p[a] - origin[a]));
+        (self.min, self.max) = bounds(relative);
     }
 
     /// Measures the box, then writes the arrays into `out`, the bytes

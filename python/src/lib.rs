@@ -730,8 +730,21 @@ fn to_py_err(e: Error) -> PyErr {
     }
 }
 
+/// The engine's allocator for what the module allocates (the interpreter
+/// keeps its own): lots' meshes, handed to numpy without a copy, come from
+/// memory the lot before freed instead of fresh pages the kernel zeroes
+/// (the system allocator maps blocks that large anew each time).
+#[global_allocator]
+static ALLOCATOR: cga_alloc::Allocator = cga_alloc::Allocator;
+
+/// Memory freed is kept this long for the next lot and the next call,
+/// then given back: a session that generated a city does not hold its peak
+/// for good.
+const KEEP_FREED: Duration = Duration::from_secs(10);
+
 #[pymodule]
 fn _cga(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    cga_alloc::keep_freed_memory(Some(KEEP_FREED));
     m.add_class::<NativeRules>()?;
     m.add_class::<Materials>()?;
     m.add_function(wrap_pyfunction!(load, m)?)?;

@@ -59,7 +59,7 @@ def report(label, seconds, n, unit="lot"):
 def candler(args):
     import cga
 
-    rpk = os.path.join(args.oracle, "rpk", "candler.rpk")
+    rpk = os.path.abspath(os.path.join(args.oracle, "rpk", "candler.rpk"))  # PRT takes absolute URIs
     lot = footprint(args.oracle)
     n = args.copies
     lots = [lot + [(i % 5) * 100.0, 0.0, -(i // 5) * 100.0] for i in range(n)]
@@ -111,7 +111,7 @@ def rect_frame(n, seed=1):
 def frame(args):
     import cga
 
-    rpk = os.path.join(args.oracle, "rpk", "candler.rpk")
+    rpk = os.path.abspath(os.path.join(args.oracle, "rpk", "candler.rpk"))  # PRT takes absolute URIs
     rules = cga.Rules.open(rpk)
     gdf = rect_frame(args.lots)
     # Reports only: 1,000 Candler buildings make a GLB over glTF's 4 GiB.

@@ -18,29 +18,11 @@ use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
 
-/// Shapes are many small allocations, and leaves made on the deriving
-/// threads are freed on the writing one: mimalloc's thread-local heaps do
-/// both with fewer instructions than the system allocator (Candler: 227 M
-/// to 202 M instructions for the derivation) at the price of more memory
-/// held (a 10,000-lot city: 2.1 GB peak instead of 1.3 GB).
+/// The engine's allocator (`cga_alloc`): mimalloc's thread-local heaps,
+/// at the price of more memory held (a 10,000-lot city: 2.1 GB peak
+/// instead of 1.3 GB with the system allocator).
 #[global_allocator]
-static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
-
-/// mimalloc's `mi_option_purge_delay` (its `mimalloc.h` option list).
-const MI_OPTION_PURGE_DELAY: libmimalloc_sys::mi_option_t = 15;
-
-/// Memory freed is kept for reuse instead of being given back to the
-/// system after 10 ms, mimalloc's default. A lot's meshes are freed and the
-/// next lot's allocated within moments: given back, the memory came back
-/// as fresh (huge) pages the kernel had to zero each time, which took a
-/// sixth of the time of 25 Candler buildings (5,800 page faults; 380 when
-/// kept). The process ends when its work does, so holding the peak costs
-/// nothing.
-fn keep_freed_memory() {
-    // SAFETY: sets one of mimalloc's documented options to a documented
-    // value (-1: never purge) before any other thread runs.
-    unsafe { libmimalloc_sys::mi_option_set(MI_OPTION_PURGE_DELAY, -1) };
-}
+static ALLOCATOR: cga_alloc::Allocator = cga_alloc::Allocator;
 
 use cga::{
     Diagnostic, Engine, Error, ExportOptions, Format, Georeference, LotResult, ModelWriter,
@@ -292,7 +274,8 @@ const MAIN_STACK: usize = 64 << 20;
 const NODES_PER_LOT_UP_TO: usize = 10_000;
 
 fn main() -> ExitCode {
-    keep_freed_memory();
+    // The process ends when its work does: holding the peak costs nothing.
+    cga_alloc::keep_freed_memory(None);
     let cli = Cli::parse();
     let worker = std::thread::Builder::new()
         .stack_size(MAIN_STACK)

@@ -819,7 +819,7 @@ impl<'a> Interp<'a> {
     /// [`child`](Interp::child) without counting it.
     fn successor(&mut self, parent: &Shape) -> Shape {
         let mut c = parent.clone();
-        c.parent_scope = parent.scope;
+        c.parent_center = parent.scope.center();
         c.rng.set(parent.child_rng(parent.next_random().to_bits()));
         if self.context.is_some() {
             c.ctx = self.context_child(parent.ctx);

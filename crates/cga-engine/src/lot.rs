@@ -235,7 +235,7 @@ pub fn initial_shape(lot: &Lot, seed: u64, name: u32) -> Shape {
         scope,
         pivot,
         geometry: Geometry::new(Arc::new(mesh)),
-        parent_scope: scope,
+        parent_center: scope.center(),
         material: Arc::new(MaterialOverrides::default()),
         attrs: None,
         split_index: 0.0,

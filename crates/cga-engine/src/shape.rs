@@ -251,8 +251,10 @@ pub struct Shape {
     pub scope: Scope,
     pub pivot: Frame,
     pub geometry: Geometry,
-    /// The scope of the shape this one was derived from (for `center`).
-    pub parent_scope: Scope,
+    /// The centre of the scope of the shape this one was derived from, in
+    /// object coordinates (all `center` needs of it: a whole scope here
+    /// made every shape 120 bytes larger, and shapes are moved often).
+    pub parent_center: DVec3,
     pub material: Arc<MaterialOverrides>,
     /// Attribute values set on this shape (or an ancestor) with `set`.
     pub attrs: Option<Arc<Vec<(AttrId, Value)>>>,

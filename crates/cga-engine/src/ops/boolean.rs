@@ -81,7 +81,7 @@ pub fn exec(
     let mut shape = result.shape;
     shape.name = st.shape.name;
     shape.rng.set(st.shape.rng.get());
-    shape.parent_scope = st.shape.parent_scope;
+    shape.parent_center = st.shape.parent_center;
     set_object_mesh(&mut shape, result.mesh);
     st.shape = shape;
     Ok(())

@@ -1509,7 +1509,7 @@ pub fn eval_fn(
         let total = sets.len() as f64;
         for (i, set) in sets.iter().enumerate() {
             let mut child = current.clone();
-            child.parent_scope = current.scope;
+            child.parent_center = current.scope.center();
             child.rng.set(current.child_rng(ordinal));
             ordinal += 1;
             comps.fill_shape(&mut child, set, align, false, upward);

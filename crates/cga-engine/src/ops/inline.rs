@@ -116,7 +116,7 @@ pub fn exec(
         }
         one.name = st.shape.name;
         one.rng.set(st.shape.rng.get());
-        one.parent_scope = st.shape.parent_scope;
+        one.parent_center = st.shape.parent_center;
         st.shape = one;
         return Ok(());
     }

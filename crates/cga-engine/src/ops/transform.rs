@@ -83,7 +83,7 @@ pub fn exec(
         }
         TransformOp::Center => {
             let which = selector(&args[0], &["x", "y", "z", "xy", "xz", "yz", "xyz"])?;
-            let parent = shape.parent_scope.center();
+            let parent = shape.parent_center;
             let own = shape.scope.center();
             let axes = shape.scope.frame.axes;
             let mut d = axes.transpose() * (parent - own);

@@ -70,6 +70,25 @@ fn bounds<const N: usize>(points: impl Iterator<Item = [f64; N]>) -> ([f64; N], 
     (lo, hi)
 }
 
+/// Writes each of `points` as N 16-bit steps, `(p - offset) * scale`
+/// rounded, into `out` (2 N bytes a point).
+fn write_steps<const N: usize>(
+    points: &[[f64; N]],
+    offset: [f64; N],
+    scale: [f64; N],
+    out: &mut [u8],
+) {
+    for (p, q) in points.iter().zip(out.chunks_exact_mut(2 * N)) {
+        for a in 0..N {
+            // Non-negative by the box: adding a half and cutting off
+            // rounds (without a call to `round`, which this target does
+            // not inline).
+            let v = ((p[a] - offset[a]) * scale[a] + 0.5).clamp(0.0, STEPS) as u16;
+            q[2 * a..2 * a + 2].copy_from_slice(&v.to_le_bytes());
+        }
+    }
+}
+
 /// How a mesh's texture coordinates are sent.
 #[derive(Clone, Copy, PartialEq)]
 enum Uvs {
@@ -157,27 +176,17 @@ impl Placed<'_> {
         let scale = STEPS / self.extent();
         let mesh = self.mesh;
         let offset: [f64; 3] = std::array::from_fn(|a| origin[a] + self.min[a]);
-        let q = out[positions - base..uvs - base].chunks_exact_mut(6);
-        for (p, q) in mesh.positions.iter().zip(q) {
-            for a in 0..3 {
-                // Non-negative by the box: adding a half and cutting off
-                // rounds (without a call to `round`, which this target
-                // does not inline).
-                let v = ((p[a] - offset[a]) * scale + 0.5).clamp(0.0, STEPS) as u16;
-                q[2 * a..2 * a + 2].copy_from_slice(&v.to_le_bytes());
-            }
-        }
+        write_steps(
+            &mesh.positions,
+            offset,
+            [scale; 3],
+            &mut out[positions - base..uvs - base],
+        );
         match self.uvs {
             Uvs::None => {}
             Uvs::Steps { min, extent } => {
                 let scale = extent.map(|e| STEPS / e);
-                let q = out[uvs - base..normals - base].chunks_exact_mut(4);
-                for (uv, b) in mesh.uvs.iter().zip(q) {
-                    for a in 0..2 {
-                        let v = ((uv[a] - min[a]) * scale[a] + 0.5).clamp(0.0, STEPS) as u16;
-                        b[2 * a..2 * a + 2].copy_from_slice(&v.to_le_bytes());
-                    }
-                }
+                write_steps(&mesh.uvs, min, scale, &mut out[uvs - base..normals - base]);
             }
             Uvs::Floats => {
                 let f = out[uvs - base..normals - base].chunks_exact_mut(8);

@@ -66,6 +66,13 @@ struct PrimitiveLayout {
     max: [f32; 3],
 }
 
+impl PrimitiveLayout {
+    /// How many accessors (each with its buffer view) the primitive has.
+    fn accessor_count(&self) -> usize {
+        3 + self.coords.len() + usize::from(self.tangents.is_some()) + usize::from(self.features)
+    }
+}
+
 /// Vertex data held before it is written out, by default (see the module
 /// docs).
 pub const DEFAULT_FLUSH_MIB: usize = 64;
@@ -1046,8 +1053,20 @@ impl GltfWriter {
             .map(|(id, b)| b.primitive(id as u32))
             .collect();
         // Accessors in the order of the binary data, with their material.
-        let mut primitives: Vec<(u32, json::mesh::Primitive)> = Vec::new();
+        let mut primitives: Vec<(u32, json::mesh::Primitive)> =
+            Vec::with_capacity(self.written.len() + held.len());
         let mut used = vec![false; self.buckets.len()];
+        // Reserved at their final size: grown by doubling, the arrays of a
+        // model of 10,000 lots (200,000 accessors) would hold twice their
+        // room, and briefly three times while being moved.
+        let accessors: usize = self
+            .written
+            .iter()
+            .chain(&held)
+            .map(PrimitiveLayout::accessor_count)
+            .sum();
+        root.accessors.reserve_exact(accessors);
+        root.buffer_views.reserve_exact(accessors);
         for p in self.written.iter().chain(&held) {
             let prim = primitive_accessors(&mut root, &mut layout, p);
             primitives.push((p.material, prim));
@@ -1135,7 +1154,12 @@ impl GltfWriter {
             self.instance_nodes(&mut root, laid_out, &gltf_materials);
         // Meshes and nodes: one per lot, or one per material.
         let groups: Vec<NodeGroup> = if self.per_lot && !self.lots.is_empty() {
-            lot_groups(self.lots.clone(), primitives)
+            // The property table of per-lot features reads the lots below.
+            let lots = match self.features {
+                true => self.lots.clone(),
+                false => std::mem::take(&mut self.lots),
+            };
+            lot_groups(lots, primitives)
         } else {
             let mut by_material: Vec<Vec<(u32, json::mesh::Primitive)>> = Vec::new();
             by_material.resize_with(self.buckets.len(), Vec::new);
@@ -1417,18 +1441,20 @@ impl GltfWriter {
     ) -> Result<(), ExportError> {
         let path = self.path.clone();
         let io = |e| ExportError::io(&path, e);
-        let mut json = root.to_vec().map_err(|e| io(e.into()))?;
-        // Chunks are 4-byte aligned; JSON pads with spaces.
-        while json.len() % 4 != 0 {
-            json.push(b' ');
-        }
+        // The JSON is serialised twice, once to count its bytes (the chunk
+        // header comes first) and once into the file, rather than held: a
+        // model of 10,000 lots has some 40 MB of it, and a vector grown to
+        // that size by doubling would be the writer's peak of memory.
+        let json_len = json_length(root).map_err(io)?;
         if self.written_bytes > 0 {
-            return self.finish_early_glb(json, bin_len, images, textures);
+            return self.finish_early_glb(root, json_len, bin_len, images, textures);
         }
+        // Chunks are 4-byte aligned; JSON pads with spaces.
+        let chunk = json_len.next_multiple_of(4);
         let bin_chunk = if bin_len > 0 { 8 + bin_len } else { 0 };
-        let total = glb_length(12 + 8 + json.len() as u64 + bin_chunk)?;
+        let total = glb_length(12 + 8 + chunk + bin_chunk)?;
         let out = &mut self.out;
-        write_glb_head(out, total, &json, bin_len).map_err(io)?;
+        write_glb_head(out, total, root, chunk, bin_len).map_err(io)?;
         if bin_len > 0 {
             let held = Held {
                 buckets: &self.buckets,
@@ -1446,7 +1472,8 @@ impl GltfWriter {
     /// moved up to make room) go before it.
     fn finish_early_glb(
         &mut self,
-        mut json: Vec<u8>,
+        root: &json::Root,
+        json_len: u64,
         bin_len: u64,
         images: &[u32],
         textures: &Textures,
@@ -1461,7 +1488,7 @@ impl GltfWriter {
         write_bin(&mut self.out, &held, images, textures, &path)?;
         self.out.flush().map_err(io)?;
         // Header (12), JSON chunk header (8), JSON, BIN chunk header (8).
-        let head = 12 + 8 + json.len() as u64 + 8;
+        let head = 12 + 8 + json_len.next_multiple_of(4) + 8;
         let room = self.json_room;
         let start = if head <= room {
             room
@@ -1470,12 +1497,21 @@ impl GltfWriter {
             move_up(&mut **file, room, bin_len, head - room).map_err(io)?;
             head
         };
-        json.resize((start - 28) as usize, b' ');
         let total = glb_length(start + bin_len)?;
         self.out.seek(SeekFrom::Start(0)).map_err(io)?;
-        write_glb_head(&mut self.out, total, &json, bin_len).map_err(io)?;
+        write_glb_head(&mut self.out, total, root, start - 28, bin_len).map_err(io)?;
         self.out.flush().map_err(io)
     }
+}
+
+/// The length in bytes of `root`'s compact JSON.
+fn json_length(root: &json::Root) -> std::io::Result<u64> {
+    let mut count = Counted {
+        out: std::io::sink(),
+        len: 0,
+    };
+    serde_json::to_writer(&mut count, root)?;
+    Ok(count.len)
 }
 
 /// A GLB's total length, which the header holds as `u32`.
@@ -1484,25 +1520,52 @@ fn glb_length(total: u64) -> Result<u32, ExportError> {
         .map_err(|_| ExportError::TooLarge(format!("GLB of {total} bytes exceeds 4 GiB")))
 }
 
-/// The GLB header, the JSON chunk and the BIN chunk's header (if there is
-/// binary data).
+/// The GLB header, the JSON chunk (`root` as compact JSON, padded with
+/// spaces to `chunk` bytes) and the BIN chunk's header (if there is binary
+/// data).
 fn write_glb_head(
     out: &mut impl Write,
     total: u32,
-    json: &[u8],
+    root: &json::Root,
+    chunk: u64,
     bin_len: u64,
 ) -> std::io::Result<()> {
     out.write_all(b"glTF")?;
     out.write_all(&2u32.to_le_bytes())?;
     out.write_all(&total.to_le_bytes())?;
-    out.write_all(&(json.len() as u32).to_le_bytes())?;
+    out.write_all(&(chunk as u32).to_le_bytes())?;
     out.write_all(b"JSON")?;
-    out.write_all(json)?;
+    let mut json = Counted {
+        out: &mut *out,
+        len: 0,
+    };
+    serde_json::to_writer(&mut json, root)?;
+    let pad = chunk.checked_sub(json.len).ok_or_else(|| {
+        std::io::Error::other("the model's JSON changed between counting and writing it")
+    })?;
+    std::io::copy(&mut std::io::repeat(b' ').take(pad), out)?;
     if bin_len > 0 {
         out.write_all(&(bin_len as u32).to_le_bytes())?;
         out.write_all(b"BIN\0")?;
     }
     Ok(())
+}
+
+/// A writer that counts the bytes passed through it.
+struct Counted<W> {
+    out: W,
+    len: u64,
+}
+
+impl<W: Write> Write for Counted<W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let n = self.out.write(buf)?;
+        self.len += n as u64;
+        Ok(n)
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.out.flush()
+    }
 }
 
 /// Moves the `len` bytes of `file` at `start` up by `by` bytes, from the

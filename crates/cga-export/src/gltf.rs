@@ -45,6 +45,7 @@ use json::validation::{Checked::Valid, USize64};
 use crate::bucket::Bucket;
 use crate::encode::Buckets;
 use crate::instances::{Instances, Pending, Trs};
+use crate::json_spool::{self, GlbJson, Spool};
 use crate::materials::{color_to_linear, MaterialTable};
 use crate::textures::{uri_encode, Textures};
 use crate::{ExportError, ExportStats, FaceData};
@@ -1056,23 +1057,33 @@ impl GltfWriter {
         let mut primitives: Vec<(u32, json::mesh::Primitive)> =
             Vec::with_capacity(self.written.len() + held.len());
         let mut used = vec![false; self.buckets.len()];
-        // Reserved at their final size: grown by doubling, the arrays of a
-        // model of 10,000 lots (200,000 accessors) would hold twice their
-        // room, and briefly three times while being moved.
-        let accessors: usize = self
-            .written
-            .iter()
-            .chain(&held)
-            .map(PrimitiveLayout::accessor_count)
-            .sum();
-        root.accessors.reserve_exact(accessors);
-        root.buffer_views.reserve_exact(accessors);
+        // A large GLB's primitives have their accessors and views written
+        // out as JSON text (see `json_spool`); a smaller model's are
+        // reserved at their final size in the document.
+        let bulk = self.written.len() + held.len();
+        match (self.binary && json_spool::spools(bulk))
+            .then(Spool::create)
+            .flatten()
+        {
+            Some(spool) => layout.start_spool(spool),
+            None => {
+                let accessors: usize = self
+                    .written
+                    .iter()
+                    .chain(&held)
+                    .map(PrimitiveLayout::accessor_count)
+                    .sum();
+                root.accessors.reserve_exact(accessors);
+                root.buffer_views.reserve_exact(accessors);
+            }
+        }
         for p in self.written.iter().chain(&held) {
             let prim = primitive_accessors(&mut root, &mut layout, p);
             primitives.push((p.material, prim));
             used[p.material as usize] = true;
             stats.vertices += p.vertices;
         }
+        let spool = layout.end_spool(&mut root);
         let laid_out = self.lay_out_instances(&mut root, &mut layout, &mut used, stats);
         let layouts: Vec<&PrimitiveLayout> = self.written.iter().chain(&held).collect();
         stats.bounds = bounds_of(&layouts);
@@ -1249,7 +1260,7 @@ impl GltfWriter {
             Vec::new()
         };
         if self.binary {
-            self.write_glb(&root, bin_len, &embedded, textures)?;
+            self.write_glb(&root, spool, bin_len, &embedded, textures)?;
         } else {
             let json = root
                 .to_vec_pretty()
@@ -1330,6 +1341,7 @@ impl GltfWriter {
                     (data.len() / width) as u64,
                     type_,
                     ComponentType::F32,
+                    None,
                     None,
                 )
             };
@@ -1435,26 +1447,23 @@ impl GltfWriter {
     fn write_glb(
         &mut self,
         root: &json::Root,
+        spool: Option<Spool>,
         bin_len: u64,
         images: &[u32],
         textures: &Textures,
     ) -> Result<(), ExportError> {
         let path = self.path.clone();
         let io = |e| ExportError::io(&path, e);
-        // The JSON is serialised twice, once to count its bytes (the chunk
-        // header comes first) and once into the file, rather than held: a
-        // model of 10,000 lots has some 40 MB of it, and a vector grown to
-        // that size by doubling would be the writer's peak of memory.
-        let json_len = json_length(root).map_err(io)?;
+        let mut json = GlbJson::new(root, spool).map_err(io)?;
         if self.written_bytes > 0 {
-            return self.finish_early_glb(root, json_len, bin_len, images, textures);
+            return self.finish_early_glb(&mut json, bin_len, images, textures);
         }
         // Chunks are 4-byte aligned; JSON pads with spaces.
-        let chunk = json_len.next_multiple_of(4);
+        let chunk = json.len().next_multiple_of(4);
         let bin_chunk = if bin_len > 0 { 8 + bin_len } else { 0 };
         let total = glb_length(12 + 8 + chunk + bin_chunk)?;
         let out = &mut self.out;
-        write_glb_head(out, total, root, chunk, bin_len).map_err(io)?;
+        write_glb_head(out, total, &mut json, chunk, bin_len).map_err(io)?;
         if bin_len > 0 {
             let held = Held {
                 buckets: &self.buckets,
@@ -1472,8 +1481,7 @@ impl GltfWriter {
     /// moved up to make room) go before it.
     fn finish_early_glb(
         &mut self,
-        root: &json::Root,
-        json_len: u64,
+        json: &mut GlbJson,
         bin_len: u64,
         images: &[u32],
         textures: &Textures,
@@ -1488,7 +1496,7 @@ impl GltfWriter {
         write_bin(&mut self.out, &held, images, textures, &path)?;
         self.out.flush().map_err(io)?;
         // Header (12), JSON chunk header (8), JSON, BIN chunk header (8).
-        let head = 12 + 8 + json_len.next_multiple_of(4) + 8;
+        let head = 12 + 8 + json.len().next_multiple_of(4) + 8;
         let room = self.json_room;
         let start = if head <= room {
             room
@@ -1499,19 +1507,9 @@ impl GltfWriter {
         };
         let total = glb_length(start + bin_len)?;
         self.out.seek(SeekFrom::Start(0)).map_err(io)?;
-        write_glb_head(&mut self.out, total, root, start - 28, bin_len).map_err(io)?;
+        write_glb_head(&mut self.out, total, json, start - 28, bin_len).map_err(io)?;
         self.out.flush().map_err(io)
     }
-}
-
-/// The length in bytes of `root`'s compact JSON.
-fn json_length(root: &json::Root) -> std::io::Result<u64> {
-    let mut count = Counted {
-        out: std::io::sink(),
-        len: 0,
-    };
-    serde_json::to_writer(&mut count, root)?;
-    Ok(count.len)
 }
 
 /// A GLB's total length, which the header holds as `u32`.
@@ -1520,13 +1518,12 @@ fn glb_length(total: u64) -> Result<u32, ExportError> {
         .map_err(|_| ExportError::TooLarge(format!("GLB of {total} bytes exceeds 4 GiB")))
 }
 
-/// The GLB header, the JSON chunk (`root` as compact JSON, padded with
-/// spaces to `chunk` bytes) and the BIN chunk's header (if there is binary
-/// data).
+/// The GLB header, the JSON chunk (`json`, padded with spaces to `chunk`
+/// bytes) and the BIN chunk's header (if there is binary data).
 fn write_glb_head(
     out: &mut impl Write,
     total: u32,
-    root: &json::Root,
+    json: &mut GlbJson,
     chunk: u64,
     bin_len: u64,
 ) -> std::io::Result<()> {
@@ -1535,37 +1532,14 @@ fn write_glb_head(
     out.write_all(&total.to_le_bytes())?;
     out.write_all(&(chunk as u32).to_le_bytes())?;
     out.write_all(b"JSON")?;
-    let mut json = Counted {
-        out: &mut *out,
-        len: 0,
-    };
-    serde_json::to_writer(&mut json, root)?;
-    let pad = chunk.checked_sub(json.len).ok_or_else(|| {
-        std::io::Error::other("the model's JSON changed between counting and writing it")
-    })?;
+    json.write_to(out)?;
+    let pad = chunk - json.len();
     std::io::copy(&mut std::io::repeat(b' ').take(pad), out)?;
     if bin_len > 0 {
         out.write_all(&(bin_len as u32).to_le_bytes())?;
         out.write_all(b"BIN\0")?;
     }
     Ok(())
-}
-
-/// A writer that counts the bytes passed through it.
-struct Counted<W> {
-    out: W,
-    len: u64,
-}
-
-impl<W: Write> Write for Counted<W> {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        let n = self.out.write(buf)?;
-        self.len += n as u64;
-        Ok(n)
-    }
-    fn flush(&mut self) -> std::io::Result<()> {
-        self.out.flush()
-    }
 }
 
 /// Moves the `len` bytes of `file` at `start` up by `by` bytes, from the
@@ -1590,16 +1564,45 @@ fn move_up(file: &mut dyn Output, start: u64, len: u64, by: u64) -> std::io::Res
 struct Layout {
     /// Bytes laid out so far (always a multiple of 4).
     len: u64,
+    /// While laying out a large GLB's primitives: where their accessors and
+    /// views go instead of the document (see `json_spool`).
+    spool: Option<Spool>,
+    /// Accessors and views spooled before the document's own, less the
+    /// marker standing for them: added to the document's indices.
+    accessor_base: usize,
+    view_base: usize,
 }
 
 impl Layout {
+    /// Accessors and views laid out from now on go to `spool`, until
+    /// [`end_spool`](Layout::end_spool). Only for a document with none yet.
+    fn start_spool(&mut self, spool: Spool) {
+        self.spool = Some(spool);
+    }
+
+    /// Accessors and views go to the document again, after a marker for
+    /// the spooled ones (if any); returns the spool.
+    fn end_spool(&mut self, root: &mut json::Root) -> Option<Spool> {
+        let spool = self.spool.take()?;
+        debug_assert!(root.accessors.is_empty() && root.buffer_views.is_empty());
+        if spool.accessors.count() > 0 {
+            root.accessors.push(json_spool::accessor_marker());
+            self.accessor_base = spool.accessors.count() - 1;
+        }
+        if spool.views.count() > 0 {
+            root.buffer_views.push(json_spool::view_marker());
+            self.view_base = spool.views.count() - 1;
+        }
+        Some(spool)
+    }
+
     fn view(
         &mut self,
         root: &mut json::Root,
         bytes: u64,
         target: Option<json::buffer::Target>,
     ) -> json::Index<json::buffer::View> {
-        let view = root.push(json::buffer::View {
+        let view = json::buffer::View {
             buffer: json::Index::new(0),
             byte_length: USize64(bytes),
             byte_offset: Some(USize64(self.len)),
@@ -1608,12 +1611,24 @@ impl Layout {
             target: target.map(Valid),
             extensions: None,
             extras: Default::default(),
-        });
+        };
         self.len += bytes.next_multiple_of(4);
-        view
+        let index = match &mut self.spool {
+            Some(spool) => {
+                spool.push_view(&view);
+                spool.views.count() - 1
+            }
+            None => {
+                root.buffer_views.push(view);
+                self.view_base + root.buffer_views.len() - 1
+            }
+        };
+        json::Index::new(index as u32)
     }
 
-    /// A view holding `components` 4-byte values and an accessor on it.
+    /// A view holding `components` 4-byte values and an accessor on it
+    /// (with the bounds `min_max`, if given).
+    #[allow(clippy::too_many_arguments)]
     fn accessor(
         &mut self,
         root: &mut json::Root,
@@ -1622,9 +1637,10 @@ impl Layout {
         type_: json::accessor::Type,
         component_type: json::accessor::ComponentType,
         target: Option<json::buffer::Target>,
+        min_max: Option<([f32; 3], [f32; 3])>,
     ) -> json::Index<json::Accessor> {
         let view = self.view(root, components as u64 * 4, target);
-        root.push(json::Accessor {
+        let accessor = json::Accessor {
             buffer_view: Some(view),
             byte_offset: None,
             count: USize64(count),
@@ -1632,12 +1648,23 @@ impl Layout {
             extensions: None,
             extras: Default::default(),
             type_: Valid(type_),
-            min: None,
-            max: None,
+            min: min_max.map(|m| m.0.to_vec().into()),
+            max: min_max.map(|m| m.1.to_vec().into()),
             name: None,
             normalized: false,
             sparse: None,
-        })
+        };
+        let index = match &mut self.spool {
+            Some(spool) => {
+                spool.push_accessor(&accessor);
+                spool.accessors.count() - 1
+            }
+            None => {
+                root.accessors.push(accessor);
+                self.accessor_base + root.accessors.len() - 1
+            }
+        };
+        json::Index::new(index as u32)
     }
 }
 
@@ -1659,10 +1686,8 @@ fn primitive_accessors(
         Type::Vec3,
         ComponentType::F32,
         vertex_data,
+        Some((p.min, p.max)),
     );
-    let accessor = &mut root.accessors[positions.value()];
-    accessor.min = Some(p.min.to_vec().into());
-    accessor.max = Some(p.max.to_vec().into());
     attributes.insert(Valid(json::mesh::Semantic::Positions), positions);
     let normals = layout.accessor(
         root,
@@ -1671,6 +1696,7 @@ fn primitive_accessors(
         Type::Vec3,
         ComponentType::F32,
         vertex_data,
+        None,
     );
     attributes.insert(Valid(json::mesh::Semantic::Normals), normals);
     for (n, &len) in p.coords.iter().enumerate() {
@@ -1681,6 +1707,7 @@ fn primitive_accessors(
             Type::Vec2,
             ComponentType::F32,
             vertex_data,
+            None,
         );
         attributes.insert(Valid(json::mesh::Semantic::TexCoords(n as u32)), tex);
     }
@@ -1692,6 +1719,7 @@ fn primitive_accessors(
             Type::Vec4,
             ComponentType::F32,
             vertex_data,
+            None,
         );
         attributes.insert(Valid(json::mesh::Semantic::Tangents), acc);
     }
@@ -1702,6 +1730,7 @@ fn primitive_accessors(
         Type::Scalar,
         ComponentType::U32,
         Some(json::buffer::Target::ElementArrayBuffer),
+        None,
     );
     let extensions = p.features.then(|| {
         let acc = layout.accessor(
@@ -1711,6 +1740,7 @@ fn primitive_accessors(
             Type::Scalar,
             ComponentType::F32,
             vertex_data,
+            None,
         );
         attributes.insert(Valid(json::mesh::Semantic::Extras("FEATURE_ID_0".into())), acc);
         let mut others = serde_json::Map::new();

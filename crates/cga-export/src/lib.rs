@@ -33,6 +33,7 @@ mod faces;
 mod gltf;
 mod hash;
 mod instances;
+mod json_spool;
 mod materials;
 mod obj;
 mod plain;

@@ -168,7 +168,12 @@ fn cut_parts(mesh: &Arc<Mesh>, axis: usize, sign: f64, placed: &[Placed]) -> Vec
     if mesh.faces.is_empty() {
         return placed.iter().map(|_| Mesh::new()).collect();
     }
-    let mut slabs = cga_geometry::split_along_axis(mesh, axis, &cuts);
+    // Options, so that a part taking a whole slab leaves `None` behind
+    // rather than an empty mesh built for nothing.
+    let mut slabs: Vec<Option<Mesh>> = cga_geometry::split_along_axis(mesh, axis, &cuts)
+        .into_iter()
+        .map(Some)
+        .collect();
     // Slab i lies between cuts[i-1] and cuts[i].
     let slab_index = |c: f64| cuts.partition_point(|&x| x < c - 1e-12 * (1.0 + c.abs()));
     let ranges: Vec<(usize, usize)> = placed
@@ -189,17 +194,22 @@ fn cut_parts(mesh: &Arc<Mesh>, axis: usize, sign: f64, placed: &[Placed]) -> Vec
     ranges
         .iter()
         .map(|&(first, last)| {
+            let end = last.min(slabs.len().saturating_sub(1));
+            if first == last && first <= end {
+                uses[first] -= 1;
+                let slab = &mut slabs[first];
+                let whole = match uses[first] {
+                    0 => slab.take(),
+                    _ => slab.clone(),
+                };
+                return whole.unwrap_or_default();
+            }
             let mut out = Mesh::new();
-            for k in first..=last.min(slabs.len().saturating_sub(1)) {
+            for k in first..=end {
                 uses[k] -= 1;
-                if first == last {
-                    return if uses[k] == 0 {
-                        std::mem::take(&mut slabs[k])
-                    } else {
-                        slabs[k].clone()
-                    };
+                if let Some(slab) = &slabs[k] {
+                    cga_geometry::transform::merge(&mut out, slab);
                 }
-                cga_geometry::transform::merge(&mut out, &slabs[k]);
             }
             out
         })

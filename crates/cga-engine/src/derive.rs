@@ -211,13 +211,16 @@ impl Arg {
 
 /// The shape an operation sequence works on, and what became of it.
 pub struct ShapeState {
-    pub shape: Shape,
+    /// Boxed: a shape is some 500 bytes, and it travels from its parent's
+    /// operation through the rule queue into the state of its rule; a box
+    /// moves as a pointer.
+    pub shape: Box<Shape>,
     pub has_successor: bool,
     pub deleted: bool,
 }
 
 impl ShapeState {
-    pub fn new(shape: Shape) -> ShapeState {
+    pub fn new(shape: Box<Shape>) -> ShapeState {
         ShapeState {
             shape,
             has_successor: false,
@@ -297,7 +300,7 @@ pub(crate) enum AttrSlot {
 pub(crate) struct PendingRule {
     rule: RuleId,
     args: Vec<Value>,
-    shape: Shape,
+    shape: Box<Shape>,
     span: Span,
     /// Rule invocations from the initial shape to this one.
     generation: usize,
@@ -666,7 +669,7 @@ impl<'a> Interp<'a> {
             cx.queue.push_back(PendingRule {
                 rule,
                 args,
-                shape,
+                shape: Box::new(shape),
                 span,
                 generation,
                 key,
@@ -802,7 +805,7 @@ impl<'a> Interp<'a> {
         } else if st.deleted && !st.has_successor {
             if let Some(list) = &mut self.collected {
                 list.push(Collected {
-                    shape: st.shape,
+                    shape: *st.shape,
                     deleted: true,
                 });
             }
@@ -811,14 +814,14 @@ impl<'a> Interp<'a> {
 
     /// A successor of `parent`: a copy with its own random stream and the
     /// parent's scope remembered for `center`.
-    pub fn child(&mut self, parent: &Shape, span: Span) -> Result<Shape, RtError> {
+    pub fn child(&mut self, parent: &Shape, span: Span) -> Result<Box<Shape>, RtError> {
         self.count_shape(span)?;
         Ok(self.successor(parent))
     }
 
     /// [`child`](Interp::child) without counting it.
-    fn successor(&mut self, parent: &Shape) -> Shape {
-        let mut c = parent.clone();
+    fn successor(&mut self, parent: &Shape) -> Box<Shape> {
+        let mut c = Box::new(parent.clone());
         c.parent_center = parent.scope.center();
         c.rng.set(parent.child_rng(parent.next_random().to_bits()));
         if self.context.is_some() {
@@ -1126,10 +1129,23 @@ impl<'a> Interp<'a> {
                     // The successor is the shape's last use (a dynamic
                     // import still evaluates its overrides on the shape).
                     self.count_shape(rc.span)?;
+                    // What is shared by reference count moves over: the
+                    // parent is dropped unread, and cloning each shared part
+                    // (then dropping the parent's) cost two atomic
+                    // operations apiece.
+                    let parent = &mut st.shape;
                     let geometry =
-                        std::mem::replace(&mut st.shape.geometry, crate::shape::Geometry::empty());
+                        std::mem::replace(&mut parent.geometry, crate::shape::Geometry::empty());
+                    let (attrs, comp, projections) = (
+                        parent.attrs.take(),
+                        parent.comp.take(),
+                        parent.projections.take(),
+                    );
                     let mut c = self.successor(&st.shape);
                     c.geometry = geometry;
+                    c.attrs = attrs;
+                    c.comp = comp;
+                    c.projections = projections;
                     c
                 } else {
                     self.child(&st.shape, rc.span)?

@@ -83,7 +83,7 @@ pub fn exec(
     shape.rng.set(st.shape.rng.get());
     shape.parent_center = st.shape.parent_center;
     set_object_mesh(&mut shape, result.mesh);
-    st.shape = shape;
+    *st.shape = shape;
     Ok(())
 }
 
@@ -114,7 +114,7 @@ fn derive_operand(
         let mut shape = st.shape.clone();
         shape.material = Arc::new(MaterialOverrides::default());
         return Ok(Operand {
-            shape,
+            shape: *shape,
             mesh: Mesh::new(),
         });
     };
@@ -151,7 +151,7 @@ fn derive_operand(
                 }
             }
         }
-        acc.shape = shape;
+        acc.shape = *shape;
     }
     Ok(acc)
 }

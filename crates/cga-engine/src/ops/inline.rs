@@ -117,7 +117,7 @@ pub fn exec(
         one.name = st.shape.name;
         one.rng.set(st.shape.rng.get());
         one.parent_center = st.shape.parent_center;
-        st.shape = one;
+        *st.shape = one;
         return Ok(());
     }
     let uniform = uniform_material(&collected);

@@ -18,6 +18,7 @@ impl<'m, 'b> Cutter<'m, 'b> {
         let mut cb = std::mem::take(&mut self.bufs.caps);
         bb.remap.clear();
         bb.remap.resize(self.bufs.verts.len(), NONE);
+        let mut reference = None;
         for part in 0..nparts {
             bb.touched.clear();
             bb.corners.clear();
@@ -83,13 +84,12 @@ impl<'m, 'b> Cutter<'m, 'b> {
                             // The outer loop starts where its first edge runs
                             // like the source face's first edge.
                             let shift = if li == rec.first {
-                                self.first_corner(cs, rec.face)
+                                self.first_corner(cs, rec.face, &mut reference)
                             } else {
                                 0
                             };
                             let start = corners.len() as u32;
-                            for i in 0..cs.len() {
-                                let c = &cs[(i + shift) % cs.len()];
+                            for c in cs[shift..].iter().chain(&cs[..shift]) {
                                 corners.push(map(c.v));
                                 sources.push(*c);
                             }

@@ -40,6 +40,12 @@ impl<'m, 'b> Cutter<'m, 'b> {
     /// direction as in the other (so cut parts can be closed with caps).
     pub(super) fn input_is_closed(&mut self) -> bool {
         let mesh = self.mesh;
+        if mesh.faces.len() == 1 && self.face_has_distinct_vertices(0) {
+            // One face whose corners are all different vertices uses every
+            // edge once, in one direction (a facade being split: most
+            // calls).
+            return false;
+        }
         let mut balance = std::mem::take(&mut self.bufs.build.balance);
         balance.clear();
         let mut any = false;
@@ -69,6 +75,26 @@ impl<'m, 'b> Cutter<'m, 'b> {
             .all(|g| g.iter().map(|e| e.1).sum::<i32>() == 0);
         self.bufs.build.balance = balance;
         any && balanced
+    }
+
+    /// Whether the corners of `face` (all its loops) are distinct welded
+    /// vertices; `false` for faces of more than 16 corners (not checked).
+    fn face_has_distinct_vertices(&self, face: usize) -> bool {
+        const MAX: usize = 16;
+        let mesh = self.mesh;
+        let mut seen = [0u32; MAX];
+        let mut n = 0;
+        for &l in mesh.face_loops(face) {
+            for c in mesh.loop_corners(l) {
+                let v = self.original_vertex(c as u32);
+                if n == MAX || seen[..n].contains(&v) {
+                    return false;
+                }
+                seen[n] = v;
+                n += 1;
+            }
+        }
+        true
     }
 
     /// Cap faces of `part` in plane `k`, facing `outward` (`+n` for the
@@ -273,23 +299,30 @@ impl<'m, 'b> Cutter<'m, 'b> {
     /// in the loop). A facade split into tiles and floors so keeps its first
     /// edges along the ground, and the pieces' `comp(f)` scopes keep the
     /// facade's orientation, whichever corner the cut reached first.
-    pub(super) fn first_corner(&self, cs: &[WCorner], face: u32) -> usize {
-        let mesh = self.mesh;
-        let outer = mesh.loop_indices(mesh.outer_loop(face as usize));
-        let reference = (0..outer.len())
-            .map(|i| {
-                mesh.positions[outer[(i + 1) % outer.len()] as usize]
-                    - mesh.positions[outer[i] as usize]
-            })
-            .find(|e| e.length() > self.tol)
-            .map(|e| e.normalize());
+    pub(super) fn first_corner(
+        &self,
+        cs: &[WCorner],
+        face: u32,
+        reference: &mut Option<(u32, Option<DVec3>)>,
+    ) -> usize {
+        // The reference edge of the face, kept while its pieces come one
+        // after the other.
+        let reference = match *reference {
+            Some((f, r)) if f == face => r,
+            _ => {
+                let r = self.reference_edge(face);
+                *reference = Some((face, r));
+                r
+            }
+        };
         let Some(reference) = reference else {
             return 0;
         };
         let verts = &self.bufs.verts;
         let mut best = (f64::NEG_INFINITY, 0);
         for i in 0..cs.len() {
-            let e = verts[cs[(i + 1) % cs.len()].v as usize] - verts[cs[i].v as usize];
+            let next = if i + 1 == cs.len() { 0 } else { i + 1 };
+            let e = verts[cs[next].v as usize] - verts[cs[i].v as usize];
             let len = e.length();
             if len <= self.tol {
                 continue;
@@ -300,5 +333,19 @@ impl<'m, 'b> Cutter<'m, 'b> {
             }
         }
         best.1
+    }
+
+    /// The direction of the first edge of `face`'s outer loop longer than
+    /// the tolerance.
+    fn reference_edge(&self, face: u32) -> Option<DVec3> {
+        let mesh = self.mesh;
+        let outer = mesh.loop_indices(mesh.outer_loop(face as usize));
+        (0..outer.len())
+            .map(|i| {
+                mesh.positions[outer[(i + 1) % outer.len()] as usize]
+                    - mesh.positions[outer[i] as usize]
+            })
+            .find(|e| e.length() > self.tol)
+            .map(|e| e.normalize())
     }
 }

@@ -604,7 +604,7 @@ impl<'a> Interp<'a> {
             .map(|_| AttrSlot::Unevaluated)
             .collect();
         for (id, v) in attr_values {
-            slots[*id as usize] = AttrSlot::Done(v.clone());
+            slots[*id as usize] = AttrSlot::Done(v.own_copy());
         }
         Interp {
             program,
@@ -641,7 +641,7 @@ impl<'a> Interp<'a> {
 
     /// Replaces an attribute's value for this initial shape (outside values).
     pub fn set_attr_default(&mut self, id: crate::program::AttrId, v: Value) {
-        self.attr_values[id as usize] = AttrSlot::Done(v);
+        self.attr_values[id as usize] = AttrSlot::Done(v.own_copy());
     }
 
     /// Derives the initial shape with `rule`. Whatever was generated before
@@ -817,6 +817,30 @@ impl<'a> Interp<'a> {
     pub fn child(&mut self, parent: &Shape, span: Span) -> Result<Box<Shape>, RtError> {
         self.count_shape(span)?;
         Ok(self.successor(parent))
+    }
+
+    /// [`child`](Interp::child) of a shape used no more after it (its last
+    /// statement; see `exec_stmt`): what it shares by reference count (its
+    /// geometry, attributes, component and projection info) moves to the
+    /// child instead of being cloned, and the parent no longer shares the
+    /// geometry (which can then be edited without a copy, and is not
+    /// mistaken for an inserted asset). Cloning each shared part, then
+    /// dropping the parent's, cost two atomic operations apiece.
+    fn last_child(&mut self, st: &mut ShapeState, span: Span) -> Result<Box<Shape>, RtError> {
+        self.count_shape(span)?;
+        let parent = &mut st.shape;
+        let geometry = std::mem::replace(&mut parent.geometry, crate::shape::Geometry::empty());
+        let (attrs, comp, projections) = (
+            parent.attrs.take(),
+            parent.comp.take(),
+            parent.projections.take(),
+        );
+        let mut c = self.successor(&st.shape);
+        c.geometry = geometry;
+        c.attrs = attrs;
+        c.comp = comp;
+        c.projections = projections;
+        Ok(c)
     }
 
     /// [`child`](Interp::child) without counting it.
@@ -1128,25 +1152,7 @@ impl<'a> Interp<'a> {
                 let mut child = if last && !rc.dynamic {
                     // The successor is the shape's last use (a dynamic
                     // import still evaluates its overrides on the shape).
-                    self.count_shape(rc.span)?;
-                    // What is shared by reference count moves over: the
-                    // parent is dropped unread, and cloning each shared part
-                    // (then dropping the parent's) cost two atomic
-                    // operations apiece.
-                    let parent = &mut st.shape;
-                    let geometry =
-                        std::mem::replace(&mut parent.geometry, crate::shape::Geometry::empty());
-                    let (attrs, comp, projections) = (
-                        parent.attrs.take(),
-                        parent.comp.take(),
-                        parent.projections.take(),
-                    );
-                    let mut c = self.successor(&st.shape);
-                    c.geometry = geometry;
-                    c.attrs = attrs;
-                    c.comp = comp;
-                    c.projections = projections;
-                    c
+                    self.last_child(st, rc.span)?
                 } else {
                     self.child(&st.shape, rc.span)?
                 };
@@ -1171,7 +1177,10 @@ impl<'a> Interp<'a> {
             RStmt::Leaf(sym) => {
                 // A leaf is a shape of the tree too: it takes a child index.
                 self.next_tree_key();
-                let mut child = self.child(&st.shape, Span::default())?;
+                let mut child = match last {
+                    true => self.last_child(st, Span::default())?,
+                    false => self.child(&st.shape, Span::default())?,
+                };
                 child.name = *sym;
                 st.has_successor = true;
                 self.emit(&child);

@@ -234,6 +234,7 @@ impl Interp<'_> {
         let r = self.eval_with_locals(&[], &def.default, &initial);
         match r {
             Ok(v) => {
+                let v = v.own_copy();
                 self.attr_values[id as usize] = AttrSlot::Done(v.clone());
                 Ok(v)
             }

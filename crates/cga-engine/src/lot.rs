@@ -198,6 +198,7 @@ fn face_mesh(src: &Mesh, loops: &[Vec<usize>], material: u32) -> Mesh {
 /// The initial shape of a lot, ready for derivation.
 pub fn initial_shape(lot: &Lot, seed: u64, name: u32) -> Shape {
     let mut mesh = lot.mesh.clone();
+    mesh.share_on_this_thread();
     remove_repeated_corners(&mut mesh);
     let (normal, x) = first_edge_frame(&mesh);
     let y = normal;

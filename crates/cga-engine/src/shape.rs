@@ -385,11 +385,16 @@ impl Shape {
     }
 }
 
-/// A shared empty mesh (a placeholder that costs no allocation).
+/// A shared empty mesh (a placeholder that costs no allocation), one per
+/// thread: a reference count shared by all threads would bounce between
+/// the cores (see `cga_geometry::mesh::no_tags`).
 fn empty_mesh() -> Arc<Mesh> {
-    static EMPTY: std::sync::LazyLock<Arc<Mesh>> =
-        std::sync::LazyLock::new(|| Arc::new(Mesh::new()));
-    EMPTY.clone()
+    thread_local! {
+        static EMPTY: Arc<Mesh> = Arc::new(Mesh::new());
+    }
+    EMPTY
+        .try_with(|m| m.clone())
+        .unwrap_or_else(|_| Arc::new(Mesh::new()))
 }
 
 /// Bounding box of the positions a mesh's faces use.

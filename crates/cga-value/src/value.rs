@@ -238,6 +238,26 @@ impl fmt::Display for ValueType {
 }
 
 impl Value {
+    /// The value with storage of its own (a string or array not shared
+    /// with the value it was made from). For values a derivation keeps and
+    /// clones often (attribute values): cloned from the program's
+    /// constants, which every thread shares, each clone and drop would
+    /// change a reference count that bounces between the cores.
+    pub fn own_copy(&self) -> Value {
+        match self {
+            Value::Float(x) => Value::Float(*x),
+            Value::Bool(b) => Value::Bool(*b),
+            Value::Str(s) => Value::Str(Arc::from(&**s)),
+            Value::FloatArray(a) => Value::FloatArray(Arc::new((**a).clone())),
+            Value::BoolArray(a) => Value::BoolArray(Arc::new((**a).clone())),
+            Value::StrArray(a) => Value::StrArray(Arc::new(Array {
+                rows: a.rows,
+                cols: a.cols,
+                data: a.data.iter().map(|s| Arc::from(&**s)).collect(),
+            })),
+        }
+    }
+
     pub fn str(s: &str) -> Value {
         Value::Str(Arc::from(s))
     }
@@ -391,5 +411,34 @@ impl fmt::Display for Value {
         let mut s = String::new();
         crate::format::write_value(&mut s, self);
         f.write_str(&s)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn own_copies_are_equal_and_unshared() {
+        let s = Value::str("#d8cfc4");
+        let row = Value::float_row(vec![1.0, 2.5]);
+        let names = Value::StrArray(Arc::new(Array {
+            rows: 1,
+            cols: 2,
+            data: vec![Arc::from("a"), Arc::from("b")],
+        }));
+        for v in [&s, &row, &names, &Value::Float(3.0), &Value::Bool(true)] {
+            assert_eq!(&v.own_copy(), v);
+        }
+        let (Value::Str(a), Value::Str(b)) = (&s, &s.own_copy()) else {
+            unreachable!()
+        };
+        assert!(!Arc::ptr_eq(a, b));
+        let (Value::StrArray(a), Value::StrArray(b)) = (&names, &names.own_copy()) else {
+            unreachable!()
+        };
+        assert!(!Arc::ptr_eq(a, b));
+        assert!(!Arc::ptr_eq(&a.data[1], &b.data[1]));
+        assert_eq!((b.rows, b.cols), (1, 2));
     }
 }

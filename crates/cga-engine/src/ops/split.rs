@@ -157,7 +157,7 @@ pub(crate) fn collect_parts<'b, T, F: Fn(Option<&'b RExpr>, &'b RBody) -> T>(
 
 /// The geometry of each placed part, cut from `mesh` (scope-local) in one
 /// pass. Positions along the axis are `sign * distance` from the origin.
-fn cut_parts(mesh: &Arc<Mesh>, axis: usize, sign: f64, placed: &[Placed]) -> Vec<Mesh> {
+fn cut_parts(mesh: &Arc<Mesh>, axis: usize, sign: f64, placed: &[Placed]) -> Vec<Arc<Mesh>> {
     let coord = |d: f64| sign * d;
     let mut cuts: Vec<f64> = placed
         .iter()
@@ -166,7 +166,7 @@ fn cut_parts(mesh: &Arc<Mesh>, axis: usize, sign: f64, placed: &[Placed]) -> Vec
     cuts.sort_by(f64::total_cmp);
     cuts.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * (1.0 + a.abs()));
     if mesh.faces.is_empty() {
-        return placed.iter().map(|_| Mesh::new()).collect();
+        return placed.iter().map(|_| Arc::new(Mesh::new())).collect();
     }
     // Options, so that a part taking a whole slab leaves `None` behind
     // rather than an empty mesh built for nothing.
@@ -202,7 +202,9 @@ fn cut_parts(mesh: &Arc<Mesh>, axis: usize, sign: f64, placed: &[Placed]) -> Vec
                     0 => slab.take(),
                     _ => slab.clone(),
                 };
-                return whole.unwrap_or_default();
+                // Straight into its shared box: a mesh is some 400 bytes,
+                // moved once here rather than at every step to its shape.
+                return Arc::new(whole.unwrap_or_default());
             }
             let mut out = Mesh::new();
             for k in first..=end {
@@ -211,7 +213,7 @@ fn cut_parts(mesh: &Arc<Mesh>, axis: usize, sign: f64, placed: &[Placed]) -> Vec
                     cga_geometry::transform::merge(&mut out, slab);
                 }
             }
-            out
+            Arc::new(out)
         })
         .collect()
 }
@@ -221,7 +223,7 @@ fn cut_parts(mesh: &Arc<Mesh>, axis: usize, sign: f64, placed: &[Placed]) -> Vec
 /// geometry's bounding box (`adjust`).
 pub(crate) fn place_part(
     child: &mut Shape,
-    piece: Mesh,
+    piece: Arc<Mesh>,
     axis: usize,
     start: f64,
     size: f64,
@@ -234,7 +236,7 @@ pub(crate) fn place_part(
     scope.frame.origin += axes * offset;
     scope.size[axis] = size;
     let empty = piece.faces.is_empty();
-    let mut g = Geometry::new(Arc::new(piece));
+    let mut g = Geometry::new(piece);
     g.transform(DAffine3::from_translation(-offset));
     child.geometry = g;
     child.scope = scope;

@@ -118,7 +118,7 @@ pub fn exec(
     let total = plan.parts.len() as f64;
     for (index, part) in plan.parts.iter().enumerate() {
         let (start, end) = (plan.positions[part.slab - 1], plan.positions[part.slab]);
-        let piece = std::mem::take(&mut slabs[part.slab - plan.first_cut]);
+        let piece = std::sync::Arc::new(std::mem::take(&mut slabs[part.slab - plan.first_cut]));
         let mut child = cx.child(&st.shape, call.span)?;
         place_part(
             &mut child,

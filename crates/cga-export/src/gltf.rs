@@ -1613,17 +1613,8 @@ impl Layout {
             extras: Default::default(),
         };
         self.len += bytes.next_multiple_of(4);
-        let index = match &mut self.spool {
-            Some(spool) => {
-                spool.push_view(&view);
-                spool.views.count() - 1
-            }
-            None => {
-                root.buffer_views.push(view);
-                self.view_base + root.buffer_views.len() - 1
-            }
-        };
-        json::Index::new(index as u32)
+        let spool = self.spool.as_mut().map(|s| &mut s.views);
+        add_item(spool, &mut root.buffer_views, self.view_base, view)
     }
 
     /// A view holding `components` 4-byte values and an accessor on it
@@ -1654,18 +1645,27 @@ impl Layout {
             normalized: false,
             sparse: None,
         };
-        let index = match &mut self.spool {
-            Some(spool) => {
-                spool.push_accessor(&accessor);
-                spool.accessors.count() - 1
-            }
-            None => {
-                root.accessors.push(accessor);
-                self.accessor_base + root.accessors.len() - 1
-            }
-        };
-        json::Index::new(index as u32)
+        let spool = self.spool.as_mut().map(|s| &mut s.accessors);
+        add_item(spool, &mut root.accessors, self.accessor_base, accessor)
     }
+}
+
+/// Adds `item` to its spooled part while a spool is open, else to the
+/// document's `list`, which follows `base` spooled items: its index.
+fn add_item<T: serde::Serialize>(
+    spooled: Option<&mut json_spool::Part>,
+    list: &mut Vec<T>,
+    base: usize,
+    item: T,
+) -> json::Index<T> {
+    let index = match spooled {
+        Some(part) => part.push(&item),
+        None => {
+            list.push(item);
+            base + list.len() - 1
+        }
+    };
+    json::Index::new(index as u32)
 }
 
 /// The accessors (and buffer views) of a primitive's arrays, laid out next

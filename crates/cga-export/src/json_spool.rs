@@ -38,6 +38,9 @@ pub(crate) struct Part {
     file: BufWriter<File>,
     bytes: u64,
     count: usize,
+    /// The first error writing the file: reported when the GLB is written
+    /// (laying out goes on counting indices meanwhile).
+    error: Option<io::Error>,
 }
 
 impl Part {
@@ -46,6 +49,7 @@ impl Part {
             file: BufWriter::with_capacity(1 << 16, tempfile::tempfile()?),
             bytes: 0,
             count: 0,
+            error: None,
         })
     }
 
@@ -54,7 +58,16 @@ impl Part {
         self.count
     }
 
-    fn push(&mut self, item: &impl Serialize) -> io::Result<()> {
+    /// Spools `item`; its index among the spooled items.
+    pub(crate) fn push(&mut self, item: &impl Serialize) -> usize {
+        if let Err(e) = self.write(item) {
+            self.error.get_or_insert(e);
+        }
+        self.count += 1;
+        self.count - 1
+    }
+
+    fn write(&mut self, item: &impl Serialize) -> io::Result<()> {
         if self.count > 0 {
             self.file.write_all(b",")?;
             self.bytes += 1;
@@ -65,11 +78,13 @@ impl Part {
         };
         serde_json::to_writer(&mut w, item)?;
         self.bytes += w.len;
-        self.count += 1;
         Ok(())
     }
 
     fn into_reader(self) -> io::Result<(File, u64)> {
+        if let Some(e) = self.error {
+            return Err(e);
+        }
         let mut file = self.file.into_inner().map_err(|e| e.into_error())?;
         file.seek(SeekFrom::Start(0))?;
         Ok((file, self.bytes))
@@ -80,9 +95,6 @@ impl Part {
 pub(crate) struct Spool {
     pub(crate) accessors: Part,
     pub(crate) views: Part,
-    /// The first error writing the files: reported when the GLB is
-    /// written (laying out goes on counting indices meanwhile).
-    error: Option<io::Error>,
 }
 
 impl Spool {
@@ -94,24 +106,7 @@ impl Spool {
         Some(Spool {
             accessors: Part::new().ok()?,
             views: Part::new().ok()?,
-            error: None,
         })
-    }
-
-    pub(crate) fn push_accessor(&mut self, accessor: &json::Accessor) {
-        let r = self.accessors.push(accessor);
-        self.keep_error(r);
-    }
-
-    pub(crate) fn push_view(&mut self, view: &json::buffer::View) {
-        let r = self.views.push(view);
-        self.keep_error(r);
-    }
-
-    fn keep_error(&mut self, r: io::Result<()>) {
-        if let (Err(e), None) = (r, &self.error) {
-            self.error = Some(e);
-        }
     }
 }
 
@@ -171,9 +166,6 @@ impl GlbJson {
         let text = serde_json::to_vec(root)?;
         let mut splices = Vec::new();
         if let Some(spool) = spool {
-            if let Some(e) = spool.error {
-                return Err(e);
-            }
             let parts = [
                 (spool.accessors, serde_json::to_vec(&accessor_marker())?),
                 (spool.views, serde_json::to_vec(&view_marker())?),

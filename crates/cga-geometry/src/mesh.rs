@@ -272,20 +272,16 @@ impl Mesh {
     /// piece holds its lists, and reference counts changed by two threads
     /// at every cut bounce between the cores.
     pub fn share_on_this_thread(&mut self) {
+        fn local<T: Clone + PartialEq>(list: &SharedVec<T>, default: SharedVec<T>) -> SharedVec<T> {
+            match **list == *default {
+                true => default,
+                false => list.to_vec().into(),
+            }
+        }
         let (materials, groups) = default_slots();
-        self.materials = match *self.materials == *materials {
-            true => materials,
-            false => self.materials.to_vec().into(),
-        };
-        self.groups = match *self.groups == *groups {
-            true => groups,
-            false => self.groups.to_vec().into(),
-        };
-        let tags = no_tags();
-        self.tags = match *self.tags == *tags {
-            true => tags,
-            false => self.tags.to_vec().into(),
-        };
+        self.materials = local(&self.materials, materials);
+        self.groups = local(&self.groups, groups);
+        self.tags = local(&self.tags, no_tags());
     }
 
     /// Room for `corners` more corners (and as many positions, a loop and

@@ -20,7 +20,7 @@ use crate::instances::{decompose, Pending};
 use crate::materials::MaterialTable;
 use crate::prepare::{FacePrep, SlotIds};
 use crate::textures::TextureProbe;
-use crate::{check_mesh, ExportError, FaceData};
+use crate::{check_mesh, ExportError, ExportOptions, FaceData};
 
 /// Meshes encoded into vertex data, ready for [`ModelWriter::append`]
 /// (crate::ModelWriter::append).
@@ -43,6 +43,9 @@ pub struct Encoded {
     /// Emptied buckets of an earlier use of this batch, whose room new
     /// materials take.
     spare: Vec<Bucket>,
+    /// The encoders that made the batch, whose pool takes its room back
+    /// once appended (also when appended to another writer's model).
+    pub(crate) home: Option<Arc<EncoderShared>>,
 }
 
 impl Encoded {
@@ -259,6 +262,26 @@ impl Encoder {
         Encoder::new(self.shared.clone())
     }
 
+    /// An encoder for the glTF and GLB writers made with `options`, with
+    /// no writer of its own: its batches can be appended to any of them
+    /// whose origin is the encoder's ([`set_origin`](Encoder::set_origin);
+    /// the tiles of a tileset, each with the origin of its lots).
+    pub fn for_export(options: &ExportOptions) -> Encoder {
+        let options = options.clone().exact_origin();
+        Encoder::new(Arc::new(EncoderShared::new(
+            TextureProbe::new(options.world.clone(), &options.texture_roots),
+            options.origin,
+            options.instances,
+        )))
+    }
+
+    /// Writes the positions of the meshes added from now on relative to
+    /// `origin` (see [`ExportOptions::origin`]), as a writer made with that
+    /// origin does.
+    pub fn set_origin(&mut self, origin: Option<DVec3>) {
+        self.mesh.origin = origin.map(crate::exact);
+    }
+
     /// Encodes one shape's geometry, given in its own coordinates and
     /// placed in the world by `transform`, with `materials` for its
     /// material slots (see [`ModelWriter::add_placed`]
@@ -321,6 +344,7 @@ impl Encoder {
         let fresh = self.shared.pool().pop().unwrap_or_default();
         let mut batch = std::mem::replace(&mut self.batch, fresh);
         batch.materials = self.table.take_materials();
+        batch.home = Some(self.shared.clone());
         // Slot ids name this batch's materials.
         self.mesh.forget_ids();
         batch

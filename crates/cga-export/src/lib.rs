@@ -130,12 +130,19 @@ impl ExportOptions {
     /// coordinates are 32-bit floats: glTF's node translation is one, and
     /// positions must be relative to exactly what it says (whole metres are
     /// such floats up to 16,777 km).
-    fn exact_origin(self) -> ExportOptions {
+    pub(crate) fn exact_origin(self) -> ExportOptions {
         ExportOptions {
-            origin: self.origin.map(|o| o.as_vec3().as_dvec3()),
+            origin: self.origin.map(exact),
             ..self
         }
     }
+}
+
+/// An origin as the model keeps it: a point that 32-bit floats hold
+/// exactly, so that positions relative to it and the origin add up to
+/// the same point however they are stored.
+pub(crate) fn exact(origin: DVec3) -> DVec3 {
+    origin.as_vec3().as_dvec3()
 }
 
 /// How the output keeps lots apart.
@@ -672,7 +679,10 @@ impl ModelWriter {
         for p in batch.instances.drain(..) {
             self.place(p)?;
         }
-        self.encoders.recycle(batch);
+        match batch.home.take() {
+            Some(home) => home.recycle(batch),
+            None => self.encoders.recycle(batch),
+        }
         Ok(())
     }
 

@@ -8,8 +8,11 @@
 //! massing (the lot extruded to the building's height), so that a
 //! city-wide view loads fast; tiles with more lots than
 //! [`TilesetOptions::max_massing_lots`] have no content of their own.
-//! Leaves are generated one after another, each in parallel over its lots,
-//! and written as they finish: memory holds one tile's lots.
+//! All lots are generated in one run of the workers, leaf after leaf
+//! ([`Target::PerLot`]): the workers derive the next lots while a leaf's
+//! GLB is finished and written, and memory holds the open tile and a few
+//! lots per worker. Tiles written are dropped from the page cache once on
+//! disk (module `evict`).
 //!
 //! Coordinates: the model's frame is y up, x east and -z north (metres);
 //! glTF tile contents stay so, and the tileset's bounding boxes are in
@@ -23,6 +26,7 @@
 //! Lot results (prints, reports, errors) are handed over in lot order, as
 //! the command line writes them for other formats.
 
+mod evict;
 pub mod globe;
 pub mod tree;
 
@@ -30,8 +34,8 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use cga::{
-    Error, ExportOptions, Format, Georeference, Granularity, Lot, LotResult, ModelWriter, Options,
-    Rules, Summary, Target,
+    Encoder, Error, ExportOptions, Format, Georeference, Granularity, Lot, LotResult, LotWriters,
+    ModelWriter, Options, Rules, Summary, Target,
 };
 use cga_geometry::extrude::{extrude, Extrusion};
 use cga_geometry::{DVec3, Material};
@@ -113,12 +117,6 @@ pub fn write_tileset(
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    let io = |p: &Path, source: std::io::Error| {
-        Error::Export(cga::ExportError::Io {
-            path: p.to_path_buf(),
-            source,
-        })
-    };
     let tiles_dir = dir.join("tiles");
     std::fs::create_dir_all(&tiles_dir).map_err(|e| io(&tiles_dir, e))?;
     // Context queries between lots see the whole run, not one tile.
@@ -128,22 +126,37 @@ pub fn write_tileset(
     };
     let centres: Vec<[f64; 2]> = lots.iter().map(centre).collect();
     let root = tree::build(&centres, tiles.max_lots_per_tile);
-    let mut w = Writer {
-        rules,
-        lots,
-        options,
-        tiles,
-        tiles_dir,
-        lot_bounds: vec![None; lots.len()],
+    let leaves = root.leaves();
+    let mut contents = Contents::new(lots, &leaves, tiles, tiles_dir);
+    let mut results = Results {
         pending: BTreeMap::new(),
         next: 0,
         each,
-        stats: TilesetStats::default(),
-        generated: 0,
         metadata: vec![None; lots.len()],
     };
-    let (mut tile, _, error) = w.tile(&root)?;
-    w.release();
+    // All leaves in one run of the workers: a leaf's lots are derived
+    // while the one before is written.
+    let order = contents.order.clone();
+    let summary = rules.generate_lots_in_order(
+        lots,
+        &order,
+        options,
+        Target::PerLot(&mut contents),
+        |r| results.add(r, lots),
+    )?;
+    contents.close()?;
+    results.release_rest();
+    let mut w = Writer {
+        lots,
+        tiles,
+        metadata: results.metadata,
+        leaf_contents: contents.leaves.into_iter().map(|l| l.contents).collect(),
+        lot_bounds: contents.lot_bounds,
+        stats: contents.stats,
+        tiles_dir: contents.tiles_dir,
+    };
+    let mut next_leaf = 0;
+    let (mut tile, _, error) = w.tile(&root, &mut next_leaf)?;
     let georeference = tiles.export.georeference.as_ref();
     if let Some(g) = georeference {
         tile["transform"] = json!(globe::enu_to_ecef(g.longitude, g.latitude));
@@ -162,8 +175,19 @@ pub fn write_tileset(
     let text = serde_json::to_vec_pretty(&tileset).expect("JSON of numbers and strings");
     std::fs::write(path, text).map_err(|e| io(path, e))?;
     let mut stats = w.stats;
-    stats.summary.lots = lots.len();
+    stats.summary = Summary {
+        lots: lots.len(),
+        ..summary
+    };
     Ok(stats)
+}
+
+/// A failure to write `p`.
+fn io(p: &Path, source: std::io::Error) -> Error {
+    Error::Export(cga::ExportError::Io {
+        path: p.to_path_buf(),
+        source,
+    })
 }
 
 /// The centre of a lot's outline in the ground plane (x, z).
@@ -213,33 +237,238 @@ fn diagonal(b: Bounds) -> f64 {
     (DVec3::from_array(hi) - DVec3::from_array(lo)).length()
 }
 
-struct Writer<'a, F: FnMut(LotResult)> {
-    rules: &'a Rules,
-    lots: &'a [Lot],
-    options: &'a Options,
+/// A leaf of the tree while its lots are written.
+struct LeafTile {
+    /// The tile's name (`LEVEL_X_Y`).
+    name: String,
+    /// Its lots' positions are written relative to this point.
+    origin: Option<DVec3>,
+    /// The GLBs written for it, with geometry.
+    contents: Vec<Content>,
+}
+
+/// The content being written: a GLB of some of a leaf's lots.
+struct OpenContent {
+    leaf: usize,
+    name: String,
+    path: PathBuf,
+    writer: ModelWriter,
+    /// The lots in it (positions in `Contents::order`), in order.
+    lots: Vec<usize>,
+}
+
+/// The leaves' contents, written as their lots come ([`LotWriters`]): a
+/// leaf's lots go into one GLB, or into several where they make more than
+/// `max_triangles_per_tile` triangles.
+struct Contents<'a> {
     tiles: &'a TilesetOptions,
     tiles_dir: PathBuf,
-    /// Each lot's model box, once its leaf is written.
+    leaves: Vec<LeafTile>,
+    /// The lots in the order they are generated (the leaves' lots one
+    /// leaf after another, each leaf's in the order of a Z curve over
+    /// their centres), and the leaf of each.
+    order: Vec<usize>,
+    leaf_of: Vec<usize>,
+    open: Option<OpenContent>,
+    /// The position (in `order`) of the lot asked for last.
+    current: Option<usize>,
+    /// Each lot's model box, once its content is written.
     lot_bounds: Vec<Option<Bounds>>,
+    /// Lots in closed contents (with `stats.triangles`, the triangles per
+    /// lot that decide when a content is full).
+    closed_lots: usize,
+    stats: TilesetStats,
+    evict: evict::Evict,
+}
+
+impl<'a> Contents<'a> {
+    fn new(
+        lots: &[Lot],
+        leaves: &[&tree::Node],
+        tiles: &'a TilesetOptions,
+        tiles_dir: PathBuf,
+    ) -> Self {
+        let (mut order, mut leaf_of) = (Vec::new(), Vec::new());
+        let leaves = leaves
+            .iter()
+            .enumerate()
+            .map(|(k, node)| {
+                let mut mine = node.lots.clone();
+                tree::z_order(&mut mine, |i| centre(&lots[i]));
+                leaf_of.resize(leaf_of.len() + mine.len(), k);
+                order.extend(&mine);
+                LeafTile {
+                    name: node.name(),
+                    origin: tile_origin(tiles, lots, &node.lots),
+                    contents: Vec::new(),
+                }
+            })
+            .collect();
+        Contents {
+            tiles,
+            tiles_dir,
+            leaves,
+            order,
+            leaf_of,
+            open: None,
+            current: None,
+            lot_bounds: vec![None; lots.len()],
+            closed_lots: 0,
+            stats: TilesetStats::default(),
+            evict: evict::Evict::default(),
+        }
+    }
+
+    /// Whether the open content has no room left for a lot of the average
+    /// size so far.
+    fn full(&self, open: &OpenContent) -> bool {
+        let made = open.writer.triangles();
+        let lots = (self.closed_lots + open.lots.len()) as u64;
+        let triangles = self.stats.triangles + made;
+        if made == 0 || lots == 0 || triangles == 0 {
+            return false;
+        }
+        let room = self.tiles.max_triangles_per_tile.saturating_sub(made);
+        room < (triangles / lots).max(1)
+    }
+
+    /// Writes the open content; one without geometry is left out.
+    fn close(&mut self) -> Result<(), Error> {
+        let Some(open) = self.open.take() else {
+            return Ok(());
+        };
+        let stats = open.writer.finish().map_err(Error::Export)?;
+        self.stats.triangles += stats.triangles;
+        self.stats.warnings.extend(stats.warnings);
+        self.closed_lots += open.lots.len();
+        for (k, &i) in open.lots.iter().enumerate() {
+            self.lot_bounds[self.order[i]] = stats.lot_bounds.get(k).copied().flatten();
+        }
+        if stats.bounds.is_none() {
+            let _ = std::fs::remove_file(&open.path);
+            return Ok(());
+        }
+        self.evict.written(&open.path);
+        self.stats.contents += 1;
+        self.leaves[open.leaf].contents.push(Content {
+            uri: Some(format!("tiles/{}", open.name)),
+            bounds: stats.bounds,
+        });
+        Ok(())
+    }
+
+    /// A new content for leaf `leaf`.
+    fn open(&mut self, leaf: usize) -> Result<OpenContent, Error> {
+        let tile = &self.leaves[leaf];
+        let name = match tile.contents.len() {
+            0 => format!("{}.glb", tile.name),
+            k => format!("{}.{k}.glb", tile.name),
+        };
+        let path = self.tiles_dir.join(&name);
+        let export = tile_export(self.tiles, tile.origin);
+        let mut writer = ModelWriter::create(&path, Format::Glb, export).map_err(Error::Export)?;
+        writer.with_features();
+        Ok(OpenContent {
+            leaf,
+            name,
+            path,
+            writer,
+            lots: Vec::new(),
+        })
+    }
+}
+
+impl LotWriters for Contents<'_> {
+    fn encoder(&self) -> Option<Encoder> {
+        Some(Encoder::for_export(&tile_export(self.tiles, None)))
+    }
+
+    fn origin(&self, i: usize) -> Option<DVec3> {
+        self.leaves[self.leaf_of[i]].origin
+    }
+
+    fn writer(&mut self, i: usize) -> Result<&mut ModelWriter, Error> {
+        if self.current != Some(i) {
+            self.current = Some(i);
+            let leaf = self.leaf_of[i];
+            let done = match &self.open {
+                Some(open) => open.leaf != leaf || self.full(open),
+                None => false,
+            };
+            if done {
+                self.close()?;
+            }
+            if self.open.is_none() {
+                self.open = Some(self.open(leaf)?);
+            }
+            if let Some(open) = &mut self.open {
+                open.lots.push(i);
+            }
+        }
+        match &mut self.open {
+            Some(open) => Ok(&mut open.writer),
+            None => unreachable!("a content is open once a lot is asked for"),
+        }
+    }
+}
+
+/// The lots' results, handed over in lot order, and each lot's row of the
+/// parents' property tables.
+struct Results<F: FnMut(LotResult)> {
     /// Results of lots after the next one to hand over.
     pending: BTreeMap<usize, LotResult>,
     next: usize,
     each: F,
-    stats: TilesetStats,
-    /// Lots generated so far (with `stats.triangles`, the triangles per
-    /// lot that decide how many lots go into a content at once).
-    generated: usize,
-    /// Each lot's index, attributes and reports, once generated: its row
-    /// in the parents' property tables.
+    /// Each lot's index, attributes and reports, once generated.
     metadata: Vec<Option<Json>>,
 }
 
-impl<F: FnMut(LotResult)> Writer<'_, F> {
-    /// A tile's JSON, its box and its geometric error.
-    fn tile(&mut self, node: &tree::Node) -> Result<(Json, Option<Bounds>, f64), Error> {
+impl<F: FnMut(LotResult)> Results<F> {
+    fn add(&mut self, r: LotResult, lots: &[Lot]) {
+        let mut m = cga::metadata::lot_metadata(r.index, &lots[r.index]);
+        if !r.reports.is_empty() {
+            m["reports"] = cga::metadata::reports_metadata(&r.reports);
+        }
+        self.metadata[r.index] = Some(m);
+        self.pending.insert(r.index, r);
+        while let Some(r) = self.pending.remove(&self.next) {
+            (self.each)(r);
+            self.next += 1;
+        }
+    }
+
+    /// Hands over what is left: lots after one that gave no result (none
+    /// is missing unless generation stopped).
+    fn release_rest(&mut self) {
+        let rest = std::mem::take(&mut self.pending);
+        rest.into_values().for_each(&mut self.each);
+    }
+}
+
+/// The tree's JSON, and the parents' massing, once the leaves are written.
+struct Writer<'a> {
+    lots: &'a [Lot],
+    tiles: &'a TilesetOptions,
+    tiles_dir: PathBuf,
+    metadata: Vec<Option<Json>>,
+    /// The contents of each leaf, in the order of [`tree::Node::leaves`].
+    leaf_contents: Vec<Vec<Content>>,
+    lot_bounds: Vec<Option<Bounds>>,
+    stats: TilesetStats,
+}
+
+impl Writer<'_> {
+    /// A tile's JSON, its box and its geometric error; `next_leaf` counts
+    /// the leaves met so far.
+    fn tile(
+        &mut self,
+        node: &tree::Node,
+        next_leaf: &mut usize,
+    ) -> Result<(Json, Option<Bounds>, f64), Error> {
         self.stats.tiles += 1;
         if node.children.is_empty() {
-            let contents = self.leaf(node)?;
+            let contents = std::mem::take(&mut self.leaf_contents[*next_leaf]);
+            *next_leaf += 1;
             let bounds = contents.iter().fold(None, |b, c| union(b, c.bounds));
             let bounds = bounds.or_else(|| {
                 node.lots
@@ -281,7 +510,7 @@ impl<F: FnMut(LotResult)> Writer<'_, F> {
         let mut children = Vec::with_capacity(node.children.len());
         let (mut bounds, mut child_error) = (None, 0.0f64);
         for c in &node.children {
-            let (json, b, e) = self.tile(c)?;
+            let (json, b, e) = self.tile(c, next_leaf)?;
             children.push(json);
             bounds = union(bounds, b);
             child_error = child_error.max(e);
@@ -312,95 +541,6 @@ impl<F: FnMut(LotResult)> Writer<'_, F> {
         Ok((tile, bounds, error))
     }
 
-    /// Generates a leaf's lots into GLBs: one, or several where the lots
-    /// make more than `max_triangles_per_tile` triangles, each of lots
-    /// close together (in the order of a Z curve over their centres).
-    /// Contents without geometry are left out.
-    fn leaf(&mut self, node: &tree::Node) -> Result<Vec<Content>, Error> {
-        let mut order = node.lots.clone();
-        tree::z_order(&mut order, |i| centre(&self.lots[i]));
-        // Lots are generated a few at a time into the open content, so
-        // that it can be closed when it is full: as many as the triangles
-        // per lot so far say fit, at least one per thread.
-        let least = self.options.jobs.unwrap_or(2).max(2);
-        let mut contents = Vec::new();
-        let mut rest = &order[..];
-        while !rest.is_empty() {
-            let name = match contents.len() {
-                0 => format!("{}.glb", node.name()),
-                k => format!("{}.{k}.glb", node.name()),
-            };
-            let path = self.tiles_dir.join(&name);
-            let export = self.tile_export(rest);
-            let mut writer =
-                ModelWriter::create(&path, Format::Glb, export).map_err(Error::Export)?;
-            writer.with_features();
-            let mut lots: Vec<usize> = Vec::new();
-            while !rest.is_empty() {
-                let made = writer.triangles();
-                let room = self.tiles.max_triangles_per_tile.saturating_sub(made);
-                let batch = match (self.generated as u64, self.stats.triangles + made) {
-                    (0, _) | (_, 0) => least,
-                    (n, t) => (room / (t / n).max(1)) as usize,
-                };
-                // Full: no room for a lot of average size.
-                if batch == 0 && made > 0 {
-                    break;
-                }
-                let (now, later) = rest.split_at(batch.max(1).min(rest.len()));
-                self.generate_into(&mut writer, now)?;
-                self.generated += now.len();
-                lots.extend(now);
-                rest = later;
-            }
-            let stats = writer.finish().map_err(Error::Export)?;
-            self.stats.triangles += stats.triangles;
-            self.stats.warnings.extend(stats.warnings);
-            for (k, &i) in lots.iter().enumerate() {
-                self.lot_bounds[i] = stats.lot_bounds.get(k).copied().flatten();
-            }
-            self.release();
-            if stats.bounds.is_none() {
-                let _ = std::fs::remove_file(&path);
-                continue;
-            }
-            self.stats.contents += 1;
-            contents.push(Content {
-                uri: Some(format!("tiles/{name}")),
-                bounds: stats.bounds,
-            });
-        }
-        Ok(contents)
-    }
-
-    /// Generates `lots` (indices) into `writer`, their results kept for
-    /// handing over in lot order.
-    fn generate_into(&mut self, writer: &mut ModelWriter, lots: &[usize]) -> Result<(), Error> {
-        let part: Vec<Lot> = lots.iter().map(|&i| self.lots[i].clone()).collect();
-        let options = Options {
-            lot_indices: Some(lots.to_vec().into()),
-            ..self.options.clone()
-        };
-        let (pending, metadata, all) = (&mut self.pending, &mut self.metadata, self.lots);
-        let summary = self
-            .rules
-            .generate_lots(&part, &options, Target::Writer(writer), |r| {
-                // The lot's row of the parents' property tables.
-                let mut m = cga::metadata::lot_metadata(r.index, &all[r.index]);
-                if !r.reports.is_empty() {
-                    m["reports"] = cga::metadata::reports_metadata(&r.reports);
-                }
-                metadata[r.index] = Some(m);
-                pending.insert(r.index, r);
-            })?;
-        let s = &mut self.stats.summary;
-        s.failed += summary.failed;
-        s.shapes += summary.shapes;
-        s.leaves += summary.leaves;
-        s.derived_after += summary.derived_after;
-        Ok(())
-    }
-
     /// A parent's GLB of the massing of `lots`: each lot's outline
     /// extruded from its lowest point to the top of its building, all in
     /// one mesh.
@@ -408,7 +548,7 @@ impl<F: FnMut(LotResult)> Writer<'_, F> {
         let name = format!("{}.glb", node.name());
         let path = self.tiles_dir.join(&name);
         // One mesh for the tile, the lots told apart by feature ids.
-        let export = self.tile_export(lots);
+        let export = tile_export(self.tiles, tile_origin(self.tiles, self.lots, lots));
         let mut writer = ModelWriter::create(&path, Format::Glb, export).map_err(Error::Export)?;
         writer.with_features();
         let material = Material {
@@ -451,42 +591,31 @@ impl<F: FnMut(LotResult)> Writer<'_, F> {
         self.stats.massing_triangles += stats.triangles;
         Ok(Some(format!("tiles/{name}")))
     }
+}
 
-    /// How a tile of `lots` is written: merged by material, from the
-    /// centre of the lots when tiles have origins.
-    fn tile_export(&self, lots: &[usize]) -> ExportOptions {
-        let origin = self.tiles.tile_origins.then(|| {
-            let b = lots
-                .iter()
-                .fold(None, |b, &i| union(b, footprint(&self.lots[i])));
-            b.map_or(DVec3::ZERO, |[lo, hi]| {
-                DVec3::new(
-                    ((lo[0] + hi[0]) / 2.0).round(),
-                    0.0,
-                    ((lo[2] + hi[2]) / 2.0).round(),
-                )
-            })
-        });
-        ExportOptions {
-            granularity: Granularity::Material,
-            origin: origin.filter(|o| o.is_finite()),
-            ..self.tiles.export.clone()
-        }
+/// The origin of a tile of `lots`: the centre of their outlines, in whole
+/// metres, when tiles have origins.
+fn tile_origin(tiles: &TilesetOptions, lots: &[Lot], of: &[usize]) -> Option<DVec3> {
+    if !tiles.tile_origins {
+        return None;
     }
+    let b = of.iter().fold(None, |b, &i| union(b, footprint(&lots[i])));
+    let o = b.map_or(DVec3::ZERO, |[lo, hi]| {
+        DVec3::new(
+            ((lo[0] + hi[0]) / 2.0).round(),
+            0.0,
+            ((lo[2] + hi[2]) / 2.0).round(),
+        )
+    });
+    o.is_finite().then_some(o)
+}
 
-    /// Hands over the results that are next in lot order.
-    fn release(&mut self) {
-        while let Some(r) = self.pending.remove(&self.next) {
-            (self.each)(r);
-            self.next += 1;
-        }
-        // Lots that gave no result (none is missing unless generation
-        // stopped) are skipped at the end.
-        if self.next < self.lots.len() && self.pending.len() + self.next >= self.lots.len() {
-            let rest: Vec<LotResult> = std::mem::take(&mut self.pending).into_values().collect();
-            rest.into_iter().for_each(&mut self.each);
-            self.next = self.lots.len();
-        }
+/// How a tile is written: merged by material, from `origin`.
+fn tile_export(tiles: &TilesetOptions, origin: Option<DVec3>) -> ExportOptions {
+    ExportOptions {
+        granularity: Granularity::Material,
+        origin,
+        ..tiles.export.clone()
     }
 }
 

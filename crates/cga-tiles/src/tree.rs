@@ -21,6 +21,23 @@ impl Node {
         out
     }
 
+    /// The leaves under this tile (itself, if it is one), in the order of
+    /// a walk of the tree: children in order, depth first.
+    pub fn leaves(&self) -> Vec<&Node> {
+        let mut out = Vec::new();
+        self.collect_leaves(&mut out);
+        out
+    }
+
+    fn collect_leaves<'a>(&'a self, out: &mut Vec<&'a Node>) {
+        if self.children.is_empty() {
+            out.push(self);
+        }
+        for c in &self.children {
+            c.collect_leaves(out);
+        }
+    }
+
     fn collect(&self, out: &mut Vec<usize>) {
         out.extend(&self.lots);
         for c in &self.children {

@@ -7,7 +7,8 @@ use cga_engine::context::{LotContext, SceneContext};
 use cga_engine::derive::{Leaf, RtErrorKind};
 use cga_engine::generate::{collect_lot, generate_lot_streaming};
 use cga_engine::{GenerateOptions, LotOutput, RtError};
-use cga_export::{ModelWriter, PlainCollector};
+use cga_export::{Encoder, ModelWriter, PlainCollector};
+use cga_geometry::DVec3;
 
 use crate::diagnostics::Diagnostic;
 use crate::lots::Lot;
@@ -26,6 +27,44 @@ pub enum Target<'w> {
     Meshes,
     /// Into a model file (streamed: memory does not grow with the lots).
     Writer(&'w mut ModelWriter),
+    /// Into models that follow one another, each lot wholly into one (the
+    /// tiles of a tileset), streamed like [`Target::Writer`]: one run of
+    /// the workers over all of them.
+    PerLot(&'w mut dyn LotWriters),
+}
+
+/// The models of [`Target::PerLot`]: which lot goes where, and from which
+/// origin its positions are written.
+pub trait LotWriters {
+    /// An encoder of the writers' format for the deriving threads (for
+    /// glTF and GLB, [`Encoder::for_export`] with the writers' options);
+    /// `None` has meshes added on the calling thread.
+    fn encoder(&self) -> Option<Encoder>;
+    /// What lot `i`'s positions are written relative to: the origin of its
+    /// writer. Asked for every lot before generating.
+    fn origin(&self, i: usize) -> Option<DVec3>;
+    /// The writer of lot `i`, asked before each piece of its output, lot
+    /// after lot in order (a writer can be closed and the next opened when
+    /// `i` moves on).
+    fn writer(&mut self, i: usize) -> Result<&mut ModelWriter, Error>;
+}
+
+/// Where a call's geometry is written, if anywhere.
+enum Out<'w> {
+    None,
+    One(&'w mut ModelWriter),
+    PerLot(&'w mut dyn LotWriters),
+}
+
+impl Out<'_> {
+    /// The writer of lot `i`.
+    fn writer(&mut self, i: usize) -> Result<Option<&mut ModelWriter>, Error> {
+        match self {
+            Out::None => Ok(None),
+            Out::One(w) => Ok(Some(&mut **w)),
+            Out::PerLot(w) => w.writer(i).map(Some),
+        }
+    }
 }
 
 impl Rules {
@@ -59,6 +98,38 @@ impl Rules {
         lots: &[Lot],
         options: &Options,
         target: Target<'_>,
+        each: impl FnMut(LotResult),
+    ) -> Result<Summary, Error> {
+        self.generate_list(lots, None, options, target, each)
+    }
+
+    /// [`generate_lots`](Rules::generate_lots) of the lots `order` names,
+    /// in that order: `lots[order[0]]` first. Results carry the lots'
+    /// indices in `lots` (or what [`Options::lot_indices`] says of them),
+    /// and context queries between lots see all of `lots`.
+    pub fn generate_lots_in_order(
+        &self,
+        lots: &[Lot],
+        order: &[usize],
+        options: &Options,
+        target: Target<'_>,
+        each: impl FnMut(LotResult),
+    ) -> Result<Summary, Error> {
+        if let Some(&i) = order.iter().find(|&&i| i >= lots.len()) {
+            return Err(Error::Value(format!(
+                "lot {i} in the order of {} lots",
+                lots.len()
+            )));
+        }
+        self.generate_list(lots, Some(order), options, target, each)
+    }
+
+    fn generate_list(
+        &self,
+        lots: &[Lot],
+        order: Option<&[usize]>,
+        options: &Options,
+        target: Target<'_>,
         mut each: impl FnMut(LotResult),
     ) -> Result<Summary, Error> {
         self.check_usable()?;
@@ -73,17 +144,22 @@ impl Rules {
                 lots.len()
             )));
         }
+        // The call's lot `i`, and its index in the run.
+        let position = |i: usize| order.map_or(i, |o| o[i]);
+        let lot = |i: usize| &lots[position(i)];
+        let lot_index = |i: usize| options.lot_index(position(i));
+        let count = order.map_or(lots.len(), <[usize]>::len);
         let started = std::time::Instant::now();
         let rule = self.start_rule(options.start_rule.as_deref())?;
         let mut engine_options = self.engine_options(options)?;
-        let jobs = options.threads().min(lots.len().max(1));
+        let jobs = options.threads().min(count.max(1));
         let program = &self.inner.program;
         let assets = &self.inner.assets;
         let usage = self.inner.context_use;
         engine_options.context_use = Some(usage);
         if let (true, Some(scene)) = (usage.inter, &options.scene) {
             engine_options.scene = Some(scene.0.clone());
-        } else if usage.inter && lots.len() > 1 {
+        } else if usage.inter && count > 1 {
             engine_options.scene = Some(Arc::new(self.collect_scene(
                 rule,
                 lots,
@@ -97,10 +173,11 @@ impl Rules {
             return Err(Error::Cancelled);
         }
 
-        let (mut writer, keep_meshes) = match target {
-            Target::Nothing => (None, false),
-            Target::Meshes => (None, true),
-            Target::Writer(w) => (Some(w), false),
+        let (mut out, keep_meshes) = match target {
+            Target::Nothing => (Out::None, false),
+            Target::Meshes => (Out::None, true),
+            Target::Writer(w) => (Out::One(w), false),
+            Target::PerLot(w) => (Out::PerLot(w), false),
         };
         // Leaves go to the calling thread in batches as they are emitted,
         // so that writing the model overlaps deriving it, even for a single
@@ -111,9 +188,15 @@ impl Rules {
         // leaves are encoded in the same batches (`Batcher`), so the model
         // is written out at the same points and the file is the same.
         // Plain meshes are made on the workers, per lot.
-        let encoder = writer.as_ref().and_then(|w| w.encoder());
+        let (encoder, origins) = match &out {
+            Out::None => (None, Vec::new()),
+            Out::One(w) => (w.encoder(), Vec::new()),
+            Out::PerLot(w) => (w.encoder(), (0..count).map(|i| w.origin(i)).collect()),
+        };
+        // Each lot's origin, when lots have origins of their own.
+        let origin = |i: usize| origins.get(i).copied();
         let workers_encode = jobs > 1;
-        let has_writer = writer.is_some();
+        let has_writer = !matches!(out, Out::None);
         let new_batcher = || match &encoder {
             Some(e) if workers_encode => Batcher::Encode(Box::new(e.another()), 0),
             _ if has_writer => Batcher::Leaves(Vec::new()),
@@ -125,28 +208,29 @@ impl Rules {
             _ => None,
         };
         let mut summary = Summary {
-            lots: lots.len(),
+            lots: count,
             ..Summary::default()
         };
         // The lot whose output was begun last (a node or group per lot).
         let mut begun: Option<usize> = None;
-        if let Some(w) = writer.as_deref_mut() {
-            w.expect_lots(lots.len());
+        if let Out::One(w) = &mut out {
+            w.expect_lots(count);
         }
         let mut take = |i: usize, taken: Taken<Piece, Done>| -> Result<(), Error> {
             if begun != Some(i) {
                 begun = Some(i);
-                if let Some(w) = writer.as_deref_mut() {
+                if let (Some(o), Some(own)) = (origin(i), &mut own_batcher) {
+                    own.set_origin(o);
+                }
+                if let Some(w) = out.writer(i)? {
                     w.begin_lot(
-                        &lots[i].name,
-                        Some(crate::metadata::lot_metadata(
-                            options.lot_index(i),
-                            &lots[i],
-                        )),
+                        &lot(i).name,
+                        Some(crate::metadata::lot_metadata(lot_index(i), lot(i))),
                     )
                     .map_err(Error::Export)?;
                 }
             }
+            let mut writer = out.writer(i)?;
             let mut result = Ok(());
             let mut write = |piece| {
                 if let (Some(w), Ok(())) = (writer.as_deref_mut(), &result) {
@@ -179,28 +263,31 @@ impl Rules {
             {
                 return Err(Error::Cancelled);
             }
-            let mut lot = self.lot_result(options.lot_index(i), &lots[i], done);
-            if let (Some(w), false) = (writer.as_deref_mut(), lot.reports.is_empty()) {
-                w.annotate_lot("reports", crate::metadata::reports_metadata(&lot.reports));
+            let mut warnings = self.annotation_warnings(options, lot(i));
+            let mut made = self.lot_result(lot_index(i), lot(i), done);
+            if let (Some(w), false) = (writer, made.reports.is_empty()) {
+                w.annotate_lot("reports", crate::metadata::reports_metadata(&made.reports));
             }
-            let mut warnings = self.annotation_warnings(options, &lots[i]);
-            warnings.append(&mut lot.warnings);
-            lot.warnings = warnings;
-            summary.failed += lot.error.is_some() as usize;
-            summary.shapes += lot.shapes;
-            summary.leaves += lot.leaf_count;
-            each(lot);
+            warnings.append(&mut made.warnings);
+            made.warnings = warnings;
+            summary.failed += made.error.is_some() as usize;
+            summary.shapes += made.shapes;
+            summary.leaves += made.leaf_count;
+            each(made);
             Ok(())
         };
         let generate_one = |batcher: &mut Batcher, i: usize, send: &mut dyn FnMut(Piece)| {
+            if let Some(o) = origin(i) {
+                batcher.set_origin(o);
+            }
             let mut leaves = 0usize;
             let mut origins = Vec::new();
             let (out, error) = generate_lot_streaming(
                 program,
                 assets,
                 rule.0,
-                &lots[i],
-                options.lot_index(i),
+                lot(i),
+                lot_index(i),
                 &engine_options,
                 |leaf| {
                     leaves += 1;
@@ -218,14 +305,14 @@ impl Rules {
                 origins,
             }
         };
-        if lots.len() == 1 && !has_writer {
+        if count == 1 && !has_writer {
             // One lot and nothing to overlap with: derived here (on a stack
             // with room), without worker threads.
             let mut batcher = new_batcher();
             let done = on_big_stack(|| generate_one(&mut batcher, 0, &mut |_| {}));
             take(0, Taken::Done(done))?;
         } else {
-            run_pipeline(lots.len(), jobs, new_batcher, generate_one, &mut take)?;
+            run_pipeline(count, jobs, new_batcher, generate_one, &mut take)?;
         }
         summary.derived_after = started.elapsed().as_secs_f64();
         Ok(summary)
@@ -500,6 +587,14 @@ enum Batcher {
 }
 
 impl Batcher {
+    /// Writes the positions of the leaves added from now on relative to
+    /// `origin` (encoding only).
+    fn set_origin(&mut self, origin: Option<DVec3>) {
+        if let Batcher::Encode(encoder, _) = self {
+            encoder.set_origin(origin);
+        }
+    }
+
     fn add(&mut self, leaf: Leaf, send: &mut dyn FnMut(Piece)) {
         match self {
             Batcher::Drop => {}

@@ -46,13 +46,14 @@ mod values;
 
 pub use attributes::{Annotation, Attribute, Range};
 pub use cga_engine::Workspaces;
+pub use cga_export::Encoder;
 pub use cga_export::{ExportOptions, ExportStats, Format, Georeference, Granularity, ModelWriter};
 pub use cga_geometry::DVec3;
 pub use cga_value::{Array, Value, ValueType};
 pub use cga_world::{decode_text, ConfinedWorld, DiskWorld, MemoryWorld, Metadata, World};
 pub use diagnostics::{Diagnostic, Location, Severity};
 pub use error::{Error, ExportError};
-pub use generate::{Scene, Target};
+pub use generate::{LotWriters, Scene, Target};
 pub use lots::{Axes, CrsOption, GeoOrigin, InvalidPolicy, Lot, LotOptions, LotSet};
 pub use model::{
     write_plain, LeafOrigin, LotResult, Material, PlainMesh, PlainModel, Provenance, Summary,

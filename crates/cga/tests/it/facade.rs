@@ -533,3 +533,104 @@ fn parts_with_their_lot_indices_make_the_same_city() {
         .collect();
     assert_ne!(alone, whole[2..]);
 }
+
+#[test]
+fn lots_in_a_given_order_keep_their_indices() {
+    let rules = memory_rules("Lot --> print(scope.sx) extrude(1) X.\n");
+    let lots: Vec<_> = (1..=12).map(|i| cga::lots::rect(i as f64, 2.0)).collect();
+    let order = [5, 0, 11, 3];
+    for jobs in [1, 2] {
+        let mut seen = Vec::new();
+        let summary = rules
+            .generate_lots_in_order(
+                &lots,
+                &order,
+                &Options::default().jobs(jobs),
+                Target::Meshes,
+                |r| seen.push((r.index, r.prints.clone())),
+            )
+            .unwrap();
+        assert_eq!(summary.lots, 4);
+        let want: Vec<_> = order
+            .iter()
+            .map(|&i| (i, vec![(i + 1).to_string()]))
+            .collect();
+        assert_eq!(seen, want, "{jobs} jobs");
+    }
+    let bad = rules.generate_lots_in_order(
+        &lots,
+        &[2, 12],
+        &Options::default(),
+        Target::Nothing,
+        |_| {},
+    );
+    assert!(matches!(bad, Err(Error::Value(_))), "{bad:?}");
+}
+
+/// Lots of even index into one model, of odd index into another, each
+/// written relative to an origin of its own.
+struct EvenAndOdd {
+    writers: [cga::ModelWriter; 2],
+    origins: [cga::DVec3; 2],
+}
+
+impl cga::LotWriters for EvenAndOdd {
+    fn encoder(&self) -> Option<cga::Encoder> {
+        Some(cga::Encoder::for_export(&cga::ExportOptions::default()))
+    }
+
+    fn origin(&self, i: usize) -> Option<cga::DVec3> {
+        Some(self.origins[i % 2])
+    }
+
+    fn writer(&mut self, i: usize) -> Result<&mut cga::ModelWriter, Error> {
+        Ok(&mut self.writers[i % 2])
+    }
+}
+
+#[test]
+fn lots_go_to_the_writer_the_target_names() {
+    let rules = memory_rules("Lot --> extrude(3) X.\n");
+    // Unit squares 100 m apart along x.
+    let lots: Vec<_> = (0..6)
+        .map(|i| {
+            let mut lot = cga::lots::rect(1.0, 1.0);
+            for p in &mut lot.mesh.positions {
+                p.x += 100.0 * i as f64;
+            }
+            lot
+        })
+        .collect();
+    let origins = [
+        cga::DVec3::new(1000.0, 0.0, 0.0),
+        cga::DVec3::new(-7.0, 0.0, 5.0),
+    ];
+    for jobs in [1, 2] {
+        let writer = |o: cga::DVec3| {
+            cga::ModelWriter::glb_in_memory(cga::ExportOptions {
+                origin: Some(o),
+                ..cga::ExportOptions::default()
+            })
+            .unwrap()
+        };
+        let mut out = EvenAndOdd {
+            writers: origins.map(writer),
+            origins,
+        };
+        rules
+            .generate_lots(
+                &lots,
+                &Options::default().jobs(jobs),
+                Target::PerLot(&mut out),
+                |_| {},
+            )
+            .unwrap();
+        let [even, odd] = out.writers.map(|w| w.finish_bytes().unwrap().1);
+        // Three boxes each; the bounds are in world coordinates again.
+        assert_eq!((even.triangles, odd.triangles), (36, 36), "{jobs} jobs");
+        let [lo, hi] = even.bounds.unwrap();
+        assert_eq!((lo[0], hi[0], hi[1]), (0.0, 401.0, 3.0), "{jobs} jobs");
+        let [lo, hi] = odd.bounds.unwrap();
+        assert_eq!((lo[0], hi[0]), (100.0, 501.0), "{jobs} jobs");
+    }
+}

@@ -568,7 +568,11 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
         if let Some(r) = &mut reports {
             r.add_lot(lot.index, &lot.name, &lot.reports);
         }
-        progress.inc(1);
+        // A tileset counts lots as they are generated, not as they are
+        // handed over in lot order.
+        if tileset.is_none() {
+            progress.inc(1);
+        }
     };
     let mut tiles_written = None;
     let summary = match tileset {
@@ -584,7 +588,10 @@ fn generate(args: GenerateArgs) -> Result<(), Failure> {
                 max_triangles_per_tile: args.tile_triangles.max(1),
                 ..Default::default()
             };
-            let stats = cga_tiles::write_tileset(&rules, &lots.lots, &options, &tiles, path, each)?;
+            let generated = |n: usize| progress.set_position(n as u64);
+            let stats = cga_tiles::write_tileset(
+                &rules, &lots.lots, &options, &tiles, path, each, generated,
+            )?;
             let summary = stats.summary.clone();
             tiles_written = Some(stats);
             summary

@@ -11,7 +11,12 @@ use std::time::Instant;
 
 use cga::{Engine, Options, Target};
 
+// The allocator of the `cga` command and the Python module.
+#[global_allocator]
+static ALLOCATOR: cga_alloc::Allocator = cga_alloc::Allocator;
+
 fn main() {
+    cga_alloc::keep_freed_memory(None);
     let args: Vec<String> = std::env::args().skip(1).collect();
     let [rules, lots, rest @ ..] = &args[..] else {
         eprintln!("usage: meshes_bench RULES.cga LOTSPEC [RUNS]");

@@ -30,7 +30,7 @@ pub enum Target<'w> {
     /// Into models that follow one another, each lot wholly into one (the
     /// tiles of a tileset), streamed like [`Target::Writer`]: one run of
     /// the workers over all of them.
-    PerLot(&'w mut dyn LotWriters),
+    PerLot(&'w mut (dyn LotWriters + Send)),
 }
 
 /// The models of [`Target::PerLot`]: which lot goes where, and from which
@@ -53,7 +53,7 @@ pub trait LotWriters {
 enum Out<'w> {
     None,
     One(&'w mut ModelWriter),
-    PerLot(&'w mut dyn LotWriters),
+    PerLot(&'w mut (dyn LotWriters + Send)),
 }
 
 impl Out<'_> {

@@ -634,3 +634,17 @@ fn lots_go_to_the_writer_the_target_names() {
         assert_eq!((lo[0], hi[0]), (100.0, 501.0), "{jobs} jobs");
     }
 }
+
+/// Hosts generate off their own thread (the Python module releases the
+/// interpreter's lock around a call): a target must travel with it.
+#[test]
+fn targets_can_be_sent_to_another_thread() {
+    fn send<T: Send>(_: &T) {}
+    let mut writers = EvenAndOdd {
+        writers: [(); 2]
+            .map(|_| cga::ModelWriter::glb_in_memory(cga::ExportOptions::default()).unwrap()),
+        origins: [cga::DVec3::ZERO; 2],
+    };
+    send(&Target::PerLot(&mut writers));
+    send(&Target::Meshes);
+}

@@ -257,7 +257,9 @@ impl Encoder {
         }
     }
 
-    /// A new encoder for the same writer (for another thread).
+    /// A new encoder for the same writer or export options (for another
+    /// thread), with their origin (not one given by
+    /// [`set_origin`](Encoder::set_origin)).
     pub fn another(&self) -> Encoder {
         Encoder::new(self.shared.clone())
     }

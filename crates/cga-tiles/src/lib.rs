@@ -10,9 +10,12 @@
 //! [`TilesetOptions::max_massing_lots`] have no content of their own.
 //! All lots are generated in one run of the workers, leaf after leaf
 //! ([`Target::PerLot`]): the workers derive the next lots while a leaf's
-//! GLB is finished and written, and memory holds the open tile and a few
-//! lots per worker. Tiles written are dropped from the page cache once on
-//! disk (module `evict`).
+//! GLB is finished and written, and the geometry in memory is the open
+//! tile's and a few lots per worker's. What is kept of every lot is small:
+//! its box and metadata row (for the parents' massing), and its result
+//! until the results before it in lot order are handed over (for a city
+//! whose lot order runs across the tiles, most of them). Tiles written are
+//! dropped from the page cache once on disk (module `evict`).
 //!
 //! Coordinates: the model's frame is y up, x east and -z north (metres);
 //! glTF tile contents stay so, and the tileset's bounding boxes are in
@@ -47,9 +50,12 @@ pub struct TilesetOptions {
     /// Lots in a leaf tile at most (more only where lots share a centre).
     pub max_lots_per_tile: usize,
     /// Triangles in a tile's content: a leaf whose lots make more is
-    /// written as several contents, each a child tile of at most this many
-    /// triangles (more only where one lot makes more by itself), its lots
-    /// close together.
+    /// written as several contents, each a child tile of about this many
+    /// triangles at most, its lots close together. A content is closed
+    /// before a lot when the room left is less than the triangles per lot
+    /// so far, so its last lot can take it over by as much as that lot is
+    /// larger than the average (a lot larger than the bound is a content of
+    /// its own).
     pub max_triangles_per_tile: u64,
     /// A parent tile holds the massing of its lots up to this many lots;
     /// larger tiles only bound their children.
@@ -58,7 +64,8 @@ pub struct TilesetOptions {
     /// always GLB, merged by material, with per-lot features.
     pub export: ExportOptions,
     /// Each tile's positions are written relative to the centre of its
-    /// lots (whole metres), the node of its GLB translated there, so that
+    /// leaf's lots (whole metres; the contents of a leaf split by the
+    /// triangle bound share it), the node of its GLB translated there, so that
     /// 32-bit floats keep their millimetres wherever the city lies (a
     /// national grid's millions of metres); `export.origin` is not used.
     pub tile_origins: bool,
@@ -146,8 +153,9 @@ pub fn write_tileset(
         &order,
         options,
         Target::PerLot(&mut contents),
+        // Results come in the order generated.
         |r| {
-            results.add(r, lots);
+            results.add(order[done], r, lots);
             done += 1;
             progress(done);
         },
@@ -397,7 +405,6 @@ impl LotWriters for Contents<'_> {
 
     fn writer(&mut self, i: usize) -> Result<&mut ModelWriter, Error> {
         if self.current != Some(i) {
-            self.current = Some(i);
             let leaf = self.leaf_of[i];
             let done = match &self.open {
                 Some(open) => open.leaf != leaf || self.full(open),
@@ -412,6 +419,9 @@ impl LotWriters for Contents<'_> {
             if let Some(open) = &mut self.open {
                 open.lots.push(i);
             }
+            // Only once its content is open: after a failure the lot is
+            // asked for again from the start.
+            self.current = Some(i);
         }
         match &mut self.open {
             Some(open) => Ok(&mut open.writer),
@@ -423,7 +433,8 @@ impl LotWriters for Contents<'_> {
 /// The lots' results, handed over in lot order, and each lot's row of the
 /// parents' property tables.
 struct Results<F: FnMut(LotResult)> {
-    /// Results of lots after the next one to hand over.
+    /// Results of lots after the next one to hand over, by position in
+    /// the lots.
     pending: BTreeMap<usize, LotResult>,
     next: usize,
     each: F,
@@ -432,13 +443,16 @@ struct Results<F: FnMut(LotResult)> {
 }
 
 impl<F: FnMut(LotResult)> Results<F> {
-    fn add(&mut self, r: LotResult, lots: &[Lot]) {
-        let mut m = cga::metadata::lot_metadata(r.index, &lots[r.index]);
+    /// The result of `lots[position]` (whose `index` is its index in the
+    /// whole run: the position, unless `Options::lot_indices` says
+    /// otherwise).
+    fn add(&mut self, position: usize, r: LotResult, lots: &[Lot]) {
+        let mut m = cga::metadata::lot_metadata(r.index, &lots[position]);
         if !r.reports.is_empty() {
             m["reports"] = cga::metadata::reports_metadata(&r.reports);
         }
-        self.metadata[r.index] = Some(m);
-        self.pending.insert(r.index, r);
+        self.metadata[position] = Some(m);
+        self.pending.insert(position, r);
         while let Some(r) = self.pending.remove(&self.next) {
             (self.each)(r);
             self.next += 1;
@@ -690,6 +704,47 @@ mod tests {
         assert!(stats.leaves >= 10, "{} leaves", stats.leaves);
         let written = std::fs::read_dir(dir.join("tiles")).unwrap().count();
         assert_eq!(written, stats.contents);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A tileset of part of a larger run: its lots' indices are those of
+    /// the run, in the results and in the tiles' property tables.
+    #[test]
+    fn lots_keep_the_indices_of_their_run() {
+        let rules = cga::Engine::new(cga::MemoryWorld::new())
+            .load_text("/p/rules/r.cga", "Lot --> extrude(2) X.\n");
+        let lots: Vec<Lot> = (0..12)
+            .map(|i| {
+                let mut lot = cga::lots::rect(4.0, 4.0);
+                for p in &mut lot.mesh.positions {
+                    p.x += 10.0 * (i % 4) as f64;
+                    p.z -= 10.0 * (i / 4) as f64;
+                }
+                lot
+            })
+            .collect();
+        let dir = std::env::temp_dir().join(format!("cga-tiles-part-{}", std::process::id()));
+        let tiles = TilesetOptions {
+            max_lots_per_tile: 2,
+            ..TilesetOptions::default()
+        };
+        let options = Options {
+            lot_indices: Some((100..112).collect::<Vec<usize>>().into()),
+            ..Options::default()
+        };
+        let mut indices = Vec::new();
+        let stats = write_tileset(
+            &rules,
+            &lots,
+            &options,
+            &tiles,
+            &dir.join("tileset.json"),
+            |r| indices.push(r.index),
+            |_| {},
+        )
+        .unwrap();
+        assert_eq!(indices, (100..112).collect::<Vec<_>>());
+        assert_eq!(stats.triangles, 12 * 12);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -103,8 +103,8 @@ impl Rules {
         self.generate_list(lots, None, options, target, each)
     }
 
-    /// [`generate_lots`](Rules::generate_lots) of the lots `order` names,
-    /// in that order: `lots[order[0]]` first. Results carry the lots'
+    /// [`generate_lots`](Rules::generate_lots) of the lots `order` names
+    /// (each at most once), in that order: `lots[order[0]]` first. Results carry the lots'
     /// indices in `lots` (or what [`Options::lot_indices`] says of them),
     /// and context queries between lots see all of `lots`.
     pub fn generate_lots_in_order(
@@ -115,11 +115,14 @@ impl Rules {
         target: Target<'_>,
         each: impl FnMut(LotResult),
     ) -> Result<Summary, Error> {
-        if let Some(&i) = order.iter().find(|&&i| i >= lots.len()) {
-            return Err(Error::Value(format!(
-                "lot {i} in the order of {} lots",
-                lots.len()
-            )));
+        let mut seen = vec![false; lots.len()];
+        for &i in order {
+            if i >= lots.len() || std::mem::replace(&mut seen[i], true) {
+                return Err(Error::Value(format!(
+                    "lot {i} named twice or out of range in the order of {} lots",
+                    lots.len()
+                )));
+            }
         }
         self.generate_list(lots, Some(order), options, target, each)
     }
@@ -159,13 +162,15 @@ impl Rules {
         engine_options.context_use = Some(usage);
         if let (true, Some(scene)) = (usage.inter, &options.scene) {
             engine_options.scene = Some(scene.0.clone());
-        } else if usage.inter && count > 1 {
+        } else if usage.inter && lots.len() > 1 {
+            // The first pass goes over all of `lots`, also those the order
+            // leaves out.
             engine_options.scene = Some(Arc::new(self.collect_scene(
                 rule,
                 lots,
                 options,
                 &engine_options,
-                jobs,
+                options.threads().min(lots.len()),
             )?));
         }
         let cancelled = || options.cancel.as_ref().is_some_and(|c| c.is_cancelled());

@@ -557,14 +557,39 @@ fn lots_in_a_given_order_keep_their_indices() {
             .collect();
         assert_eq!(seen, want, "{jobs} jobs");
     }
-    let bad = rules.generate_lots_in_order(
-        &lots,
-        &[2, 12],
-        &Options::default(),
-        Target::Nothing,
-        |_| {},
-    );
-    assert!(matches!(bad, Err(Error::Value(_))), "{bad:?}");
+    for order in [&[2, 12][..], &[2, 5, 2]] {
+        let bad = rules.generate_lots_in_order(
+            &lots,
+            order,
+            &Options::default(),
+            Target::Nothing,
+            |_| {},
+        );
+        assert!(matches!(bad, Err(Error::Value(_))), "{order:?}: {bad:?}");
+    }
+}
+
+#[test]
+fn one_lot_in_order_sees_every_lot_of_the_call() {
+    let rules =
+        memory_rules("Lot --> label(\"lot\") print(contextCount(inter, \"lot\")) extrude(1) X.\n");
+    let lots: Vec<_> = (0..4)
+        .map(|i| {
+            let mut lot = cga::lots::rect(4.0, 4.0);
+            for p in &mut lot.mesh.positions {
+                p.x += 10.0 * i as f64;
+            }
+            lot
+        })
+        .collect();
+    let mut prints = Vec::new();
+    rules
+        .generate_lots_in_order(&lots, &[2], &Options::default(), Target::Nothing, |r| {
+            prints.extend(r.prints)
+        })
+        .unwrap();
+    // The three other lots of the call, though only one is generated.
+    assert_eq!(prints, ["3"]);
 }
 
 /// Lots of even index into one model, of odd index into another, each

@@ -654,21 +654,31 @@ pub fn georeference(origin: Option<cga::GeoOrigin>) -> Option<Georeference> {
 mod tests {
     use super::*;
 
-    #[test]
-    fn lots_are_counted_as_generated_and_handed_over_in_lot_order() {
-        let rules = cga::Engine::new(cga::MemoryWorld::new())
-            .load_text("/p/rules/r.cga", "Lot --> extrude(2) X.\n");
-        // 8 x 5 lots of 4 x 4 m, 10 m apart: leaves of at most 4 lots.
-        let lots: Vec<Lot> = (0..40)
+    /// Rules that make a box of 12 triangles per lot.
+    fn box_rules() -> Rules {
+        cga::Engine::new(cga::MemoryWorld::new())
+            .load_text("/p/rules/r.cga", "Lot --> extrude(2) X.\n")
+    }
+
+    /// `count` lots of 4 x 4 m, 10 m apart, in rows of `columns`.
+    fn lots_in_rows(count: usize, columns: usize) -> Vec<Lot> {
+        (0..count)
             .map(|i| {
                 let mut lot = cga::lots::rect(4.0, 4.0);
                 for p in &mut lot.mesh.positions {
-                    p.x += 10.0 * (i % 8) as f64;
-                    p.z -= 10.0 * (i / 8) as f64;
+                    p.x += 10.0 * (i % columns) as f64;
+                    p.z -= 10.0 * (i / columns) as f64;
                 }
                 lot
             })
-            .collect();
+            .collect()
+    }
+
+    #[test]
+    fn lots_are_counted_as_generated_and_handed_over_in_lot_order() {
+        let rules = box_rules();
+        // 8 x 5 lots, leaves of at most 4 lots.
+        let lots = lots_in_rows(40, 8);
         let dir = std::env::temp_dir().join(format!("cga-tiles-order-{}", std::process::id()));
         let tiles = TilesetOptions {
             max_lots_per_tile: 4,
@@ -707,22 +717,12 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
-    /// A tileset of part of a larger run: its lots' indices are those of
-    /// the run, in the results and in the tiles' property tables.
+    /// A tileset of part of a larger run: its lots' results carry the
+    /// run's indices, in lot order.
     #[test]
     fn lots_keep_the_indices_of_their_run() {
-        let rules = cga::Engine::new(cga::MemoryWorld::new())
-            .load_text("/p/rules/r.cga", "Lot --> extrude(2) X.\n");
-        let lots: Vec<Lot> = (0..12)
-            .map(|i| {
-                let mut lot = cga::lots::rect(4.0, 4.0);
-                for p in &mut lot.mesh.positions {
-                    p.x += 10.0 * (i % 4) as f64;
-                    p.z -= 10.0 * (i / 4) as f64;
-                }
-                lot
-            })
-            .collect();
+        let rules = box_rules();
+        let lots = lots_in_rows(12, 4);
         let dir = std::env::temp_dir().join(format!("cga-tiles-part-{}", std::process::id()));
         let tiles = TilesetOptions {
             max_lots_per_tile: 2,

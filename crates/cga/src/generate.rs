@@ -104,9 +104,9 @@ impl Rules {
     }
 
     /// [`generate_lots`](Rules::generate_lots) of the lots `order` names
-    /// (each at most once), in that order: `lots[order[0]]` first. Results carry the lots'
-    /// indices in `lots` (or what [`Options::lot_indices`] says of them),
-    /// and context queries between lots see all of `lots`.
+    /// (each at most once), in that order: `lots[order[0]]` first. Results
+    /// carry the lots' indices in `lots` (or what [`Options::lot_indices`]
+    /// says of them), and context queries between lots see all of `lots`.
     pub fn generate_lots_in_order(
         &self,
         lots: &[Lot],
@@ -222,12 +222,13 @@ impl Rules {
             w.expect_lots(count);
         }
         let mut take = |i: usize, taken: Taken<Piece, Done>| -> Result<(), Error> {
+            let mut writer = out.writer(i)?;
             if begun != Some(i) {
                 begun = Some(i);
                 if let (Some(o), Some(own)) = (origin(i), &mut own_batcher) {
                     own.set_origin(o);
                 }
-                if let Some(w) = out.writer(i)? {
+                if let Some(w) = writer.as_deref_mut() {
                     w.begin_lot(
                         &lot(i).name,
                         Some(crate::metadata::lot_metadata(lot_index(i), lot(i))),
@@ -235,7 +236,6 @@ impl Rules {
                     .map_err(Error::Export)?;
                 }
             }
-            let mut writer = out.writer(i)?;
             let mut result = Ok(());
             let mut write = |piece| {
                 if let (Some(w), Ok(())) = (writer.as_deref_mut(), &result) {

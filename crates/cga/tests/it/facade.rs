@@ -569,19 +569,24 @@ fn lots_in_a_given_order_keep_their_indices() {
     }
 }
 
+/// `count` squares of side `side`, the `i`-th moved `i * step` along x.
+fn squares_along_x(count: usize, side: f64, step: f64) -> Vec<cga::Lot> {
+    (0..count)
+        .map(|i| {
+            let mut lot = cga::lots::rect(side, side);
+            for p in &mut lot.mesh.positions {
+                p.x += step * i as f64;
+            }
+            lot
+        })
+        .collect()
+}
+
 #[test]
 fn one_lot_in_order_sees_every_lot_of_the_call() {
     let rules =
         memory_rules("Lot --> label(\"lot\") print(contextCount(inter, \"lot\")) extrude(1) X.\n");
-    let lots: Vec<_> = (0..4)
-        .map(|i| {
-            let mut lot = cga::lots::rect(4.0, 4.0);
-            for p in &mut lot.mesh.positions {
-                p.x += 10.0 * i as f64;
-            }
-            lot
-        })
-        .collect();
+    let lots = squares_along_x(4, 4.0, 10.0);
     let mut prints = Vec::new();
     rules
         .generate_lots_in_order(&lots, &[2], &Options::default(), Target::Nothing, |r| {
@@ -617,15 +622,7 @@ impl cga::LotWriters for EvenAndOdd {
 fn lots_go_to_the_writer_the_target_names() {
     let rules = memory_rules("Lot --> extrude(3) X.\n");
     // Unit squares 100 m apart along x.
-    let lots: Vec<_> = (0..6)
-        .map(|i| {
-            let mut lot = cga::lots::rect(1.0, 1.0);
-            for p in &mut lot.mesh.positions {
-                p.x += 100.0 * i as f64;
-            }
-            lot
-        })
-        .collect();
+    let lots = squares_along_x(6, 1.0, 100.0);
     let origins = [
         cga::DVec3::new(1000.0, 0.0, 0.0),
         cga::DVec3::new(-7.0, 0.0, 5.0),

@@ -205,7 +205,10 @@ impl Rules {
         let new_batcher = || match &encoder {
             Some(e) if workers_encode => Batcher::Encode(Box::new(e.another()), 0),
             _ if has_writer => Batcher::Leaves(Vec::new()),
-            _ if keep_meshes => Batcher::Plain(Box::default(), 0),
+            _ if keep_meshes => {
+                let room = self.mesh_room().clone();
+                Batcher::Plain(Box::new(PlainCollector::with_room(room)), 0)
+            }
             _ => Batcher::Drop,
         };
         let mut own_batcher = match &encoder {
@@ -302,6 +305,13 @@ impl Rules {
             );
             batcher.flush(send);
             let model = batcher.take_model();
+            if let Batcher::Plain(collector, _) = batcher {
+                let mut room = self.mesh_room();
+                if room.as_slice() != collector.room() {
+                    room.clear();
+                    room.extend_from_slice(collector.room());
+                }
+            }
             Done {
                 out,
                 error,
@@ -331,6 +341,14 @@ impl Rules {
     }
 
     /// The engine's options for `options`: attribute names resolved.
+    /// The room plain meshes of the last lot took (see `Inner::mesh_room`).
+    fn mesh_room(&self) -> std::sync::MutexGuard<'_, Vec<(usize, usize)>> {
+        self.inner
+            .mesh_room
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+    }
+
     fn engine_options(&self, options: &Options) -> Result<GenerateOptions, Error> {
         let program = &self.inner.program;
         let mut out = GenerateOptions {
@@ -678,5 +696,43 @@ impl Batcher {
             }
             _ => cga_export::PlainModel::default(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::{lots, Engine, MemoryWorld, Options};
+
+    /// The rules keep the room of the last lot collected as plain meshes,
+    /// for the next call's collectors; generating without meshes keeps it.
+    #[test]
+    fn rules_keep_the_room_of_the_last_lot_collected() {
+        let rules = Engine::new(MemoryWorld::new()).load_text(
+            "/p/rules/r.cga",
+            "Lot --> extrude(10) comp(f) { side : split(x) { ~2 : color(\"#a04020\") W. }* | all : X. }\n",
+        );
+        let room = || rules.mesh_room().clone();
+        assert!(room().is_empty());
+        let big = rules.generate_all(&[lots::rect(40.0, 40.0)], &Options::default());
+        let sizes: Vec<(usize, usize)> = big.unwrap()[0]
+            .model
+            .meshes
+            .iter()
+            .map(|m| (m.positions.len(), m.indices.len()))
+            .collect();
+        assert_eq!(sizes.iter().map(|s| s.1).sum::<usize>(), 2 * (4 * 20 + 2));
+        assert_eq!(room(), sizes);
+        let small = lots::rect(4.0, 4.0);
+        rules
+            .generate_lots(
+                &[small.clone()],
+                &Options::default(),
+                crate::Target::Nothing,
+                |_| {},
+            )
+            .unwrap();
+        assert_eq!(room(), sizes);
+        rules.generate_all(&[small], &Options::default()).unwrap();
+        assert_eq!(room().iter().map(|s| s.1).sum::<usize>(), 2 * (4 * 2 + 2));
     }
 }

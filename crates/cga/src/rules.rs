@@ -189,6 +189,7 @@ impl Engine {
                 assets,
                 context_use,
                 engine: self.clone(),
+                mesh_room: Default::default(),
             }),
         };
         let attributes = rules.read_attributes();
@@ -216,6 +217,12 @@ pub(crate) struct Inner {
     pub assets: Assets,
     pub context_use: ContextUse,
     pub engine: Engine,
+    /// The room each material's mesh of the last lot collected as plain
+    /// meshes took, which the next generation's collectors start with
+    /// (`cga_export::PlainCollector::with_room`): a host calls again and
+    /// again with lots much alike (the preview on every edit, Python per
+    /// batch).
+    pub mesh_room: std::sync::Mutex<Vec<(usize, usize)>>,
 }
 
 /// A rule of the rule files, as a library user names it.

@@ -670,3 +670,43 @@ fn targets_can_be_sent_to_another_thread() {
     send(&Target::PerLot(&mut writers));
     send(&Target::Meshes);
 }
+
+/// Plain meshes start with the room the last call's lots took; what a lot
+/// collects does not depend on the calls before (a small lot after large
+/// ones, a large one after small ones, one and many jobs).
+#[test]
+fn meshes_do_not_depend_on_earlier_calls() {
+    const RULES: &str =
+        "Lot --> extrude(10) comp(f) { side : split(x) { ~2 : Tile }* | all : color(\"#808080\") X. }\n\
+         Tile --> split(y) { ~3 : color(\"#a04020\") Floor. }*\n";
+    let rules = memory_rules(RULES);
+    let big = squares_along_x(3, 100.0, 110.0);
+    let small = squares_along_x(1, 4.0, 0.0);
+    let fresh = |lots: &[cga::Lot]| {
+        memory_rules(RULES)
+            .generate_all(lots, &Options::default())
+            .unwrap()
+    };
+    let models = |r: Vec<cga::LotResult>| r.into_iter().map(|r| r.model).collect::<Vec<_>>();
+    let small_alone = models(fresh(&small));
+    let big_alone = models(fresh(&big));
+    assert_eq!(big_alone[0].triangles(), 1204);
+    assert_eq!(small_alone[0].triangles(), 52);
+    for jobs in [1, 2] {
+        let options = Options::default().jobs(jobs);
+        let first = models(rules.generate_all(&big, &options).unwrap());
+        assert_eq!(first, big_alone);
+        let after_big = models(rules.generate_all(&small, &options).unwrap());
+        assert_eq!(after_big, small_alone);
+        // It started with the room a large lot took, and holds what it
+        // uses.
+        for mesh in &after_big[0].meshes {
+            assert_eq!(mesh.positions.capacity(), mesh.positions.len());
+            assert_eq!(mesh.indices.capacity(), mesh.indices.len());
+        }
+        assert_eq!(
+            models(rules.generate_all(&big, &options).unwrap()),
+            big_alone
+        );
+    }
+}

@@ -725,7 +725,7 @@ mod tests {
         let small = lots::rect(4.0, 4.0);
         rules
             .generate_lots(
-                &[small.clone()],
+                std::slice::from_ref(&small),
                 &Options::default(),
                 crate::Target::Nothing,
                 |_| {},

@@ -205,10 +205,7 @@ impl Rules {
         let new_batcher = || match &encoder {
             Some(e) if workers_encode => Batcher::Encode(Box::new(e.another()), 0),
             _ if has_writer => Batcher::Leaves(Vec::new()),
-            _ if keep_meshes => {
-                let room = self.mesh_room().clone();
-                Batcher::Plain(Box::new(PlainCollector::with_room(room)), 0)
-            }
+            _ if keep_meshes => Batcher::Plain(Box::new(self.plain_collector()), 0),
             _ => Batcher::Drop,
         };
         let mut own_batcher = match &encoder {
@@ -340,7 +337,6 @@ impl Rules {
         self.engine_options(options).map(|_| ())
     }
 
-    /// The engine's options for `options`: attribute names resolved.
     /// The room plain meshes of the last lot took (see `Inner::mesh_room`).
     fn mesh_room(&self) -> std::sync::MutexGuard<'_, Vec<(usize, usize)>> {
         self.inner
@@ -349,6 +345,20 @@ impl Rules {
             .unwrap_or_else(|e| e.into_inner())
     }
 
+    /// A collector of plain meshes for a worker, starting with the room the
+    /// rules' last lot took, at most [`KEPT_ROOM`] vertices and triangles a
+    /// material (one huge lot does not make every later lot reserve its
+    /// size).
+    fn plain_collector(&self) -> PlainCollector {
+        let room = self
+            .mesh_room()
+            .iter()
+            .map(|&(v, t)| (v.min(KEPT_ROOM), t.min(KEPT_ROOM)))
+            .collect();
+        PlainCollector::with_room(room)
+    }
+
+    /// The engine's options for `options`: attribute names resolved.
     fn engine_options(&self, options: &Options) -> Result<GenerateOptions, Error> {
         let program = &self.inner.program;
         let mut out = GenerateOptions {
@@ -590,6 +600,11 @@ enum Piece {
     Encoded(cga_export::Encoded),
 }
 
+/// Vertices or triangles of a material's plain mesh that a new collector
+/// reserves at most from the rules' last lot (a quarter of a million
+/// vertices are 16 MB of arrays; Candler's largest mesh has 116,000).
+const KEPT_ROOM: usize = 1 << 18;
+
 /// Leaves per piece at most: a message per leaf would wake the calling
 /// thread for each (a system call apiece).
 const LEAF_BATCH: usize = 512;
@@ -722,6 +737,8 @@ mod tests {
             .collect();
         assert_eq!(sizes.iter().map(|s| s.1).sum::<usize>(), 2 * (4 * 20 + 2));
         assert_eq!(room(), sizes);
+        // The next call's collectors start with it.
+        assert_eq!(rules.plain_collector().room(), sizes.as_slice());
         let small = lots::rect(4.0, 4.0);
         rules
             .generate_lots(
@@ -732,7 +749,18 @@ mod tests {
             )
             .unwrap();
         assert_eq!(room(), sizes);
-        rules.generate_all(&[small], &Options::default()).unwrap();
-        assert_eq!(room().iter().map(|s| s.1).sum::<usize>(), 2 * (4 * 2 + 2));
+        let small = rules.generate_all(&[small], &Options::default()).unwrap();
+        let sizes: Vec<(usize, usize)> = small[0]
+            .model
+            .meshes
+            .iter()
+            .map(|m| (m.positions.len(), m.indices.len()))
+            .collect();
+        assert_eq!(sizes.iter().map(|s| s.1).sum::<usize>(), 2 * (4 * 2 + 2));
+        assert_eq!(room(), sizes);
+        // A huge lot's room is kept only up to a bound.
+        *rules.mesh_room() = vec![(10, 20), (usize::MAX, 1 << 30)];
+        let capped = [(10, 20), (super::KEPT_ROOM, super::KEPT_ROOM)];
+        assert_eq!(rules.plain_collector().room(), capped.as_slice());
     }
 }

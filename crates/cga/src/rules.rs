@@ -217,11 +217,12 @@ pub(crate) struct Inner {
     pub assets: Assets,
     pub context_use: ContextUse,
     pub engine: Engine,
-    /// The room each material's mesh of the last lot collected as plain
-    /// meshes took, which the next generation's collectors start with
-    /// (`cga_export::PlainCollector::with_room`): a host calls again and
-    /// again with lots much alike (the preview on every edit, Python per
-    /// batch).
+    /// The room each material's mesh took (by material in order of first
+    /// use) in the lot last collected as plain meshes (with several
+    /// workers, whichever finished last), which the next generation's
+    /// collectors start with, bounded (`Rules::plain_collector`): a host
+    /// calls again and again with lots much alike (the preview on every
+    /// edit, Python per batch).
     pub mesh_room: std::sync::Mutex<Vec<(usize, usize)>>,
 }
 

@@ -698,11 +698,11 @@ fn meshes_do_not_depend_on_earlier_calls() {
         assert_eq!(first, big_alone);
         let after_big = models(rules.generate_all(&small, &options).unwrap());
         assert_eq!(after_big, small_alone);
-        // It started with the room a large lot took, and holds what it
-        // uses.
+        // Whatever room it started with (a large lot's, twenty times what
+        // it needs), it holds about what it uses.
         for mesh in &after_big[0].meshes {
-            assert_eq!(mesh.positions.capacity(), mesh.positions.len());
-            assert_eq!(mesh.indices.capacity(), mesh.indices.len());
+            assert!(mesh.positions.capacity() <= 2 * mesh.positions.len());
+            assert!(mesh.indices.capacity() <= 2 * mesh.indices.len());
         }
         assert_eq!(
             models(rules.generate_all(&big, &options).unwrap()),

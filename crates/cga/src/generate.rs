@@ -727,14 +727,17 @@ mod tests {
             "Lot --> extrude(10) comp(f) { side : split(x) { ~2 : color(\"#a04020\") W. }* | all : X. }\n",
         );
         let room = || rules.mesh_room().clone();
+        // Vertices and triangles of each mesh of the one lot generated.
+        let sizes_of = |results: Vec<crate::LotResult>| -> Vec<(usize, usize)> {
+            let meshes = &results[0].model.meshes;
+            meshes
+                .iter()
+                .map(|m| (m.positions.len(), m.indices.len()))
+                .collect()
+        };
         assert!(room().is_empty());
         let big = rules.generate_all(&[lots::rect(40.0, 40.0)], &Options::default());
-        let sizes: Vec<(usize, usize)> = big.unwrap()[0]
-            .model
-            .meshes
-            .iter()
-            .map(|m| (m.positions.len(), m.indices.len()))
-            .collect();
+        let sizes = sizes_of(big.unwrap());
         assert_eq!(sizes.iter().map(|s| s.1).sum::<usize>(), 2 * (4 * 20 + 2));
         assert_eq!(room(), sizes);
         // The next call's collectors start with it.
@@ -749,13 +752,7 @@ mod tests {
             )
             .unwrap();
         assert_eq!(room(), sizes);
-        let small = rules.generate_all(&[small], &Options::default()).unwrap();
-        let sizes: Vec<(usize, usize)> = small[0]
-            .model
-            .meshes
-            .iter()
-            .map(|m| (m.positions.len(), m.indices.len()))
-            .collect();
+        let sizes = sizes_of(rules.generate_all(&[small], &Options::default()).unwrap());
         assert_eq!(sizes.iter().map(|s| s.1).sum::<usize>(), 2 * (4 * 2 + 2));
         assert_eq!(room(), sizes);
         // A huge lot's room is kept only up to a bound.

@@ -21,18 +21,25 @@ fn main() {
         .generate_all(&lots, &cga::Options::default())
         .expect("generates");
     let mut bytes = 0;
+    let mut last = Vec::new();
     let mut times: Vec<f64> = (0..runs)
         .map(|_| {
             let t = Instant::now();
             let model = cga_serve::encode::model(&results, [0.0; 3], &mut |p| Some(p.to_string()));
             bytes = model.len();
-            std::hint::black_box(model);
-            t.elapsed().as_secs_f64() * 1e3
+            let took = t.elapsed().as_secs_f64() * 1e3;
+            last = model;
+            took
         })
         .collect();
     times.sort_by(f64::total_cmp);
+    // FNV-1a of the bytes: a change of code that should not change them
+    // shows here.
+    let digest = last.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3)
+    });
     println!(
-        "{} lots, {:.1} MB: best {:.1} ms, median {:.1} ms",
+        "{} lots, {:.1} MB (digest {digest:016x}): best {:.1} ms, median {:.1} ms",
         lots.len(),
         bytes as f64 / 1e6,
         times[0],

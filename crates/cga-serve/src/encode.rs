@@ -56,18 +56,59 @@ const STEPS: f64 = 65535.0;
 /// are sent as 16-bit steps.
 const UV_SPAN: f64 = 64.0;
 
+/// Points taken at a time by the loops below: their coordinates, read as
+/// one flat run of `f64`, go through the same steps lane by lane, which
+/// the compiler turns into vector instructions (these loops are most of
+/// the encoding's time: a street is millions of vertices).
+const RUN: usize = 4;
+
 /// The corner and far corner of the box around `points` (infinite and
-/// inverted for none).
-fn bounds<const N: usize>(points: impl Iterator<Item = [f64; N]>) -> ([f64; N], [f64; N]) {
-    let mut lo = [f64::INFINITY; N];
-    let mut hi = [f64::NEG_INFINITY; N];
-    for p in points {
-        for a in 0..N {
-            lo[a] = lo[a].min(p[a]);
-            hi[a] = hi[a].max(p[a]);
+/// inverted for none; NaN coordinates are passed over).
+fn bounds<const N: usize>(points: &[[f64; N]]) -> ([f64; N], [f64; N]) {
+    // Lane `i` of a run holds coordinate `i % N` of a point.
+    let mut lo = [[f64::INFINITY; N]; RUN];
+    let mut hi = [[f64::NEG_INFINITY; N]; RUN];
+    let runs = points.chunks_exact(RUN);
+    let rest = runs.remainder();
+    for run in runs {
+        for k in 0..RUN {
+            for a in 0..N {
+                // A comparison rather than `f64::min`, whose care for NaN
+                // keeps the loop from being vectorised; NaN loses both.
+                let v = run[k][a];
+                lo[k][a] = if v < lo[k][a] { v } else { lo[k][a] };
+                hi[k][a] = if v > hi[k][a] { v } else { hi[k][a] };
+            }
         }
     }
-    (lo, hi)
+    for p in rest {
+        for a in 0..N {
+            lo[0][a] = if p[a] < lo[0][a] { p[a] } else { lo[0][a] };
+            hi[0][a] = if p[a] > hi[0][a] { p[a] } else { hi[0][a] };
+        }
+    }
+    let mut min = lo[0];
+    let mut max = hi[0];
+    for k in 1..RUN {
+        for a in 0..N {
+            min[a] = min[a].min(lo[k][a]);
+            max[a] = max[a].max(hi[k][a]);
+        }
+    }
+    (min, max)
+}
+
+/// A coordinate as a 16-bit step: `(v - offset) * scale` rounded, within
+/// 0 and [`STEPS`] (0 for NaN).
+#[inline(always)]
+fn step(v: f64, offset: f64, scale: f64) -> u16 {
+    // Adding a half and cutting off rounds (without a call to `round`,
+    // which this target does not inline); the comparisons keep the value
+    // within the steps, NaN included, before the cut.
+    let v = (v - offset) * scale + 0.5;
+    let v = if v > 0.0 { v } else { 0.0 };
+    let v = if v < STEPS { v } else { STEPS };
+    v as u16
 }
 
 /// Writes each of `points` as N 16-bit steps, `(p - offset) * scale`
@@ -78,14 +119,53 @@ fn write_steps<const N: usize>(
     scale: [f64; N],
     out: &mut [u8],
 ) {
-    for (p, q) in points.iter().zip(out.chunks_exact_mut(2 * N)) {
+    let runs = points.chunks_exact(RUN);
+    let rest = runs.remainder();
+    let mut outs = out.chunks_exact_mut(2 * N * RUN);
+    for (run, q) in runs.zip(&mut outs) {
+        let mut steps = [[0u16; N]; RUN];
+        for k in 0..RUN {
+            for a in 0..N {
+                steps[k][a] = step(run[k][a], offset[a], scale[a]);
+            }
+        }
+        for (s, b) in steps.as_flattened().iter().zip(q.chunks_exact_mut(2)) {
+            b.copy_from_slice(&s.to_le_bytes());
+        }
+    }
+    let q = outs.into_remainder();
+    for (p, q) in rest.iter().zip(q.chunks_exact_mut(2 * N)) {
         for a in 0..N {
-            // Non-negative by the box: adding a half and cutting off
-            // rounds (without a call to `round`, which this target does
-            // not inline).
-            let v = ((p[a] - offset[a]) * scale[a] + 0.5).clamp(0.0, STEPS) as u16;
+            let v = step(p[a], offset[a], scale[a]);
             q[2 * a..2 * a + 2].copy_from_slice(&v.to_le_bytes());
         }
+    }
+}
+
+/// A coordinate of a unit normal as a signed byte, `n * 127` rounded
+/// (the page reads it as normalised).
+#[inline(always)]
+fn normal_byte(n: f64) -> u8 {
+    let n = if n > -1.0 { n } else { -1.0 };
+    let n = if n < 1.0 { n } else { 1.0 };
+    // Rounded as the positions are, shifted to be non-negative first.
+    let up = (n * 127.0 + 127.5) as i32;
+    ((up - 127) as i8) as u8
+}
+
+/// Writes each of `normals` as three signed bytes into `out`.
+fn write_normals(normals: &[[f64; 3]], out: &mut [u8]) {
+    let runs = normals.chunks_exact(RUN);
+    let rest = runs.remainder();
+    let mut outs = out.chunks_exact_mut(3 * RUN);
+    for (run, b) in runs.zip(&mut outs) {
+        for (n, b) in run.as_flattened().iter().zip(b.iter_mut()) {
+            *b = normal_byte(*n);
+        }
+    }
+    let b = outs.into_remainder();
+    for (n, b) in rest.as_flattened().iter().zip(b.iter_mut()) {
+        *b = normal_byte(*n);
     }
 }
 
@@ -103,7 +183,7 @@ enum Uvs {
 impl Uvs {
     /// How `uvs` are sent: as steps where their box is small.
     fn of(uvs: &[[f64; 2]]) -> Uvs {
-        let (lo, hi) = bounds(uvs.iter().copied());
+        let (lo, hi) = bounds(uvs);
         let extent: [f64; 2] = std::array::from_fn(|a| hi[a] - lo[a]);
         if extent.iter().all(|e| e.is_finite() && *e <= UV_SPAN) {
             Uvs::Steps {
@@ -159,12 +239,11 @@ impl Placed<'_> {
     }
 
     fn measure(&mut self, origin: [f64; 3]) {
-        let relative = self
-            .mesh
-            .positions
-            .iter()
-            .map(|p| std::array::from_fn(|a| p[a] - origin[a]));
-        (self.min, self.max) = bounds(relative);
+        // The box of the positions relative to the origin is the box of
+        // the positions moved: subtracting is monotonic, rounding too.
+        let (lo, hi) = bounds(&self.mesh.positions);
+        self.min = std::array::from_fn(|a| lo[a] - origin[a]);
+        self.max = std::array::from_fn(|a| hi[a] - origin[a]);
     }
 
     /// Measures the box, then writes the arrays into `out`, the bytes
@@ -196,16 +275,9 @@ impl Placed<'_> {
                 }
             }
         }
-        // Unit normals need no more than a byte per coordinate (the page
-        // reads them as normalised), rounded as the positions are.
+        // Unit normals need no more than a byte per coordinate.
         if self.normals {
-            let bytes = out[normals - base..indices - base].chunks_exact_mut(3);
-            for (n, b) in mesh.normals.iter().zip(bytes) {
-                for a in 0..3 {
-                    let up = (n[a].clamp(-1.0, 1.0) * 127.0 + 127.5) as i32;
-                    b[a] = ((up - 127) as i8) as u8;
-                }
-            }
+            write_normals(&mesh.normals, &mut out[normals - base..indices - base]);
         }
         let out = &mut out[indices - base..end - base];
         if self.short {
@@ -440,6 +512,74 @@ mod tests {
                 })
             })
             .collect()
+    }
+
+    /// Points from `k` on, a few of them NaN or outside the steps.
+    fn points<const N: usize>(n: usize, k: usize) -> Vec<[f64; N]> {
+        (0..n)
+            .map(|i| {
+                std::array::from_fn(|a| match (i * 7 + a * 3 + k) % 23 {
+                    0 => f64::NAN,
+                    1 => -5.0,
+                    2 => 1e9,
+                    j => (j as f64 * 0.37 - 2.0) * (a as f64 + 1.0),
+                })
+            })
+            .collect()
+    }
+
+    #[test]
+    fn run_wise_loops_give_the_pointwise_results() {
+        // Every length up to a few runs, so that runs and remainders both
+        // count: the box, the steps and the normal bytes as one point at a
+        // time, with `f64::min`/`max` and `clamp`, gives them.
+        for n in 0..(3 * RUN + 2) {
+            for k in 0..3 {
+                let p3: Vec<[f64; 3]> = points(n, k);
+                let (lo, hi) = bounds(&p3);
+                for a in 0..3 {
+                    let want_lo = p3.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min);
+                    let want_hi = p3.iter().map(|p| p[a]).fold(f64::NEG_INFINITY, f64::max);
+                    assert_eq!(lo[a].to_bits(), want_lo.to_bits(), "n {n} axis {a}");
+                    assert_eq!(hi[a].to_bits(), want_hi.to_bits(), "n {n} axis {a}");
+                }
+                let (offset, scale) = ([-1.5, 0.25, 2.0], [900.0, 3000.0, 17.5]);
+                let mut out = vec![0u8; 6 * n];
+                write_steps(&p3, offset, scale, &mut out);
+                for (i, p) in p3.iter().enumerate() {
+                    for a in 0..3 {
+                        let want = ((p[a] - offset[a]) * scale[a] + 0.5).clamp(0.0, STEPS) as u16;
+                        let o = 6 * i + 2 * a;
+                        assert_eq!(u16::from_le_bytes([out[o], out[o + 1]]), want);
+                    }
+                }
+                let normals: Vec<[f64; 3]> = p3
+                    .iter()
+                    .map(|p| {
+                        p.map(|c| {
+                            if c.is_nan() {
+                                c
+                            } else {
+                                (c / 4.0).sin() * 1.01
+                            }
+                        })
+                    })
+                    .collect();
+                let mut out = vec![0u8; 3 * n];
+                write_normals(&normals, &mut out);
+                for (n, b) in normals.iter().flatten().zip(&out) {
+                    let up = (n.clamp(-1.0, 1.0) * 127.0 + 127.5) as i32;
+                    assert_eq!(*b as i8, (up - 127) as i8, "normal {n}");
+                }
+                let p2: Vec<[f64; 2]> = points(n, k);
+                let (lo, hi) = bounds(&p2);
+                for a in 0..2 {
+                    let want_lo = p2.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min);
+                    let want_hi = p2.iter().map(|p| p[a]).fold(f64::NEG_INFINITY, f64::max);
+                    assert_eq!((lo[a], hi[a]), (want_lo, want_hi), "n {n} axis {a}");
+                }
+            }
+        }
     }
 
     #[test]

@@ -165,17 +165,17 @@ pub fn apply(shape: &mut Shape, bounds: Option<(DVec3, DVec3)>) {
         if mesh.faces.is_empty() {
             break;
         }
-        let (_, above) = cga_geometry::cut_by_plane(&mesh, n, offset);
-        mesh = without_caps(above, n, offset);
+        // Faces of the mesh lying in the plane and facing out go too.
+        mesh = without_faces_on_cut(cga_geometry::part_above_plane(&mesh, n, offset), n, offset);
     }
     shape.set_local_mesh(mesh);
 }
 
 /// `mesh` without the faces lying in the plane `n · p = offset` and facing
-/// away from `n`: the caps `cut_by_plane` adds to close a cut solid (a face
-/// of the input lying exactly in the plane and facing out of the kept part
-/// goes too; it would lie on the cut anyway).
-fn without_caps(mut mesh: Mesh, n: DVec3, offset: f64) -> Mesh {
+/// away from `n`: faces of the input lying exactly in the plane and facing
+/// out of the kept part, which would lie on the cut (a trimmed shape is
+/// open there: the cut is taken without caps).
+fn without_faces_on_cut(mut mesh: Mesh, n: DVec3, offset: f64) -> Mesh {
     let scale = mesh
         .positions
         .iter()

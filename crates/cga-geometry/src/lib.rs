@@ -65,7 +65,7 @@ pub mod uv_carry;
 
 pub use area_split::{split_by_areas, AreaProfile, Flatness};
 pub use asset_mesh::load_asset;
-pub use cut::{cut_by_plane, split_along_axis, split_by_parallel_planes};
+pub use cut::{cut_by_plane, part_above_plane, split_along_axis, split_by_parallel_planes};
 pub use extrude::{extrude, extrude_with_roles, ExtrudeRole, Extrusion};
 pub use glam::{DAffine3, DMat3, DQuat, DVec2, DVec3};
 pub use inner_rect::{inner_rectangle, largest_inner_rectangle};

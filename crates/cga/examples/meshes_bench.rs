@@ -27,7 +27,11 @@ fn main() {
         .map_or(5, |r| r.parse().expect("RUNS is a number"));
     let rules = Engine::new(cga::DiskWorld).load(rules);
     let lots = cga::lots::read(&[lots]).expect("lots").lots;
-    let options = Options::default();
+    // JOBS=n sets the number of threads (default: one per core).
+    let options = match std::env::var("JOBS").ok().and_then(|j| j.parse().ok()) {
+        Some(jobs) => Options::default().jobs(jobs),
+        None => Options::default(),
+    };
     let time = |meshes: bool| {
         let mut times: Vec<f64> = (0..runs)
             .map(|_| {
@@ -55,6 +59,10 @@ fn main() {
         "{} lots, derivation only: best {best:.1} ms, median {median:.1} ms",
         lots.len()
     );
+    // DERIVATION_ONLY=1 skips the meshes runs (for a profiler).
+    if std::env::var_os("DERIVATION_ONLY").is_some() {
+        return;
+    }
     let (best, median) = time(true);
     println!(
         "{} lots, plain meshes:    best {best:.1} ms, median {median:.1} ms",

@@ -17,6 +17,8 @@ pub(super) struct Cutter<'m, 'b> {
     /// The plane coordinates of the face being routed (see
     /// [`Cutter::face_basis`]).
     pub(super) basis: (DVec3, DVec3),
+    /// Whether the parts of a closed mesh are closed with caps.
+    pub(super) caps: bool,
     pub(super) bufs: &'b mut Bufs,
 }
 
@@ -59,6 +61,7 @@ impl<'m, 'b> Cutter<'m, 'b> {
             axis,
             tol,
             basis: (DVec3::X, DVec3::Y),
+            caps: true,
             bufs,
         }
     }

@@ -107,6 +107,20 @@ pub fn cut_by_plane(mesh: &Mesh, normal: DVec3, offset: f64) -> (Mesh, Mesh) {
     (below, above)
 }
 
+/// The part of `mesh` above the plane `normal · p = offset`, as
+/// [`cut_by_plane`] gives it but never closed with a cap: for callers that
+/// would take the cap off again (a trim plane keeps the cut open), the
+/// caps' tracing and triangulating of the cut outline is saved. A zero or
+/// non-finite normal gives an empty mesh.
+pub fn part_above_plane(mesh: &Mesh, normal: DVec3, offset: f64) -> Mesh {
+    let len = normal.length();
+    if !(len > 0.0 && len.is_finite() && offset.is_finite()) {
+        return empty_like(mesh);
+    }
+    let mut parts = cut_with(mesh, normal / len, &[offset / len], false);
+    parts.pop().unwrap_or_else(|| empty_like(mesh))
+}
+
 /// Cuts `mesh` at the planes `p[axis] = cuts[i]` into `cuts.len() + 1`
 /// slabs: slab `i` lies between `cuts[i - 1]` and `cuts[i]` (slab 0 below
 /// the first cut, the last above the last cut). Empty slabs are empty
@@ -132,6 +146,12 @@ pub fn split_along_axis(mesh: &Mesh, axis: usize, cuts: &[f64]) -> Vec<Mesh> {
 /// unit length, `offsets` ascending) into `offsets.len() + 1` parts, as
 /// [`split_along_axis`] does for a general direction.
 pub fn split_by_parallel_planes(mesh: &Mesh, normal: DVec3, offsets: &[f64]) -> Vec<Mesh> {
+    cut_with(mesh, normal, offsets, true)
+}
+
+/// [`split_by_parallel_planes`], with caps on the parts of closed meshes
+/// or without.
+fn cut_with(mesh: &Mesh, normal: DVec3, offsets: &[f64], caps: bool) -> Vec<Mesh> {
     // The working buffers of the cut are kept per thread and reused: a
     // split of a box into floors is a few microseconds of arithmetic, and
     // allocating its dozens of small buffers anew each time cost several
@@ -140,6 +160,7 @@ pub fn split_by_parallel_planes(mesh: &Mesh, normal: DVec3, offsets: &[f64]) -> 
     // both fall back to fresh buffers rather than panic.
     let run = |bufs: &mut Bufs| {
         let mut cutter = Cutter::new(mesh, normal, offsets, bufs);
+        cutter.caps = caps;
         cutter.run();
         let out = cutter.build();
         bufs.trim();

@@ -244,6 +244,53 @@ fn hollow_tube_gives_ring_caps() {
 }
 
 #[test]
+fn part_above_is_the_capped_part_without_its_caps() {
+    // A tube cut across its hole and at an angle: the part above has the
+    // faces of `cut_by_plane`'s, in the same order, with the same corners,
+    // positions and attributes, less the caps that would close it.
+    let outer = [(0., 0.), (4., 0.), (4., -4.), (0., -4.)];
+    let hole = vec![(1., -1.), (1., -3.), (3., -3.), (3., -1.)];
+    let tube = prism(&outer, &[hole], 2.0);
+    for (n, offset) in [
+        (DVec3::Y, 0.5),
+        (DVec3::new(1.0, 0.5, 0.25), 2.0),
+        (DVec3::new(0.0, 0.0, -2.0), 3.0),
+    ] {
+        let (_, capped) = cut_by_plane(&tube, n, offset);
+        let open = part_above_plane(&tube, n, offset);
+        let caps = (0..capped.faces.len())
+            .filter(|&f| is_cap(&capped, f))
+            .count();
+        assert!(caps > 0, "plane {n} {offset}");
+        assert_eq!(open.faces.len(), capped.faces.len() - caps);
+        assert!((0..open.faces.len()).all(|f| !is_cap(&open, f)));
+        // Caps come last: the faces before them are the open part's.
+        let kept = open.faces.len();
+        assert_eq!(open.faces[..], capped.faces[..kept]);
+        let corners = capped.loops[..open.loops.len()]
+            .iter()
+            .map(|l| l.len as usize)
+            .sum::<usize>();
+        assert_eq!(open.loops[..], capped.loops[..open.loops.len()]);
+        assert_eq!(open.corners[..], capped.corners[..corners]);
+        assert_eq!(open.positions[..], capped.positions[..open.positions.len()]);
+        assert_eq!(
+            open.uvs[0].as_ref().unwrap()[..],
+            capped.uvs[0].as_ref().unwrap()[..corners]
+        );
+        assert!(no_unused_positions(&open));
+        assert!((non_cap_area(&open) - non_cap_area(&capped)).abs() < 1e-12);
+    }
+    // Open meshes get no caps either way; a zero normal leaves nothing.
+    let quad = Mesh::polygon(&[v(0., 0., 0.), v(2., 0., 0.), v(2., 0., -2.), v(0., 0., -2.)]);
+    assert_eq!(
+        part_above_plane(&quad, DVec3::X, 1.0),
+        cut_by_plane(&quad, DVec3::X, 1.0).1
+    );
+    assert!(part_above_plane(&quad, DVec3::ZERO, 1.0).faces.is_empty());
+}
+
+#[test]
 fn concave_u_gives_two_pieces_above() {
     // A U open to the back (-z): arms at x in [0,1] and [2,3].
     let u = [

@@ -119,6 +119,9 @@ fn write_steps<const N: usize>(
     scale: [f64; N],
     out: &mut [u8],
 ) {
+    // The arrays are padded: runs and the rest are cut from the points'
+    // bytes alone, so that padding never passes for a run.
+    let out = &mut out[..2 * N * points.len()];
     let runs = points.chunks_exact(RUN);
     let rest = runs.remainder();
     let mut outs = out.chunks_exact_mut(2 * N * RUN);
@@ -155,6 +158,7 @@ fn normal_byte(n: f64) -> u8 {
 
 /// Writes each of `normals` as three signed bytes into `out`.
 fn write_normals(normals: &[[f64; 3]], out: &mut [u8]) {
+    let out = &mut out[..3 * normals.len()];
     let runs = normals.chunks_exact(RUN);
     let rest = runs.remainder();
     let mut outs = out.chunks_exact_mut(3 * RUN);
@@ -514,7 +518,8 @@ mod tests {
             .collect()
     }
 
-    /// Points from `k` on, a few of them NaN or outside the steps.
+    /// Points from `k` on, a few of them NaN, infinite or outside the
+    /// steps.
     fn points<const N: usize>(n: usize, k: usize) -> Vec<[f64; N]> {
         (0..n)
             .map(|i| {
@@ -522,6 +527,8 @@ mod tests {
                     0 => f64::NAN,
                     1 => -5.0,
                     2 => 1e9,
+                    3 => f64::INFINITY,
+                    4 => f64::NEG_INFINITY,
                     j => (j as f64 * 0.37 - 2.0) * (a as f64 + 1.0),
                 })
             })
@@ -544,8 +551,11 @@ mod tests {
                     assert_eq!(hi[a].to_bits(), want_hi.to_bits(), "n {n} axis {a}");
                 }
                 let (offset, scale) = ([-1.5, 0.25, 2.0], [900.0, 3000.0, 17.5]);
-                let mut out = vec![0u8; 6 * n];
+                // Padded as in the model (to 4 bytes, and a run more):
+                // the padding keeps its marker.
+                let mut out = vec![0xAAu8; (6 * n).next_multiple_of(4) + 24];
                 write_steps(&p3, offset, scale, &mut out);
+                assert!(out[6 * n..].iter().all(|&b| b == 0xAA), "n {n}");
                 for (i, p) in p3.iter().enumerate() {
                     for a in 0..3 {
                         let want = ((p[a] - offset[a]) * scale[a] + 0.5).clamp(0.0, STEPS) as u16;
@@ -565,8 +575,10 @@ mod tests {
                         })
                     })
                     .collect();
-                let mut out = vec![0u8; 3 * n];
+                let mut out = vec![0xAAu8; (3 * n).next_multiple_of(4) + 12];
                 write_normals(&normals, &mut out);
+                assert!(out[3 * n..].iter().all(|&b| b == 0xAA), "n {n}");
+                assert_eq!(normals.iter().flatten().count(), 3 * n);
                 for (n, b) in normals.iter().flatten().zip(&out) {
                     let up = (n.clamp(-1.0, 1.0) * 127.0 + 127.5) as i32;
                     assert_eq!(*b as i8, (up - 127) as i8, "normal {n}");

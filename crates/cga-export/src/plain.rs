@@ -261,8 +261,9 @@ mod tests {
     fn room_given_to_a_new_collector_changes_nothing_collected() {
         let cube = cga_geometry::primitive::cube(DVec3::new(2.0, 3.0, 4.0));
         let mut c = PlainCollector::new();
-        c.add_placed(&cube, None, &cube.materials, 0).unwrap();
-        c.add_placed(&cube, None, &cube.materials, 1).unwrap();
+        for leaf in 0..2 {
+            c.add_placed(&cube, None, &cube.materials, leaf).unwrap();
+        }
         let first = c.take();
         assert_eq!(c.room(), &[(48, 24)]);
         let mut next = PlainCollector::with_room(c.room().to_vec());
@@ -281,10 +282,9 @@ mod tests {
     fn room_kept_from_the_lot_before_changes_nothing_collected() {
         let cube = cga_geometry::primitive::cube(DVec3::new(2.0, 3.0, 4.0));
         let mut c = PlainCollector::new();
-        c.add_placed(&cube, None, &cube.materials, 0).unwrap();
-        c.add_placed(&cube, None, &cube.materials, 1).unwrap();
-        c.add_placed(&cube, None, &cube.materials, 2).unwrap();
-        c.add_placed(&cube, None, &cube.materials, 3).unwrap();
+        for leaf in 0..4 {
+            c.add_placed(&cube, None, &cube.materials, leaf).unwrap();
+        }
         let first = c.take();
         // The next lot's mesh starts with room for the first one's...
         c.add_placed(&cube, None, &cube.materials, 0).unwrap();

@@ -156,19 +156,11 @@ fn normal_byte(n: f64) -> u8 {
     ((up - 127) as i8) as u8
 }
 
-/// Writes each of `normals` as three signed bytes into `out`.
+/// Writes each of `normals` as three signed bytes into `out`: one flat
+/// loop, every coordinate treated alike (so it needs no runs to be
+/// vectorised).
 fn write_normals(normals: &[[f64; 3]], out: &mut [u8]) {
-    let out = &mut out[..3 * normals.len()];
-    let runs = normals.chunks_exact(RUN);
-    let rest = runs.remainder();
-    let mut outs = out.chunks_exact_mut(3 * RUN);
-    for (run, b) in runs.zip(&mut outs) {
-        for (n, b) in run.as_flattened().iter().zip(b.iter_mut()) {
-            *b = normal_byte(*n);
-        }
-    }
-    let b = outs.into_remainder();
-    for (n, b) in rest.as_flattened().iter().zip(b.iter_mut()) {
+    for (n, b) in normals.as_flattened().iter().zip(out.iter_mut()) {
         *b = normal_byte(*n);
     }
 }

@@ -20,6 +20,9 @@ impl<'m, 'b> Cutter<'m, 'b> {
         bb.remap.resize(self.bufs.verts.len(), NONE);
         let mut reference = None;
         for part in 0..nparts {
+            if self.only_part.is_some_and(|only| only != part) {
+                continue;
+            }
             bb.touched.clear();
             bb.corners.clear();
             bb.loops.clear();

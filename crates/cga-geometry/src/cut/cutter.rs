@@ -19,6 +19,9 @@ pub(super) struct Cutter<'m, 'b> {
     pub(super) basis: (DVec3, DVec3),
     /// Whether the parts of a closed mesh are closed with caps.
     pub(super) caps: bool,
+    /// The one part to build, or `None` for all of them (a trim keeps
+    /// only the part above its plane: building the other is wasted).
+    pub(super) only_part: Option<usize>,
     pub(super) bufs: &'b mut Bufs,
 }
 
@@ -62,6 +65,7 @@ impl<'m, 'b> Cutter<'m, 'b> {
             tol,
             basis: (DVec3::X, DVec3::Y),
             caps: true,
+            only_part: None,
             bufs,
         }
     }

@@ -117,7 +117,7 @@ pub fn part_above_plane(mesh: &Mesh, normal: DVec3, offset: f64) -> Mesh {
     if !(len > 0.0 && len.is_finite() && offset.is_finite()) {
         return empty_like(mesh);
     }
-    let mut parts = cut_with(mesh, normal / len, &[offset / len], false);
+    let mut parts = cut_with(mesh, normal / len, &[offset / len], Some(1));
     parts.pop().unwrap_or_else(|| empty_like(mesh))
 }
 
@@ -146,12 +146,12 @@ pub fn split_along_axis(mesh: &Mesh, axis: usize, cuts: &[f64]) -> Vec<Mesh> {
 /// unit length, `offsets` ascending) into `offsets.len() + 1` parts, as
 /// [`split_along_axis`] does for a general direction.
 pub fn split_by_parallel_planes(mesh: &Mesh, normal: DVec3, offsets: &[f64]) -> Vec<Mesh> {
-    cut_with(mesh, normal, offsets, true)
+    cut_with(mesh, normal, offsets, None)
 }
 
-/// [`split_by_parallel_planes`], with caps on the parts of closed meshes
-/// or without.
-fn cut_with(mesh: &Mesh, normal: DVec3, offsets: &[f64], caps: bool) -> Vec<Mesh> {
+/// [`split_by_parallel_planes`]: all parts, closed with caps where the mesh
+/// is closed (`only_part` None), or the one part asked for, without caps.
+fn cut_with(mesh: &Mesh, normal: DVec3, offsets: &[f64], only_part: Option<usize>) -> Vec<Mesh> {
     // The working buffers of the cut are kept per thread and reused: a
     // split of a box into floors is a few microseconds of arithmetic, and
     // allocating its dozens of small buffers anew each time cost several
@@ -160,7 +160,8 @@ fn cut_with(mesh: &Mesh, normal: DVec3, offsets: &[f64], caps: bool) -> Vec<Mesh
     // both fall back to fresh buffers rather than panic.
     let run = |bufs: &mut Bufs| {
         let mut cutter = Cutter::new(mesh, normal, offsets, bufs);
-        cutter.caps = caps;
+        cutter.caps = only_part.is_none();
+        cutter.only_part = only_part;
         cutter.run();
         let out = cutter.build();
         bufs.trim();

@@ -167,6 +167,32 @@ function decodeModel(buffer) {
   return { header, data: 12 };
 }
 
+// A mesh's triangle indices: sent as they are, or (`fans`) as the number
+// of corners of each face, whose triangles are the fan (b, b + i, b + i + 1)
+// over the face's own run of vertices starting at b: a byte a face on the
+// wire instead of 6 or 12 bytes a triangle, made into indices here.
+function indices(buffer, data, m) {
+  if (m.fans === null || m.fans === undefined) {
+    const Indices = m.index_bytes === 2 ? Uint16Array : Uint32Array;
+    return new Indices(buffer, data + m.indices, m.triangles * 3);
+  }
+  const corners = new Uint8Array(buffer, data + m.indices, m.fans);
+  const out = new (m.vertices <= 65536 ? Uint16Array : Uint32Array)(m.triangles * 3);
+  let at = 0;
+  let base = 0;
+  for (let f = 0; f < corners.length; f++) {
+    const n = corners[f];
+    for (let i = 1; i < n - 1; i++) {
+      out[at] = base;
+      out[at + 1] = base + i;
+      out[at + 2] = base + i + 1;
+      at += 3;
+    }
+    base += n;
+  }
+  return out;
+}
+
 // Colour maps by URL, loaded once; a texture that changes on disk is
 // seen after a reload of the page.
 const textures = new Map();
@@ -259,8 +285,7 @@ function buildMeshes(buffer, group, { lots = false } = {}) {
       // culling and picking).
       geometry.boundingBox = new THREE.Box3(new THREE.Vector3(0, 0, 0), new THREE.Vector3(1, 1, 1));
       geometry.boundingSphere = new THREE.Sphere(new THREE.Vector3(0.5, 0.5, 0.5), Math.sqrt(3) / 2);
-      const Indices = m.index_bytes === 2 ? Uint16Array : Uint32Array;
-      geometry.setIndex(new THREE.BufferAttribute(new Indices(buffer, data + m.indices, m.triangles * 3), 1));
+      geometry.setIndex(new THREE.BufferAttribute(indices(buffer, data, m), 1));
       const material = new THREE.MeshStandardMaterial({
         color: lots ? 0xa8a89e : srgb(m.color),
         map,
@@ -331,6 +356,31 @@ async function loadModel(version) {
   page.bounds = modelGroup.userData.bounds ?? null;
   $('stat-draw').textContent = `${page.drawMs.toFixed(1)} ms`;
 }
+
+// The model as drawn: its triangles and their total area in metres
+// (tests compare it with the command's output).
+page.modelTriangles = () => {
+  let triangles = 0;
+  let area = 0;
+  const a = new THREE.Vector3();
+  const b = new THREE.Vector3();
+  const c = new THREE.Vector3();
+  for (const mesh of modelGroup.children) {
+    const position = mesh.geometry.getAttribute('position');
+    const index = mesh.geometry.index;
+    let sum = 0;
+    for (let t = 0; t < index.count; t += 3) {
+      a.fromBufferAttribute(position, index.getX(t));
+      b.fromBufferAttribute(position, index.getX(t + 1));
+      c.fromBufferAttribute(position, index.getX(t + 2));
+      sum += b.sub(a).cross(c.sub(a)).length() / 2;
+    }
+    // Positions are steps across the mesh's box, scaled by its side.
+    area += sum * mesh.scale.x * mesh.scale.x;
+    triangles += index.count / 3;
+  }
+  return { triangles, area };
+};
 
 // The model's pixels: the share of the model's screen box that changes
 // when the model is hidden (tests read it).

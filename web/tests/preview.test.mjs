@@ -9,7 +9,8 @@ import assert from 'node:assert/strict';
 import { mkdtempSync, readFileSync, writeFileSync, rmSync, mkdirSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { repo, openPreview } from './harness.mjs';
+import { repo, openPreview, cgaBinary } from './harness.mjs';
+import { spawnSync } from 'node:child_process';
 
 const original = readFileSync(join(repo, 'examples', 'building.cga'), 'utf8');
 let dir;
@@ -64,6 +65,38 @@ test('the page shows the model', async () => {
   assert.equal(await page.locator('label[data-attr=floorHeight] input[type=range]').count(), 1);
   assert.equal(await page.locator('label[data-attr=wallColor] input[type=text]').count(), 1);
   assert.match(await page.locator('#stats').innerText(), /shapes\s+4,225/);
+});
+
+test('the page draws the triangles the command generates', async () => {
+  // The same rule and lot through `cga generate`, as OBJ: its faces'
+  // area against the area of the triangles the page made from the bytes
+  // it fetched (faces sent as fans, see encode.rs).
+  const obj = join(dir, 'building.obj');
+  const run = spawnSync(cgaBinary(), ['generate', rules, '-o', obj], { encoding: 'utf8' });
+  assert.equal(run.status, 0, run.stderr);
+  const v = [];
+  let area = 0;
+  let triangles = 0;
+  for (const line of readFileSync(obj, 'utf8').split('\n')) {
+    const w = line.trim().split(/\s+/);
+    if (w[0] === 'v') v.push(w.slice(1, 4).map(Number));
+    if (w[0] !== 'f') continue;
+    const p = w.slice(1).map((c) => v[Number(c.split('/')[0]) - 1]);
+    // The vector area of a planar polygon, concave or not.
+    const s = [0, 0, 0];
+    for (let i = 0; i < p.length; i++) {
+      const [a, b] = [p[i], p[(i + 1) % p.length]];
+      s[0] += a[1] * b[2] - a[2] * b[1];
+      s[1] += a[2] * b[0] - a[0] * b[2];
+      s[2] += a[0] * b[1] - a[1] * b[0];
+    }
+    area += Math.hypot(...s) / 2;
+    triangles += p.length - 2;
+  }
+  const drawn = await page.evaluate(() => window.cgaPreview.modelTriangles());
+  assert.equal(drawn.triangles, triangles);
+  // Positions are 16-bit steps across each mesh's box: sub-millimetre.
+  assert.ok(Math.abs(drawn.area - area) < 1e-4 * area, `${drawn.area} against ${area}`);
 });
 
 test('clicking the building names the rule and source line', async () => {

@@ -39,30 +39,25 @@ pub fn exec(
                 shape.set_local_mesh(delete_holes(&mesh));
             }
         }
-        CleanupOp::ReverseNormals => {
-            let mut mesh = (**shape.geometry.local()).clone();
-            reverse_keeping_first_edge(&mut mesh);
-            shape.set_local_mesh(mesh);
-        }
+        // Edited in place: a mesh no other shape shares (a component just
+        // made, most often) is not copied first.
+        CleanupOp::ReverseNormals => reverse_keeping_first_edge(shape.geometry.local_mut()),
         CleanupOp::SetNormals => {
             let mode = selector(&args[0], &["hard", "conform", "soft", "auto"])?;
-            let mut mesh = (**shape.geometry.local()).clone();
+            let mesh = shape.geometry.local_mut();
             match mode {
-                "hard" => cga_geometry::normals::soften_normals(&mut mesh, 0.0),
+                "hard" => cga_geometry::normals::soften_normals(mesh, 0.0),
                 "conform" => {
-                    cga_geometry::normals::conform_orientation(&mut mesh);
-                    cga_geometry::normals::soften_normals(&mut mesh, 0.0);
+                    cga_geometry::normals::conform_orientation(mesh);
+                    cga_geometry::normals::soften_normals(mesh, 0.0);
                 }
-                "soft" => cga_geometry::normals::soften_normals(&mut mesh, 180.0),
-                _ => cga_geometry::normals::soften_normals(&mut mesh, 30.0),
+                "soft" => cga_geometry::normals::soften_normals(mesh, 180.0),
+                _ => cga_geometry::normals::soften_normals(mesh, 30.0),
             }
-            shape.set_local_mesh(mesh);
         }
         CleanupOp::SoftenNormals => {
             let angle = args[0].num()?;
-            let mut mesh = (**shape.geometry.local()).clone();
-            cga_geometry::normals::soften_normals(&mut mesh, angle);
-            shape.set_local_mesh(mesh);
+            cga_geometry::normals::soften_normals(shape.geometry.local_mut(), angle);
         }
         CleanupOp::Mirror => {
             // Mirror inside the scope box: x -> sx - x along flipped axes.

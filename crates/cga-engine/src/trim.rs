@@ -160,15 +160,24 @@ pub fn apply(shape: &mut Shape, bounds: Option<(DVec3, DVec3)>) {
     if cutting.is_empty() {
         return;
     }
-    let mut mesh: Mesh = (**shape.geometry.local()).clone();
+    // The first cut reads the shape's mesh, each later one the last cut's.
+    let source = shape.geometry.local().clone();
+    let mut cut: Option<Mesh> = None;
     for (n, offset) in cutting {
+        let mesh = cut.as_ref().unwrap_or(&source);
         if mesh.faces.is_empty() {
             break;
         }
         // Faces of the mesh lying in the plane and facing out go too.
-        mesh = without_faces_on_cut(cga_geometry::part_above_plane(&mesh, n, offset), n, offset);
+        cut = Some(without_faces_on_cut(
+            cga_geometry::part_above_plane(mesh, n, offset),
+            n,
+            offset,
+        ));
     }
-    shape.set_local_mesh(mesh);
+    if let Some(mesh) = cut {
+        shape.set_local_mesh(mesh);
+    }
 }
 
 /// `mesh` without the faces lying in the plane `n · p = offset` and facing

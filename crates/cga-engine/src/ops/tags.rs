@@ -50,7 +50,6 @@ fn edit(st: &mut ShapeState, f: impl FnOnce(&mut Mesh)) {
     if st.shape.geometry.is_empty() {
         return;
     }
-    let mut mesh = (**st.shape.geometry.local()).clone();
-    f(&mut mesh);
-    st.shape.set_local_mesh(mesh);
+    // In place where no other shape shares the mesh.
+    f(st.shape.geometry.local_mut());
 }

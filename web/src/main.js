@@ -357,7 +357,7 @@ async function loadModel(version) {
   $('stat-draw').textContent = `${page.drawMs.toFixed(1)} ms`;
 }
 
-// The model as drawn: its triangles and their total area in metres
+// The model as drawn: its triangles and their total area in square metres
 // (tests compare it with the command's output).
 page.modelTriangles = () => {
   let triangles = 0;

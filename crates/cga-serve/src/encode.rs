@@ -264,6 +264,15 @@ struct Placed<'a> {
 }
 
 impl Placed<'_> {
+    /// Bytes per index sent: 2 or 4, or 0 where the faces go as fans.
+    fn index_bytes(&self) -> usize {
+        match (&self.fans, self.short) {
+            (Some(_), _) => 0,
+            (None, true) => 2,
+            (None, false) => 4,
+        }
+    }
+
     /// The box's largest side (1 for a point, or a box that is not finite).
     fn extent(&self) -> f64 {
         let e = (0..3)
@@ -398,7 +407,7 @@ pub fn model(
             };
         let index_bytes = match &p.fans {
             Some(fans) => fans.len(),
-            None => p.mesh.indices.len() * 3 * if p.short { 2 } else { 4 },
+            None => p.mesh.indices.len() * 3 * p.index_bytes(),
         };
         size = index_at + index_bytes.next_multiple_of(4);
         p.at = [positions, uv_at, normal_at, index_at, size];
@@ -440,11 +449,7 @@ pub fn model(
                 "uv_min": match p.uvs { Uvs::Steps { min, .. } => json!(min), _ => Json::Null },
                 "uv_extent": match p.uvs { Uvs::Steps { extent, .. } => json!(extent), _ => Json::Null },
                 "indices": indices,
-                "index_bytes": match (&p.fans, p.short) {
-                    (Some(_), _) => 0,
-                    (None, true) => 2,
-                    (None, false) => 4,
-                },
+                "index_bytes": p.index_bytes(),
                 "fans": p.fans.as_ref().map(Vec::len),
                 "texture": p.texture,
                 "color": material.map(|m| m.color).unwrap_or([0.8, 0.8, 0.8]),

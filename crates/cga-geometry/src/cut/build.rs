@@ -10,7 +10,8 @@ use super::*;
 impl<'m, 'b> Cutter<'m, 'b> {
     pub(super) fn build(&mut self) -> Vec<Mesh> {
         let mesh = self.mesh;
-        let closed = self.caps && (self.bufs.planes.is_empty() || self.input_is_closed());
+        let closed =
+            self.only_part.is_none() && (self.bufs.planes.is_empty() || self.input_is_closed());
         self.group_items_by_part();
         let nparts = self.nplanes() + 1;
         let mut out = Vec::with_capacity(nparts);

@@ -17,10 +17,9 @@ pub(super) struct Cutter<'m, 'b> {
     /// The plane coordinates of the face being routed (see
     /// [`Cutter::face_basis`]).
     pub(super) basis: (DVec3, DVec3),
-    /// Whether the parts of a closed mesh are closed with caps.
-    pub(super) caps: bool,
-    /// The one part to build, or `None` for all of them (a trim keeps
-    /// only the part above its plane: building the other is wasted).
+    /// The one part to build, open (without caps), or `None` for all of
+    /// them, closed with caps where the mesh is closed (a trim keeps only
+    /// the part above its plane, open: building the other is wasted).
     pub(super) only_part: Option<usize>,
     pub(super) bufs: &'b mut Bufs,
 }
@@ -64,7 +63,6 @@ impl<'m, 'b> Cutter<'m, 'b> {
             axis,
             tol,
             basis: (DVec3::X, DVec3::Y),
-            caps: true,
             only_part: None,
             bufs,
         }

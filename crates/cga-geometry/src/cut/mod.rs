@@ -160,7 +160,6 @@ fn cut_with(mesh: &Mesh, normal: DVec3, offsets: &[f64], only_part: Option<usize
     // both fall back to fresh buffers rather than panic.
     let run = |bufs: &mut Bufs| {
         let mut cutter = Cutter::new(mesh, normal, offsets, bufs);
-        cutter.caps = only_part.is_none();
         cutter.only_part = only_part;
         cutter.run();
         let out = cutter.build();

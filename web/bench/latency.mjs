@@ -58,7 +58,14 @@ try {
     generateTimes.push((await stats()).generate_ms);
     encodeTimes.push((await stats()).encode_ms);
     drawTimes.push(await page.evaluate(() => window.cgaPreview.drawMs));
-    if (process.env.DEBUG) console.error('page', await page.evaluate(() => JSON.stringify(window.cgaPreview.drawParts)));
+    if (process.env.DEBUG) {
+      console.error('file timeline', await page.evaluate((t) => {
+        const p = window.cgaPreview.drawParts;
+        const s = window.cgaPreview.stats;
+        const at = (x) => performance.timeOrigin + x - t;
+        return JSON.stringify({ state: at(p.state), load: at(p.loadStart), drawn: at(window.cgaPreview.drawnAt), load_ms: s.load_ms, generate: s.generate_ms, encode: s.encode_ms, fetch: p.fetch, build: p.build, render: p.render });
+      }, t0));
+    }
     await page.waitForTimeout(150);
   }
 

@@ -6,11 +6,11 @@
 //! leaves holds, in coordinates of `f64`, with each triangle's leaf.
 
 use cga_geometry::mesh::SharedVec;
-use cga_geometry::{DAffine3, Material, Mesh};
+use cga_geometry::{DAffine3, DVec2, Material, Mesh};
 
 use crate::materials::MaterialTable;
 use crate::prepare::{FacePrep, SlotIds};
-use crate::{check_mesh, ExportError};
+use crate::{check_mesh, ExportError, FaceData};
 
 /// The triangles of one material.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -76,6 +76,91 @@ fn fit<T>(v: &mut Vec<T>) {
     }
 }
 
+/// The place in its loop of the corner a face's triangles fan out from,
+/// if they are the fan `(c[r], c[r + k + 1], c[r + k + 2])` over its one
+/// loop `c` read from `r` on (round the loop): what the triangulation
+/// makes of every convex face, nearly all faces of a model.
+fn fan_start(f: &FaceData) -> Option<u32> {
+    let &[outer] = f.mesh.face_loops(f.face) else {
+        return None;
+    };
+    let (s, n) = (outer.start, outer.len);
+    let first = f.triangles.first()?[0].checked_sub(s)?;
+    if f.triangles.len() + 2 != n as usize || first >= n {
+        return None;
+    }
+    let at = |i: u32| s + (first + i) % n;
+    f.triangles
+        .iter()
+        .zip(0..)
+        .all(|(t, k)| *t == [s + first, at(k + 1), at(k + 2)])
+        .then_some(first)
+}
+
+/// Adds a face whose triangles are a fan (see [`fan_start`]) from the
+/// corner at `first` of its loop: its vertices are its corners in loop
+/// order from there, as the general path numbers them (in the order the
+/// triangles first use them), written in one pass each.
+fn push_fan(out: &mut PlainMesh, f: &FaceData, uvs: Option<&[DVec2]>, first: u32, leaf: u32) {
+    let outer = f.mesh.face_loops(f.face)[0];
+    let (s, n) = (outer.start as usize, outer.len as usize);
+    let corners = (first as usize..n).chain(0..first as usize).map(|i| s + i);
+    let base = out.positions.len() as u32;
+    out.positions.extend(
+        corners
+            .clone()
+            .map(|c| f.positions[f.mesh.corners[c] as usize].to_array()),
+    );
+    match f.normals {
+        Some(normals) => out
+            .normals
+            .extend(corners.clone().map(|c| normals[c].to_array())),
+        None => out
+            .normals
+            .extend(std::iter::repeat_n(f.normal.to_array(), n)),
+    }
+    out.uvs.extend(corners.map(|c| {
+        uvs.and_then(|u| u.get(c))
+            .map_or([0.0; 2], |t| t.to_array())
+    }));
+    out.indices
+        .extend((1..n as u32 - 1).map(|k| [base, base + k, base + k + 1]));
+    out.triangle_leaf.extend(std::iter::repeat_n(leaf, n - 2));
+}
+
+/// Adds a face's triangles, with a vertex per corner of the face in the
+/// order the triangles first use them (`corner_vertex` is scratch room,
+/// at least a slot per corner of the mesh).
+fn push_triangles(
+    out: &mut PlainMesh,
+    f: &FaceData,
+    uvs: Option<&[DVec2]>,
+    corner_vertex: &mut [u32],
+    leaf: u32,
+) {
+    for l in f.mesh.face_loops(f.face) {
+        corner_vertex[f.mesh.loop_corners(*l)].fill(NO_VERTEX);
+    }
+    for tri in f.triangles {
+        let mut ids = [0u32; 3];
+        for (k, &c) in tri.iter().enumerate() {
+            let v = &mut corner_vertex[c as usize];
+            if *v == NO_VERTEX {
+                let p = f.positions[f.mesh.corners[c as usize] as usize];
+                let n = f.normals.map_or(f.normal, |n| n[c as usize]);
+                let uv = uvs.and_then(|u| u.get(c as usize)).copied();
+                out.positions.push(p.to_array());
+                out.normals.push(n.to_array());
+                out.uvs.push(uv.map_or([0.0; 2], |t| t.to_array()));
+                *v = (out.positions.len() - 1) as u32;
+            }
+            ids[k] = *v;
+        }
+        out.indices.push(ids);
+        out.triangle_leaf.push(leaf);
+    }
+}
+
 /// Gathers leaves into a [`PlainModel`].
 #[derive(Default)]
 pub struct PlainCollector {
@@ -137,8 +222,10 @@ impl PlainCollector {
             last_sizes,
         } = self;
         slots.begin(materials);
-        corner_vertex.clear();
-        corner_vertex.resize(mesh.corners.len(), NO_VERTEX);
+        // Only long enough: each face marks its own corners before use.
+        if corner_vertex.len() < mesh.corners.len() {
+            corner_vertex.resize(mesh.corners.len(), NO_VERTEX);
+        }
         let skipped = prep.faces(mesh, transform, |f| {
             let id = slots.id(f.material, || {
                 let (id, new) = table.intern(&materials[f.material as usize]);
@@ -157,30 +244,12 @@ impl PlainCollector {
             });
             let out = &mut model.meshes[id as usize];
             let uvs = f.mesh.uvs[0].as_deref();
-            // A vertex per corner of the face, in the order the triangles
-            // first use them.
-            for l in f.mesh.face_loops(f.face) {
-                corner_vertex[f.mesh.loop_corners(*l)].fill(NO_VERTEX);
-            }
-            for tri in f.triangles {
-                let mut ids = [0u32; 3];
-                for (k, &c) in tri.iter().enumerate() {
-                    let v = &mut corner_vertex[c as usize];
-                    if *v == NO_VERTEX {
-                        let p = f.positions[f.mesh.corners[c as usize] as usize];
-                        let n = f.normals.map_or(f.normal, |n| n[c as usize]);
-                        let uv = uvs.and_then(|u| u.get(c as usize)).copied();
-                        out.positions.push(p.to_array());
-                        out.normals.push(n.to_array());
-                        out.uvs.push(uv.map_or([0.0; 2], |t| t.to_array()));
-                        *v = (out.positions.len() - 1) as u32;
-                    }
-                    ids[k] = *v;
-                }
-                out.indices.push(ids);
-                out.triangle_leaf.push(leaf);
-            }
             model.faces += 1;
+            if let Some(first) = fan_start(f) {
+                push_fan(out, f, uvs, first, leaf);
+                return Ok(());
+            }
+            push_triangles(out, f, uvs, corner_vertex, leaf);
             Ok(())
         });
         slots.end(materials);
@@ -255,6 +324,80 @@ mod tests {
             assert!(geometric.dot(n) > 0.0);
         }
         assert!(c.take().meshes.is_empty());
+    }
+
+    /// Faces whose triangles are fans take the short path, which gives
+    /// exactly what the general one gives; other faces take the general.
+    #[test]
+    fn fans_are_collected_as_the_general_path_collects_them() {
+        let mut m = Mesh::new();
+        let p = |x: f64, z: f64| DVec3::new(x, 0.0, z);
+        // A convex pentagon (a fan from the corner the triangulation
+        // picks), a quad cut along its other diagonal (a fan from its
+        // second corner: its first three are in line), a U-shaped
+        // octagon, a square with a hole, a triangle.
+        m.positions.extend([
+            p(0.0, 0.0),
+            p(2.0, 0.0),
+            p(3.0, -1.0),
+            p(1.0, -2.0),
+            p(-1.0, -1.0),
+            p(10.0, 0.0),
+            p(11.0, 0.0),
+            p(12.0, 0.0),
+            p(11.0, -2.0),
+            p(20.0, 0.0),
+            p(26.0, 0.0),
+            p(26.0, -4.0),
+            p(24.0, -4.0),
+            p(24.0, -1.0),
+            p(22.0, -1.0),
+            p(22.0, -4.0),
+            p(20.0, -4.0),
+            p(30.0, 0.0),
+            p(34.0, 0.0),
+            p(34.0, -4.0),
+            p(30.0, -4.0),
+            p(31.0, -1.0),
+            p(31.0, -3.0),
+            p(33.0, -3.0),
+            p(33.0, -1.0),
+        ]);
+        m.add_face(&[&[0, 1, 2, 3, 4]], 0);
+        m.add_face(&[&[5, 6, 7, 8]], 0);
+        m.add_face(&[&[9, 10, 11, 12, 13, 14, 15, 16]], 0);
+        m.add_face(&[&[17, 18, 19, 20], &[21, 22, 23, 24]], 0);
+        m.add_face(&[&[0, 1, 3]], 0);
+        m.uvs[0] = Some(
+            (0..m.corners.len())
+                .map(|c| DVec2::new(c as f64, 0.5))
+                .collect(),
+        );
+        let transform = DAffine3::from_translation(DVec3::new(5.0, 1.0, 2.0));
+        let mut prep = FacePrep::default();
+        let mut fans = PlainMesh::default();
+        let mut general = PlainMesh::default();
+        let mut scratch = vec![NO_VERTEX; m.corners.len()];
+        let mut starts = Vec::new();
+        prep.faces(&m, Some(&transform), |f| {
+            let uvs = f.mesh.uvs[0].as_deref();
+            let start = fan_start(f);
+            starts.push(start);
+            match start {
+                Some(first) => push_fan(&mut fans, f, uvs, first, 3),
+                None => push_triangles(&mut fans, f, uvs, &mut scratch, 3),
+            }
+            push_triangles(&mut general, f, uvs, &mut scratch, 3);
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(starts, [Some(3), Some(1), None, None, Some(0)]);
+        assert_eq!(fans, general);
+        assert_eq!(general.indices.len(), 3 + 2 + 6 + 8 + 1);
+        assert_eq!(general.positions[0], [6.0, 1.0, 0.0]);
+        // The quad's vertices start at its second corner.
+        assert_eq!(general.positions[5], [16.0, 1.0, 2.0]);
+        assert_eq!(general.uvs[5], [6.0, 0.5]);
     }
 
     #[test]

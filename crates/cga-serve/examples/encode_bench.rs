@@ -6,7 +6,13 @@
 
 use std::time::Instant;
 
+/// The allocator of the `cga` command, which serves the preview.
+#[global_allocator]
+static ALLOCATOR: cga_alloc::Allocator = cga_alloc::Allocator;
+
 fn main() {
+    // As the command: memory freed is kept for reuse.
+    cga_alloc::keep_freed_memory(None);
     let args: Vec<String> = std::env::args().skip(1).collect();
     let [rules, lots, rest @ ..] = &args[..] else {
         eprintln!("usage: encode_bench RULES.cga LOTSPEC [RUNS]");

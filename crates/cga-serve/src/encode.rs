@@ -119,7 +119,10 @@ fn step(v: f64, offset: f64, scale: f64) -> u16 {
     let v = (v - offset) * scale + 0.5;
     let v = if v > 0.0 { v } else { 0.0 };
     let v = if v < STEPS { v } else { STEPS };
-    v as u16
+    // SAFETY: `v` is within 0 and STEPS (NaN became 0 above), which an
+    // i32 holds. Unchecked, the conversion needs no test for NaN and
+    // the range per value, and the loops over points are vectorised.
+    (unsafe { v.to_int_unchecked::<i32>() }) as u16
 }
 
 /// Writes each of `points` as N 16-bit steps, `(p - offset) * scale`
@@ -163,7 +166,9 @@ fn normal_byte(n: f64) -> u8 {
     let n = if n > -1.0 { n } else { -1.0 };
     let n = if n < 1.0 { n } else { 1.0 };
     // Rounded as the positions are, shifted to be non-negative first.
-    let up = (n * 127.0 + 127.5) as i32;
+    // SAFETY: `n` is within -1 and 1 (NaN became -1 above), so `up` is
+    // within 0.5 and 254.5, which an i32 holds (see `step`).
+    let up = unsafe { (n * 127.0 + 127.5).to_int_unchecked::<i32>() };
     ((up - 127) as i8) as u8
 }
 
@@ -643,6 +648,47 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Values outside the range, infinite or NaN are clamped before the
+    /// unchecked conversions, as the checked `as` would have them.
+    #[test]
+    fn steps_and_normal_bytes_clamp_whatever_comes() {
+        let s = |v: f64| step(v, 0.0, 1.0);
+        assert_eq!(
+            [
+                f64::NAN,
+                -1e300,
+                f64::NEG_INFINITY,
+                0.0,
+                0.49,
+                0.5,
+                1.0,
+                65535.0,
+                1e300,
+                f64::INFINITY
+            ]
+            .map(s),
+            [0, 0, 0, 0, 0, 1, 1, 65535, 65535, 65535]
+        );
+        assert_eq!(step(11.0, 10.0, 65535.0 / 2.0), 32768);
+        let b = |n: f64| normal_byte(n) as i8;
+        assert_eq!(
+            [
+                f64::NAN,
+                f64::NEG_INFINITY,
+                -2.0,
+                -1.0,
+                -0.5,
+                0.0,
+                0.5,
+                1.0,
+                2.0,
+                f64::INFINITY
+            ]
+            .map(b),
+            [-127, -127, -127, -127, -63, 0, 64, 127, 127, 127]
+        );
     }
 
     #[test]

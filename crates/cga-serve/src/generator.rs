@@ -13,7 +13,8 @@ use serde_json::{json, Value as Json};
 
 use crate::encode;
 
-/// How long a file change may take to settle before it is read.
+/// How long a file change may take to settle before it is read, unless
+/// the writer closes the file sooner (see [`change_of`]).
 const SETTLE: std::time::Duration = std::time::Duration::from_millis(15);
 
 /// What the page asked for.
@@ -53,6 +54,9 @@ pub(crate) struct Request {
     dirty: bool,
     /// Reload the rules (a file changed).
     reload: bool,
+    /// The last file change was a writer closing the rule file: the save
+    /// is whole, and the rules are read without waiting for it to settle.
+    settled: bool,
     stop: bool,
     /// Counts requests: a generation serves the request of this number.
     number: u64,
@@ -141,6 +145,7 @@ impl Preview {
                 params: Params::default(),
                 dirty: true,
                 reload: true,
+                settled: true,
                 stop: false,
                 number: 0,
             }),
@@ -165,20 +170,32 @@ impl Preview {
 
     /// Watches the workspace folders: any change reloads.
     fn watch(self: &Arc<Self>) {
-        use notify::{EventKind, RecursiveMode, Watcher};
+        use notify::{RecursiveMode, Watcher};
         let weak = Arc::downgrade(self);
+        let rules = std::fs::canonicalize(&self.rules_path).ok();
         let handler = move |event: notify::Result<notify::Event>| {
             let Ok(event) = event else { return };
-            if matches!(event.kind, EventKind::Access(_) | EventKind::Other) {
-                return;
-            }
+            let settled = match change_of(&event.kind) {
+                Change::None => return,
+                // Only the rule file's own close: a file written beside
+                // it and then renamed over it (a safe save) closes first,
+                // and reading then would read the old rules.
+                Change::Closed => event
+                    .paths
+                    .iter()
+                    .any(|p| std::fs::canonicalize(p).ok() == rules),
+                Change::Step => false,
+            };
             // Build output and version control under a workspace change
             // often and are never read by rules.
             if !event.paths.iter().any(|p| !is_ignored(p)) {
                 return;
             }
             if let Some(p) = weak.upgrade() {
-                p.request(|r| r.reload = true);
+                p.request(|r| {
+                    r.reload = true;
+                    r.settled = settled;
+                });
             }
         };
         match notify::recommended_watcher(handler) {
@@ -265,18 +282,25 @@ impl Preview {
                 while !r.dirty && !r.stop {
                     r = self.wake.wait(r).unwrap();
                 }
-                if r.reload && !r.stop {
-                    // An editor saves in steps (truncate, write, rename):
-                    // the events of one save come within milliseconds,
-                    // and a file read between them would be half-written.
-                    drop(r);
-                    std::thread::sleep(SETTLE);
-                    r = self.request.lock().unwrap();
+                // An editor saves in steps (truncate, write, close or
+                // rename): the events of one save come within
+                // milliseconds, and a file read between them would be
+                // half-written. The wait ends early when a writer closes
+                // its file (the save of most editors, `cat >`, a
+                // program's write).
+                let settle = Instant::now() + SETTLE;
+                while r.reload && !r.settled && !r.stop {
+                    let left = settle.saturating_duration_since(Instant::now());
+                    if left.is_zero() {
+                        break;
+                    }
+                    r = self.wake.wait_timeout(r, left).unwrap().0;
                 }
                 if r.stop {
                     return;
                 }
                 r.dirty = false;
+                r.settled = false;
                 (r.params.clone(), std::mem::take(&mut r.reload), r.number)
             };
             if reload || rules.is_none() {
@@ -596,6 +620,27 @@ fn choices(a: &cga::Attribute) -> Option<Vec<cga::Value>> {
 
 /// Paths whose changes do not regenerate: inside `.git`, `target` or
 /// `node_modules` folders.
+/// What a file event says of the workspace's contents.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Change {
+    /// Nothing changed (a file opened, read or closed unwritten).
+    None,
+    /// A writer closed a file it wrote: its contents are whole.
+    Closed,
+    /// A change that may be one step of several (a truncation, a write
+    /// before the close, a rename away, a removal before the new file).
+    Step,
+}
+
+fn change_of(kind: &notify::EventKind) -> Change {
+    use notify::event::{AccessKind, AccessMode, EventKind};
+    match kind {
+        EventKind::Access(AccessKind::Close(AccessMode::Write)) => Change::Closed,
+        EventKind::Access(_) | EventKind::Other => Change::None,
+        _ => Change::Step,
+    }
+}
+
 fn is_ignored(path: &Path) -> bool {
     path.components().any(|c| {
         matches!(
@@ -643,6 +688,35 @@ fn lot_outlines(engine: &Engine, root: &Path, lots: &[Lot], origin: [f64; 3]) ->
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A writer's close ends a save; its other steps and renames may be
+    /// followed by more; opening or reading changes nothing.
+    #[test]
+    fn file_events_say_whether_a_save_is_whole() {
+        use notify::event::{
+            AccessKind, AccessMode, CreateKind, DataChange, EventKind, ModifyKind, RemoveKind,
+            RenameMode,
+        };
+        let closed = EventKind::Access(AccessKind::Close(AccessMode::Write));
+        assert_eq!(change_of(&closed), Change::Closed);
+        for none in [
+            EventKind::Access(AccessKind::Open(AccessMode::Any)),
+            EventKind::Access(AccessKind::Close(AccessMode::Read)),
+            EventKind::Access(AccessKind::Read),
+            EventKind::Other,
+        ] {
+            assert_eq!(change_of(&none), Change::None, "{none:?}");
+        }
+        for step in [
+            EventKind::Modify(ModifyKind::Data(DataChange::Content)),
+            EventKind::Modify(ModifyKind::Name(RenameMode::From)),
+            EventKind::Modify(ModifyKind::Name(RenameMode::To)),
+            EventKind::Create(CreateKind::File),
+            EventKind::Remove(RemoveKind::File),
+        ] {
+            assert_eq!(change_of(&step), Change::Step, "{step:?}");
+        }
+    }
 
     #[test]
     fn workspaces_and_relative_paths() {

@@ -450,3 +450,29 @@ fn a_saved_file_is_announced_before_its_model() {
     // Three boxes of 12 triangles.
     assert_eq!(state(addr)["stats"]["triangles"], 36);
 }
+
+#[test]
+fn a_file_written_in_place_is_read_when_its_writer_closes_it() {
+    let (dir, server) = workspace("Lot --> extrude(4) A.\n");
+    let version = state(server.addr)["version"].as_u64().unwrap();
+    let path = dir.path().join("project/rules/a.cga");
+    // Truncated, written in two parts, then closed: as an editor saving
+    // in place does. The close ends the wait for the save to settle; the
+    // rules read are the whole file.
+    {
+        let mut file = std::fs::File::create(&path).unwrap();
+        file.write_all(b"Lot --> extrude(8) split(y) ").unwrap();
+        file.write_all(b"{ 2 : A }*\n").unwrap();
+    }
+    assert!(server
+        .preview
+        .wait_for_version(version + 1, Duration::from_secs(30)));
+    let end = std::time::Instant::now() + Duration::from_secs(30);
+    // Four boxes of 12 triangles (a generation of a half-written file, if
+    // one was started, is cancelled by the close's).
+    while state(server.addr)["stats"]["triangles"] != 48 {
+        assert!(std::time::Instant::now() < end, "{}", state(server.addr));
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    assert_eq!(state(server.addr)["problems"], serde_json::json!([]));
+}

@@ -28,6 +28,7 @@
 
 mod bucket;
 pub mod builtin;
+mod draw;
 mod encode;
 mod faces;
 mod gltf;
@@ -50,11 +51,12 @@ use std::sync::Arc;
 
 use cga_world::World;
 
+pub use crate::draw::{normal_byte, DrawFaces, DrawMesh, DrawModel};
 pub use crate::encode::{Encoded, Encoder};
 use crate::encode::{EncoderShared, MeshEncoder};
 pub use crate::gltf::{Output, DEFAULT_FLUSH_MIB};
 use crate::materials::MaterialTable;
-pub use crate::plain::{PlainCollector, PlainMesh, PlainModel};
+pub use crate::plain::{DrawCollector, PlainCollector, PlainMesh, PlainModel};
 use crate::prepare::{FacePrep, SlotIds};
 use crate::textures::{TextureProbe, Textures};
 /// The JSON values of a lot's node `extras` ([`ModelWriter::begin_lot`]).

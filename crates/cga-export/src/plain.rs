@@ -8,6 +8,7 @@
 use cga_geometry::mesh::SharedVec;
 use cga_geometry::{DAffine3, DVec2, Material, Mesh};
 
+use crate::draw::DrawMesh;
 use crate::materials::MaterialTable;
 use crate::prepare::{FacePrep, SlotIds};
 use crate::{check_mesh, ExportError, FaceData};
@@ -32,30 +33,27 @@ pub struct PlainMesh {
     pub triangle_leaf: Vec<u32>,
 }
 
-/// Meshes by material.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct PlainModel {
+/// Meshes by material: [`PlainMesh`]es, or [`DrawMesh`]es
+/// ([`DrawModel`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlainModel<M = PlainMesh> {
     /// Distinct materials, in order of first use.
     pub materials: Vec<Material>,
     /// One mesh per material, in the order of `materials`.
-    pub meshes: Vec<PlainMesh>,
+    pub meshes: Vec<M>,
     /// Faces written (before triangulation).
     pub faces: u64,
     /// Faces left out for non-finite coordinates.
     pub skipped_non_finite: u64,
 }
 
-impl PlainMesh {
-    /// An empty mesh of `material` with room for `vertices` and
-    /// `triangles`.
-    fn with_capacity(material: usize, vertices: usize, triangles: usize) -> PlainMesh {
-        PlainMesh {
-            material,
-            positions: Vec::with_capacity(vertices),
-            normals: Vec::with_capacity(vertices),
-            uvs: Vec::with_capacity(vertices),
-            indices: Vec::with_capacity(triangles),
-            triangle_leaf: Vec::with_capacity(triangles),
+impl<M> Default for PlainModel<M> {
+    fn default() -> Self {
+        PlainModel {
+            materials: Vec::new(),
+            meshes: Vec::new(),
+            faces: 0,
+            skipped_non_finite: 0,
         }
     }
 }
@@ -67,10 +65,46 @@ impl PlainModel {
     }
 }
 
-const NO_VERTEX: u32 = u32::MAX;
+impl PlainModel<DrawMesh> {
+    /// Triangles over all meshes.
+    pub fn triangles(&self) -> usize {
+        self.meshes.iter().map(DrawMesh::triangles).sum()
+    }
+}
+
+/// What a collector needs of the arrays of one material's mesh: the
+/// faces are found, placed and triangulated once (`Collector`), and each
+/// kind of mesh stores them its way.
+pub(crate) trait MeshArrays {
+    /// An empty mesh of `material` with room for `vertices` and
+    /// `triangles`.
+    fn with_capacity(material: usize, vertices: usize, triangles: usize) -> Self;
+    /// Vertices and triangles held.
+    fn sizes(&self) -> (usize, usize);
+    /// Adds a face whose triangles are a fan (see [`fan_start`]) from the
+    /// corner at `first` of its loop: its vertices are its corners in loop
+    /// order from there, as `push_triangles` numbers them (in the order
+    /// the triangles first use them).
+    fn push_fan(&mut self, f: &FaceData, uvs: Option<&[DVec2]>, first: u32, leaf: u32);
+    /// Adds a face's triangles, with a vertex per corner of the face in the
+    /// order the triangles first use them (`corner_vertex` is scratch
+    /// room, at least a slot per corner of the mesh).
+    fn push_triangles(
+        &mut self,
+        f: &FaceData,
+        uvs: Option<&[DVec2]>,
+        corner_vertex: &mut [u32],
+        leaf: u32,
+    );
+    /// Arrays holding less than half of their room are copied into blocks
+    /// of their size.
+    fn fit(&mut self);
+}
+
+pub(crate) const NO_VERTEX: u32 = u32::MAX;
 
 /// Shrinks `v` to its length if it holds less than half of its room.
-fn fit<T>(v: &mut Vec<T>) {
+pub(crate) fn fit<T>(v: &mut Vec<T>) {
     if v.capacity() > 2 * v.len() {
         v.shrink_to_fit();
     }
@@ -80,7 +114,7 @@ fn fit<T>(v: &mut Vec<T>) {
 /// if they are the fan `(c[r], c[r + k + 1], c[r + k + 2])` over its one
 /// loop `c` read from `r` on (round the loop): what the triangulation
 /// makes of every convex face, nearly all faces of a model.
-fn fan_start(f: &FaceData) -> Option<u32> {
+pub(crate) fn fan_start(f: &FaceData) -> Option<u32> {
     let &[outer] = f.mesh.face_loops(f.face) else {
         return None;
     };
@@ -97,46 +131,26 @@ fn fan_start(f: &FaceData) -> Option<u32> {
         .then_some(first)
 }
 
-/// Adds a face whose triangles are a fan (see [`fan_start`]) from the
-/// corner at `first` of its loop: its vertices are its corners in loop
-/// order from there, as the general path numbers them (in the order the
-/// triangles first use them), written in one pass each.
-fn push_fan(out: &mut PlainMesh, f: &FaceData, uvs: Option<&[DVec2]>, first: u32, leaf: u32) {
+/// The corners of a face's loop from `first` on, round the loop: the
+/// order [`MeshArrays::push_fan`] writes a fan's vertices in.
+pub(crate) fn fan_corners(f: &FaceData, first: u32) -> impl Iterator<Item = usize> + Clone {
     let outer = f.mesh.face_loops(f.face)[0];
     let (s, n) = (outer.start as usize, outer.len as usize);
-    let corners = (first as usize..n).chain(0..first as usize).map(|i| s + i);
-    let base = out.positions.len() as u32;
-    out.positions.extend(
-        corners
-            .clone()
-            .map(|c| f.positions[f.mesh.corners[c] as usize].to_array()),
-    );
-    match f.normals {
-        Some(normals) => out
-            .normals
-            .extend(corners.clone().map(|c| normals[c].to_array())),
-        None => out
-            .normals
-            .extend(std::iter::repeat_n(f.normal.to_array(), n)),
-    }
-    out.uvs.extend(corners.map(|c| {
-        uvs.and_then(|u| u.get(c))
-            .map_or([0.0; 2], |t| t.to_array())
-    }));
-    out.indices
-        .extend((1..n as u32 - 1).map(|k| [base, base + k, base + k + 1]));
-    out.triangle_leaf.extend(std::iter::repeat_n(leaf, n - 2));
+    (first as usize..n)
+        .chain(0..first as usize)
+        .map(move |i| s + i)
 }
 
-/// Adds a face's triangles, with a vertex per corner of the face in the
-/// order the triangles first use them (`corner_vertex` is scratch room,
-/// at least a slot per corner of the mesh).
-fn push_triangles(
-    out: &mut PlainMesh,
+/// Calls `vertex` for each corner of a triangle of `f` not seen before in
+/// this face (its corner number), in the order the triangles first use
+/// them, and `triangle` with each triangle's vertex numbers (`next` is
+/// the number the first new vertex gets).
+pub(crate) fn each_triangle(
     f: &FaceData,
-    uvs: Option<&[DVec2]>,
     corner_vertex: &mut [u32],
-    leaf: u32,
+    mut next: u32,
+    mut vertex: impl FnMut(usize),
+    mut triangle: impl FnMut([u32; 3]),
 ) {
     for l in f.mesh.face_loops(f.face) {
         corner_vertex[f.mesh.loop_corners(*l)].fill(NO_VERTEX);
@@ -146,28 +160,115 @@ fn push_triangles(
         for (k, &c) in tri.iter().enumerate() {
             let v = &mut corner_vertex[c as usize];
             if *v == NO_VERTEX {
-                let p = f.positions[f.mesh.corners[c as usize] as usize];
-                let n = f.normals.map_or(f.normal, |n| n[c as usize]);
-                let uv = uvs.and_then(|u| u.get(c as usize)).copied();
-                out.positions.push(p.to_array());
-                out.normals.push(n.to_array());
-                out.uvs.push(uv.map_or([0.0; 2], |t| t.to_array()));
-                *v = (out.positions.len() - 1) as u32;
+                vertex(c as usize);
+                *v = next;
+                next += 1;
             }
             ids[k] = *v;
         }
-        out.indices.push(ids);
-        out.triangle_leaf.push(leaf);
+        triangle(ids);
+    }
+}
+
+impl MeshArrays for PlainMesh {
+    fn with_capacity(material: usize, vertices: usize, triangles: usize) -> PlainMesh {
+        PlainMesh {
+            material,
+            positions: Vec::with_capacity(vertices),
+            normals: Vec::with_capacity(vertices),
+            uvs: Vec::with_capacity(vertices),
+            indices: Vec::with_capacity(triangles),
+            triangle_leaf: Vec::with_capacity(triangles),
+        }
+    }
+
+    fn sizes(&self) -> (usize, usize) {
+        (self.positions.len(), self.indices.len())
+    }
+
+    fn push_fan(&mut self, f: &FaceData, uvs: Option<&[DVec2]>, first: u32, leaf: u32) {
+        let corners = fan_corners(f, first);
+        let n = f.mesh.face_loops(f.face)[0].len as usize;
+        let base = self.positions.len() as u32;
+        self.positions.extend(
+            corners
+                .clone()
+                .map(|c| f.positions[f.mesh.corners[c] as usize].to_array()),
+        );
+        match f.normals {
+            Some(normals) => self
+                .normals
+                .extend(corners.clone().map(|c| normals[c].to_array())),
+            None => self
+                .normals
+                .extend(std::iter::repeat_n(f.normal.to_array(), n)),
+        }
+        self.uvs.extend(corners.map(|c| {
+            uvs.and_then(|u| u.get(c))
+                .map_or([0.0; 2], |t| t.to_array())
+        }));
+        self.indices
+            .extend((1..n as u32 - 1).map(|k| [base, base + k, base + k + 1]));
+        self.triangle_leaf.extend(std::iter::repeat_n(leaf, n - 2));
+    }
+
+    fn push_triangles(
+        &mut self,
+        f: &FaceData,
+        uvs: Option<&[DVec2]>,
+        corner_vertex: &mut [u32],
+        leaf: u32,
+    ) {
+        let PlainMesh {
+            positions,
+            normals,
+            uvs: out_uvs,
+            indices,
+            triangle_leaf,
+            ..
+        } = self;
+        each_triangle(
+            f,
+            corner_vertex,
+            positions.len() as u32,
+            |c| {
+                let p = f.positions[f.mesh.corners[c] as usize];
+                let n = f.normals.map_or(f.normal, |n| n[c]);
+                let uv = uvs.and_then(|u| u.get(c)).copied();
+                positions.push(p.to_array());
+                normals.push(n.to_array());
+                out_uvs.push(uv.map_or([0.0; 2], |t| t.to_array()));
+            },
+            |ids| {
+                indices.push(ids);
+                triangle_leaf.push(leaf);
+            },
+        );
+    }
+
+    fn fit(&mut self) {
+        fit(&mut self.positions);
+        fit(&mut self.normals);
+        fit(&mut self.uvs);
+        fit(&mut self.indices);
+        fit(&mut self.triangle_leaf);
     }
 }
 
 /// Gathers leaves into a [`PlainModel`].
 #[derive(Default)]
-pub struct PlainCollector {
+pub struct PlainCollector(Collector<PlainMesh>);
+
+/// Gathers leaves into a [`DrawModel`].
+#[derive(Default)]
+pub struct DrawCollector(Collector<DrawMesh>);
+
+/// Gathers leaves into meshes by material (see [`MeshArrays`]).
+pub(crate) struct Collector<M> {
     prep: FacePrep,
     slots: SlotIds,
     table: MaterialTable,
-    model: PlainModel,
+    model: PlainModel<M>,
     /// The vertex of each corner of the mesh being added (`NO_VERTEX` for
     /// corners of the current face not yet given one): indexed, not
     /// hashed, since a street's collection visits millions of corners.
@@ -177,35 +278,73 @@ pub struct PlainCollector {
     last_sizes: Vec<(usize, usize)>,
 }
 
-impl PlainCollector {
-    pub fn new() -> PlainCollector {
-        PlainCollector::default()
-    }
-
-    /// A collector whose first model starts each mesh with the room given
-    /// (vertices and triangles per material, in order of first use), as
-    /// [`PlainCollector::room`] of an earlier collector tells it: a
-    /// generation's first lot on a worker then does not grow its arrays
-    /// by doubling (which cost a Candler building 16 M of its 70 M
-    /// instructions of collection).
-    pub fn with_room(room: Vec<(usize, usize)>) -> PlainCollector {
-        PlainCollector {
-            last_sizes: room,
-            ..PlainCollector::default()
+impl<M> Default for Collector<M> {
+    fn default() -> Self {
+        Collector {
+            prep: FacePrep::default(),
+            slots: SlotIds::default(),
+            table: MaterialTable::default(),
+            model: PlainModel::default(),
+            corner_vertex: Vec::new(),
+            last_sizes: Vec::new(),
         }
     }
+}
 
-    /// Vertices and triangles of each mesh of the model taken last, by
-    /// material in order of first use.
-    pub fn room(&self) -> &[(usize, usize)] {
-        &self.last_sizes
-    }
+/// The collectors' public face: the same methods for both kinds of mesh.
+macro_rules! collector_methods {
+    ($name:ident, $mesh:ty) => {
+        impl $name {
+            pub fn new() -> $name {
+                $name::default()
+            }
 
-    /// Adds one leaf's geometry given in its own coordinates, placed by
-    /// `transform`, with `materials` for its slots (as
-    /// [`ModelWriter::add_placed`](crate::ModelWriter::add_placed) takes
-    /// them); its triangles are marked with `leaf`.
-    pub fn add_placed(
+            /// A collector whose first model starts each mesh with the room
+            /// given (vertices and triangles per material, in order of first
+            /// use), as [`room`](Self::room) of an earlier collector tells
+            /// it: a generation's first lot on a worker then does not grow
+            /// its arrays by doubling (which cost a Candler building 16 M of
+            /// its 70 M instructions of collection).
+            pub fn with_room(room: Vec<(usize, usize)>) -> $name {
+                $name(Collector {
+                    last_sizes: room,
+                    ..Collector::default()
+                })
+            }
+
+            /// Vertices and triangles of each mesh of the model taken last,
+            /// by material in order of first use.
+            pub fn room(&self) -> &[(usize, usize)] {
+                &self.0.last_sizes
+            }
+
+            /// Adds one leaf's geometry given in its own coordinates, placed
+            /// by `transform`, with `materials` for its slots (as
+            /// [`ModelWriter::add_placed`](crate::ModelWriter::add_placed)
+            /// takes them); its triangles are marked with `leaf`.
+            pub fn add_placed(
+                &mut self,
+                mesh: &Mesh,
+                transform: Option<&DAffine3>,
+                materials: &SharedVec<Material>,
+                leaf: u32,
+            ) -> Result<(), ExportError> {
+                self.0.add_placed(mesh, transform, materials, leaf)
+            }
+
+            /// The model gathered so far; the collector starts a new one.
+            pub fn take(&mut self) -> PlainModel<$mesh> {
+                self.0.take()
+            }
+        }
+    };
+}
+
+collector_methods!(PlainCollector, PlainMesh);
+collector_methods!(DrawCollector, DrawMesh);
+
+impl<M: MeshArrays> Collector<M> {
+    fn add_placed(
         &mut self,
         mesh: &Mesh,
         transform: Option<&DAffine3>,
@@ -213,7 +352,7 @@ impl PlainCollector {
         leaf: u32,
     ) -> Result<(), ExportError> {
         check_mesh(mesh, materials.len())?;
-        let PlainCollector {
+        let Collector {
             prep,
             slots,
             table,
@@ -236,20 +375,17 @@ impl PlainCollector {
                     // grown by doubling were copied and faulted in again
                     // and again.
                     let (v, t) = last_sizes.get(id as usize).copied().unwrap_or_default();
-                    model
-                        .meshes
-                        .push(PlainMesh::with_capacity(id as usize, v, t));
+                    model.meshes.push(M::with_capacity(id as usize, v, t));
                 }
                 id
             });
             let out = &mut model.meshes[id as usize];
             let uvs = f.mesh.uvs[0].as_deref();
             model.faces += 1;
-            if let Some(first) = fan_start(f) {
-                push_fan(out, f, uvs, first, leaf);
-                return Ok(());
+            match fan_start(f) {
+                Some(first) => out.push_fan(f, uvs, first, leaf),
+                None => out.push_triangles(f, uvs, corner_vertex, leaf),
             }
-            push_triangles(out, f, uvs, corner_vertex, leaf);
             Ok(())
         });
         slots.end(materials);
@@ -257,27 +393,18 @@ impl PlainCollector {
         Ok(())
     }
 
-    /// The model gathered so far; the collector starts a new one.
-    pub fn take(&mut self) -> PlainModel {
+    fn take(&mut self) -> PlainModel<M> {
         self.table = MaterialTable::default();
         self.slots.clear();
         self.last_sizes.clear();
-        self.last_sizes.extend(
-            self.model
-                .meshes
-                .iter()
-                .map(|m| (m.positions.len(), m.indices.len())),
-        );
+        self.last_sizes
+            .extend(self.model.meshes.iter().map(MeshArrays::sizes));
         // A small lot after a large one started with the large one's room:
         // arrays holding less than half of their room are copied into
         // blocks of their size, so that a model its host keeps holds at
         // most about twice what it uses (as arrays grown by doubling do).
         for m in &mut self.model.meshes {
-            fit(&mut m.positions);
-            fit(&mut m.normals);
-            fit(&mut m.uvs);
-            fit(&mut m.indices);
-            fit(&mut m.triangle_leaf);
+            m.fit();
         }
         std::mem::take(&mut self.model)
     }
@@ -375,8 +502,8 @@ mod tests {
         );
         let transform = DAffine3::from_translation(DVec3::new(5.0, 1.0, 2.0));
         let mut prep = FacePrep::default();
-        let mut fans = PlainMesh::default();
-        let mut general = PlainMesh::default();
+        let mut fans = PlainMesh::with_capacity(0, 0, 0);
+        let mut general = PlainMesh::with_capacity(0, 0, 0);
         let mut scratch = vec![NO_VERTEX; m.corners.len()];
         let mut starts = Vec::new();
         prep.faces(&m, Some(&transform), |f| {
@@ -384,10 +511,10 @@ mod tests {
             let start = fan_start(f);
             starts.push(start);
             match start {
-                Some(first) => push_fan(&mut fans, f, uvs, first, 3),
-                None => push_triangles(&mut fans, f, uvs, &mut scratch, 3),
+                Some(first) => fans.push_fan(f, uvs, first, 3),
+                None => fans.push_triangles(f, uvs, &mut scratch, 3),
             }
-            push_triangles(&mut general, f, uvs, &mut scratch, 3);
+            general.push_triangles(f, uvs, &mut scratch, 3);
             Ok(())
         })
         .unwrap();
@@ -412,8 +539,8 @@ mod tests {
         let mut next = PlainCollector::with_room(c.room().to_vec());
         next.add_placed(&cube, None, &cube.materials, 0).unwrap();
         // Collecting, the mesh has the room given.
-        assert!(next.model.meshes[0].positions.capacity() >= 48);
-        assert!(next.model.meshes[0].triangle_leaf.capacity() >= 24);
+        assert!(next.0.model.meshes[0].positions.capacity() >= 48);
+        assert!(next.0.model.meshes[0].triangle_leaf.capacity() >= 24);
         let second = next.take();
         let mut fresh = PlainCollector::new();
         fresh.add_placed(&cube, None, &cube.materials, 0).unwrap();
@@ -431,8 +558,8 @@ mod tests {
         let first = c.take();
         // The next lot's mesh starts with room for the first one's...
         c.add_placed(&cube, None, &cube.materials, 0).unwrap();
-        assert!(c.model.meshes[0].positions.capacity() >= 96);
-        assert!(c.model.meshes[0].indices.capacity() >= 48);
+        assert!(c.0.model.meshes[0].positions.capacity() >= 96);
+        assert!(c.0.model.meshes[0].indices.capacity() >= 48);
         let second = c.take();
         // ...and, using a quarter of it, is handed over holding about what
         // it uses.

@@ -350,7 +350,7 @@ impl Preview {
             }
         }
         let t = Instant::now();
-        let outcome = rules.generate_all(&self.lots, &options);
+        let outcome = encode::drawn(rules, &self.lots, &options, self.origin);
         let gen_ms = t.elapsed().as_secs_f64() * 1e3;
         self.running.lock().unwrap().take();
         match outcome {
@@ -447,8 +447,8 @@ impl Preview {
             "failed": results.iter().filter(|l| l.error.is_some()).count(),
             "shapes": results.iter().map(|l| l.shapes).sum::<usize>(),
             "leaves": results.iter().map(|l| l.leaf_count).sum::<usize>(),
-            "faces": results.iter().map(|l| l.model.faces).sum::<u64>(),
-            "triangles": results.iter().map(|l| l.model.triangles()).sum::<usize>(),
+            "faces": results.iter().map(|l| l.drawing.faces).sum::<u64>(),
+            "triangles": results.iter().map(|l| l.drawing.triangles()).sum::<usize>(),
             "load_ms": load_ms,
             "generate_ms": made_by.as_ref().map(|m| m.generate_ms).unwrap_or(gen_ms),
             // Making the bytes the page fetches.
@@ -679,7 +679,7 @@ fn lot_outlines(engine: &Engine, root: &Path, lots: &[Lot], origin: [f64; 3]) ->
         root.join("cga-serve-lots.cga"),
         "Lot --> color(\"#9a9a92\") Ground.\n",
     );
-    match rules.generate_all(lots, &Options::default()) {
+    match encode::drawn(&rules, lots, &Options::default(), origin) {
         Ok(results) => encode::model(&results, origin, &mut |_| None),
         Err(_) => encode::model(&[], origin, &mut |_| None),
     }

@@ -1,6 +1,7 @@
 //! How long generating lots into plain meshes takes (what the Python
-//! package and the live preview ask the library for), against deriving
-//! them without geometry, best and median of several runs:
+//! package asks the library for; with `DRAWING=1` also into meshes to
+//! draw, what the live preview asks for), against deriving them without
+//! geometry, best and median of several runs:
 //!
 //!     cargo run --release -p cga --example meshes_bench -- RULES.cga LOTSPEC [RUNS]
 //!
@@ -32,20 +33,17 @@ fn main() {
         Some(jobs) => Options::default().jobs(jobs),
         None => Options::default(),
     };
-    let time = |meshes: bool| {
+    // The lots' results are kept until the run ends, as a caller that
+    // uses them does.
+    let time = |target: &dyn Fn() -> Target<'static>| {
         let mut times: Vec<f64> = (0..runs)
             .map(|_| {
                 let t = Instant::now();
-                if meshes {
-                    let out = rules.generate_all(&lots, &options).expect("generates");
-                    std::hint::black_box(out);
-                } else {
-                    rules
-                        .generate_lots(&lots, &options, Target::Nothing, |r| {
-                            std::hint::black_box(r);
-                        })
-                        .expect("generates");
-                }
+                let mut out = Vec::new();
+                rules
+                    .generate_lots(&lots, &options, target(), |r| out.push(r))
+                    .expect("generates");
+                std::hint::black_box(out);
                 t.elapsed().as_secs_f64() * 1e3
             })
             .collect();
@@ -54,7 +52,11 @@ fn main() {
     };
     // MESHES_ONLY=1 skips the derivation-only runs (for a profiler).
     let meshes_only = std::env::var_os("MESHES_ONLY").is_some();
-    let (best, median) = if meshes_only { (0.0, 0.0) } else { time(false) };
+    let (best, median) = if meshes_only {
+        (0.0, 0.0)
+    } else {
+        time(&|| Target::Nothing)
+    };
     println!(
         "{} lots, derivation only: best {best:.1} ms, median {median:.1} ms",
         lots.len()
@@ -63,9 +65,17 @@ fn main() {
     if std::env::var_os("DERIVATION_ONLY").is_some() {
         return;
     }
-    let (best, median) = time(true);
+    let (best, median) = time(&|| Target::Meshes);
     println!(
         "{} lots, plain meshes:    best {best:.1} ms, median {median:.1} ms",
         lots.len()
     );
+    // DRAWING=1 also times meshes to draw (what the preview collects).
+    if std::env::var_os("DRAWING").is_some() {
+        let (best, median) = time(&|| Target::Drawing([0.0; 3]));
+        println!(
+            "{} lots, meshes to draw: best {best:.1} ms, median {median:.1} ms",
+            lots.len()
+        );
+    }
 }

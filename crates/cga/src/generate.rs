@@ -7,8 +7,8 @@ use cga_engine::context::{LotContext, SceneContext};
 use cga_engine::derive::{Leaf, RtErrorKind};
 use cga_engine::generate::{collect_lot, generate_lot_streaming};
 use cga_engine::{GenerateOptions, LotOutput, RtError};
-use cga_export::{Encoder, ModelWriter, PlainCollector};
-use cga_geometry::DVec3;
+use cga_export::{DrawCollector, DrawModel, Encoder, ModelWriter, PlainCollector, PlainModel};
+use cga_geometry::{DAffine3, DVec3};
 
 use crate::diagnostics::Diagnostic;
 use crate::lots::Lot;
@@ -25,6 +25,9 @@ pub enum Target<'w> {
     Nothing,
     /// Into each lot's [`LotResult::model`], as plain arrays.
     Meshes,
+    /// Into each lot's [`LotResult::drawing`], as a viewer draws them
+    /// (see [`DrawModel`]): positions relative to this origin.
+    Drawing([f64; 3]),
     /// Into a model file (streamed: memory does not grow with the lots).
     Writer(&'w mut ModelWriter),
     /// Into models that follow one another, each lot wholly into one (the
@@ -178,11 +181,12 @@ impl Rules {
             return Err(Error::Cancelled);
         }
 
-        let (mut out, keep_meshes) = match target {
-            Target::Nothing => (Out::None, false),
-            Target::Meshes => (Out::None, true),
-            Target::Writer(w) => (Out::One(w), false),
-            Target::PerLot(w) => (Out::PerLot(w), false),
+        let (mut out, keep) = match target {
+            Target::Nothing => (Out::None, None),
+            Target::Meshes => (Out::None, Some(Keep::Plain)),
+            Target::Drawing(origin) => (Out::None, Some(Keep::Drawing(DVec3::from(origin)))),
+            Target::Writer(w) => (Out::One(w), None),
+            Target::PerLot(w) => (Out::PerLot(w), None),
         };
         // Leaves go to the calling thread in batches as they are emitted,
         // so that writing the model overlaps deriving it, even for a single
@@ -205,8 +209,17 @@ impl Rules {
         let new_batcher = || match &encoder {
             Some(e) if workers_encode => Batcher::Encode(Box::new(e.another()), 0),
             _ if has_writer => Batcher::Leaves(Vec::new()),
-            _ if keep_meshes => Batcher::Plain(Box::new(self.plain_collector()), 0),
-            _ => Batcher::Drop,
+            _ => match keep {
+                Some(Keep::Plain) => {
+                    Batcher::Plain(Box::new(self.collector(PlainCollector::with_room)), 0)
+                }
+                Some(Keep::Drawing(origin)) => Batcher::Draw(
+                    Box::new(self.collector(DrawCollector::with_room)),
+                    0,
+                    DAffine3::from_translation(-origin),
+                ),
+                None => Batcher::Drop,
+            },
         };
         let mut own_batcher = match &encoder {
             Some(e) if !workers_encode => Some(Batcher::Encode(Box::new(e.another()), 0)),
@@ -301,12 +314,17 @@ impl Rules {
                 },
             );
             batcher.flush(send);
-            let model = batcher.take_model();
-            if let Batcher::Plain(collector, _) = batcher {
+            let (model, drawing) = batcher.take_model();
+            let kept = match batcher {
+                Batcher::Plain(collector, _) => Some(collector.room()),
+                Batcher::Draw(collector, ..) => Some(collector.room()),
+                _ => None,
+            };
+            if let Some(kept) = kept {
                 let mut room = self.mesh_room();
-                if room.as_slice() != collector.room() {
+                if room.as_slice() != kept {
                     room.clear();
-                    room.extend_from_slice(collector.room());
+                    room.extend_from_slice(kept);
                 }
             }
             Done {
@@ -314,6 +332,7 @@ impl Rules {
                 error,
                 leaves,
                 model,
+                drawing,
                 origins,
             }
         };
@@ -345,17 +364,18 @@ impl Rules {
             .unwrap_or_else(|e| e.into_inner())
     }
 
-    /// A collector of plain meshes for a worker, starting with the room the
+    /// A collector of meshes for a worker (`with_room` of
+    /// [`PlainCollector`] or [`DrawCollector`]), starting with the room the
     /// rules' last lot took, at most [`KEPT_ROOM`] vertices and triangles a
     /// material (one huge lot does not make every later lot reserve its
     /// size).
-    fn plain_collector(&self) -> PlainCollector {
+    fn collector<C>(&self, with_room: impl FnOnce(Vec<(usize, usize)>) -> C) -> C {
         let room = self
             .mesh_room()
             .iter()
             .map(|&(v, t)| (v.min(KEPT_ROOM), t.min(KEPT_ROOM)))
             .collect();
-        PlainCollector::with_room(room)
+        with_room(room)
     }
 
     /// The engine's options for `options`: attribute names resolved.
@@ -512,6 +532,7 @@ impl Rules {
             error,
             leaves,
             model,
+            drawing,
             origins,
         } = done;
         let LotOutput {
@@ -525,6 +546,7 @@ impl Rules {
             index,
             name: lot.name.clone(),
             model,
+            drawing,
             leaves: origins,
             leaf_count: leaves,
             prints,
@@ -577,8 +599,16 @@ struct Done {
     out: LotOutput,
     error: Option<RtError>,
     leaves: usize,
-    model: cga_export::PlainModel,
+    model: PlainModel,
+    drawing: DrawModel,
     origins: Vec<LeafOrigin>,
+}
+
+/// The meshes a generation keeps of each lot.
+enum Keep {
+    Plain,
+    /// Positions relative to this origin.
+    Drawing(DVec3),
 }
 
 /// Writes a piece of a lot's output.
@@ -622,6 +652,9 @@ enum Batcher {
     Encode(Box<cga_export::Encoder>, usize),
     /// Plain meshes of the lot, and the number of leaves added so far.
     Plain(Box<PlainCollector>, u32),
+    /// Meshes to draw, the number of leaves added so far, and the move
+    /// from the frame to the origin the positions are relative to.
+    Draw(Box<DrawCollector>, u32, DAffine3),
 }
 
 impl Batcher {
@@ -665,6 +698,12 @@ impl Batcher {
                 );
                 *added += 1;
             }
+            Batcher::Draw(collector, added, shift) => {
+                // Moved to the origin before rounding to `f32`.
+                let placed = *shift * leaf.transform;
+                let _ = collector.add_placed(&leaf.mesh, Some(&placed), &leaf.materials, *added);
+                *added += 1;
+            }
         }
     }
 
@@ -676,7 +715,7 @@ impl Batcher {
         program: &cga_engine::Program,
         origins: &mut Vec<LeafOrigin>,
     ) {
-        if let Batcher::Plain(..) = self {
+        if let Batcher::Plain(..) | Batcher::Draw(..) = self {
             origins.push(LeafOrigin {
                 rule: leaf.rule.map(RuleRef),
                 shape: program.symbols[leaf.name as usize].clone(),
@@ -687,7 +726,7 @@ impl Batcher {
     /// Sends what was gathered (at the end of a lot).
     fn flush(&mut self, send: &mut dyn FnMut(Piece)) {
         match self {
-            Batcher::Drop | Batcher::Plain(..) => {}
+            Batcher::Drop | Batcher::Plain(..) | Batcher::Draw(..) => {}
             Batcher::Leaves(batch) => {
                 if !batch.is_empty() {
                     send(Piece::Leaves(std::mem::take(batch)));
@@ -702,21 +741,75 @@ impl Batcher {
         }
     }
 
-    /// The plain meshes of the lot that ended (empty unless kept).
-    fn take_model(&mut self) -> cga_export::PlainModel {
+    /// The plain meshes and the meshes to draw of the lot that ended
+    /// (empty unless kept).
+    fn take_model(&mut self) -> (PlainModel, DrawModel) {
         match self {
             Batcher::Plain(collector, added) => {
                 *added = 0;
-                collector.take()
+                (collector.take(), DrawModel::default())
             }
-            _ => cga_export::PlainModel::default(),
+            Batcher::Draw(collector, added, _) => {
+                *added = 0;
+                (PlainModel::default(), collector.take())
+            }
+            _ => Default::default(),
         }
     }
 }
 
 #[cfg(test)]
 mod tests {
-    use crate::{lots, Engine, MemoryWorld, Options};
+    use crate::{lots, Engine, MemoryWorld, Options, Target};
+
+    /// Meshes to draw hold the plain meshes' vertices relative to the
+    /// origin asked for, in `f32`, and name the same leaves.
+    #[test]
+    fn meshes_to_draw_are_the_plain_meshes_moved_and_rounded() {
+        let rules = Engine::new(MemoryWorld::new()).load_text(
+            "/p/rules/r.cga",
+            "Lot --> extrude(10) comp(f) { side : split(x) { ~2 : color(\"#a04020\") W. }* | all : Top. }\n",
+        );
+        let lot = lots::rect(30.0, 12.0);
+        let plain = rules.generate(&lot, &Options::default()).unwrap();
+        let origin = [1000.0, 0.0, -500.0];
+        let mut drawn = Vec::new();
+        rules
+            .generate_lots(
+                std::slice::from_ref(&lot),
+                &Options::default(),
+                Target::Drawing(origin),
+                |r| drawn.push(r),
+            )
+            .unwrap();
+        let drawn = drawn.pop().unwrap();
+        assert!(drawn.model.meshes.is_empty());
+        assert_eq!(drawn.drawing.materials, plain.model.materials);
+        assert_eq!(drawn.drawing.triangles(), plain.model.triangles());
+        assert_eq!(drawn.leaves, plain.leaves);
+        for (p, d) in plain.model.meshes.iter().zip(&drawn.drawing.meshes) {
+            assert_eq!(p.indices, d.indices());
+            for (p, d) in p.positions.iter().zip(&d.positions) {
+                for a in 0..3 {
+                    // Within a step of `f32` (the leaves' transforms are
+                    // composed with the move before rounding).
+                    let want = (p[a] - origin[a]) as f32;
+                    assert!((want - d[a]).abs() <= f32::EPSILON * want.abs().max(1.0));
+                }
+            }
+            for t in 0..p.indices.len() {
+                let m = p.material;
+                assert_eq!(
+                    plain.provenance(&rules, m, t),
+                    drawn.provenance(&rules, m, t)
+                );
+            }
+        }
+        assert_eq!(
+            drawn.provenance(&rules, 0, 0).unwrap().rule.as_deref(),
+            Some("Lot")
+        );
+    }
 
     /// The rules keep the room of the last lot collected as plain meshes,
     /// for the next call's collectors; generating without meshes keeps it.
@@ -741,7 +834,12 @@ mod tests {
         assert_eq!(sizes.iter().map(|s| s.1).sum::<usize>(), 2 * (4 * 20 + 2));
         assert_eq!(room(), sizes);
         // The next call's collectors start with it.
-        assert_eq!(rules.plain_collector().room(), sizes.as_slice());
+        assert_eq!(
+            rules
+                .collector(cga_export::PlainCollector::with_room)
+                .room(),
+            sizes.as_slice()
+        );
         let small = lots::rect(4.0, 4.0);
         rules
             .generate_lots(
@@ -758,6 +856,11 @@ mod tests {
         // A huge lot's room is kept only up to a bound.
         *rules.mesh_room() = vec![(10, 20), (usize::MAX, 1 << 30)];
         let capped = [(10, 20), (super::KEPT_ROOM, super::KEPT_ROOM)];
-        assert_eq!(rules.plain_collector().room(), capped.as_slice());
+        assert_eq!(
+            rules
+                .collector(cga_export::PlainCollector::with_room)
+                .room(),
+            capped.as_slice()
+        );
     }
 }

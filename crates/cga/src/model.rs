@@ -2,7 +2,7 @@
 
 use std::sync::Arc;
 
-pub use cga_export::{PlainMesh, PlainModel};
+pub use cga_export::{DrawFaces, DrawMesh, DrawModel, PlainMesh, PlainModel};
 pub use cga_geometry::Material;
 use cga_value::Value;
 
@@ -19,8 +19,12 @@ pub struct LotResult {
     /// Triangles by material, when meshes were asked for
     /// ([`Target::Meshes`](crate::Target::Meshes)); empty otherwise.
     pub model: PlainModel,
-    /// Where each leaf of `model` comes from, by the leaf numbers of
-    /// [`PlainMesh::triangle_leaf`]; empty unless meshes were asked for.
+    /// Triangles by material as a viewer draws them, when asked for
+    /// ([`Target::Drawing`](crate::Target::Drawing)); empty otherwise.
+    pub drawing: DrawModel,
+    /// Where each leaf of `model` (or `drawing`) comes from, by the leaf
+    /// numbers of [`PlainMesh::triangle_leaf`]; empty unless meshes were
+    /// asked for.
     pub leaves: Vec<LeafOrigin>,
     /// Leaf shapes made (also when no meshes were kept).
     pub leaf_count: usize,
@@ -58,9 +62,15 @@ pub struct Provenance {
 }
 
 impl LotResult {
-    /// Where the triangle `triangle` of `model.meshes[mesh]` comes from.
+    /// Where the triangle `triangle` of `model.meshes[mesh]` (or, when
+    /// the meshes kept were to draw, of `drawing.meshes[mesh]`) comes
+    /// from.
     pub fn provenance(&self, rules: &Rules, mesh: usize, triangle: usize) -> Option<Provenance> {
-        let leaf = *self.model.meshes.get(mesh)?.triangle_leaf.get(triangle)?;
+        let leaves = match self.model.meshes.get(mesh) {
+            Some(m) => &m.triangle_leaf,
+            None => &self.drawing.meshes.get(mesh)?.triangle_leaf,
+        };
+        let leaf = *leaves.get(triangle)?;
         let origin = self.leaves.get(leaf as usize)?;
         Some(rules.provenance(origin))
     }

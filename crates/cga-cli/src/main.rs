@@ -296,6 +296,9 @@ fn main() -> ExitCode {
                 workspaces,
                 max_seconds,
             } => {
+                // Edits are answered in a few hundred milliseconds: no
+                // stalls for the kernel's compaction of huge pages.
+                cga_alloc::allow_huge_pages(false);
                 let mut config = cga_serve::Config::new(rules);
                 config.lots = lots;
                 config.port = port;

@@ -29,6 +29,20 @@ pub enum DrawFaces {
     Triangles(Vec<[u32; 3]>),
 }
 
+/// How a [`DrawMesh`]'s normals are given: bytes, each coordinate
+/// `round(n * 127)` (see [`normal_byte`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum DrawNormals {
+    /// One per face, in face order, for every corner of the face: while
+    /// every face is flat (all its corners' normals the same bytes) and a
+    /// fan
+    /// ([`DrawFaces::Fans`], which gives each face's number of
+    /// vertices). A quad's normal is then 3 bytes instead of 12.
+    PerFace(Vec<[i8; 3]>),
+    /// One per vertex.
+    PerVertex(Vec<[i8; 3]>),
+}
+
 /// The triangles of one material, as a viewer draws them: the vertices and
 /// triangles of the [`PlainMesh`](crate::PlainMesh) of the same leaves, in
 /// smaller types.
@@ -39,9 +53,8 @@ pub struct DrawMesh {
     /// Vertex positions as placed, rounded to `f32` (leaves are placed
     /// relative to an origin near them: `f32` keeps about 7 digits).
     pub positions: Vec<[f32; 3]>,
-    /// Unit normal per vertex (the mesh's own, else its face's), each
-    /// coordinate as `round(n * 127)`.
-    pub normals: Vec<[i8; 3]>,
+    /// Unit normals (the mesh's own, else the face's).
+    pub normals: DrawNormals,
     /// Texture coordinates of UV set 0 per vertex; (0, 0) where the face
     /// has none.
     pub uvs: Vec<[f32; 2]>,
@@ -76,8 +89,47 @@ impl DrawMesh {
         }
     }
 
-    /// Holds the triangles as indices from now on.
+    /// The normal of each vertex, whichever way they are held.
+    pub fn vertex_normals(&self) -> Vec<[i8; 3]> {
+        match (&self.normals, &self.faces) {
+            (DrawNormals::PerVertex(n), _) => n.clone(),
+            (DrawNormals::PerFace(n), DrawFaces::Fans(sizes)) => {
+                per_vertex(n, sizes, self.positions.len())
+            }
+            (DrawNormals::PerFace(_), DrawFaces::Triangles(_)) => {
+                unreachable!("normals per face are held with fans only")
+            }
+        }
+    }
+
+    /// Holds the normals per vertex from now on.
+    fn as_vertex_normals(&mut self) -> &mut Vec<[i8; 3]> {
+        if let DrawNormals::PerFace(_) = &self.normals {
+            self.normals = DrawNormals::PerVertex(self.vertex_normals());
+        }
+        match &mut self.normals {
+            DrawNormals::PerVertex(n) => n,
+            DrawNormals::PerFace(_) => unreachable!("made per vertex above"),
+        }
+    }
+
+    /// Holds the normals per vertex from now on, while the last face
+    /// counted in the fans has no normals yet (its own are added next).
+    fn normals_without_last_face(&mut self) -> &mut Vec<[i8; 3]> {
+        if let (DrawNormals::PerFace(n), DrawFaces::Fans(sizes)) = (&self.normals, &self.faces) {
+            let before = &sizes[..sizes.len().saturating_sub(1)];
+            self.normals = DrawNormals::PerVertex(per_vertex(n, before, self.positions.len()));
+        }
+        match &mut self.normals {
+            DrawNormals::PerVertex(n) => n,
+            DrawNormals::PerFace(_) => unreachable!("held with indices, made per vertex"),
+        }
+    }
+
+    /// Holds the triangles as indices (and so the normals per vertex)
+    /// from now on.
     fn as_triangles(&mut self) -> &mut Vec<[u32; 3]> {
+        self.as_vertex_normals();
         if let DrawFaces::Fans(sizes) = &self.faces {
             self.faces = DrawFaces::Triangles(fan_indices(sizes, self.triangle_leaf.len()));
         }
@@ -86,6 +138,16 @@ impl DrawMesh {
             DrawFaces::Fans(_) => unreachable!("made indices above"),
         }
     }
+}
+
+/// Normals given per face as per vertex, each face's for its `sizes[f]`
+/// vertices.
+fn per_vertex(normals: &[[i8; 3]], sizes: &[u8], vertices: usize) -> Vec<[i8; 3]> {
+    let mut out = Vec::with_capacity(vertices);
+    for (n, &k) in normals.iter().zip(sizes) {
+        out.extend(std::iter::repeat_n(*n, k as usize));
+    }
+    out
 }
 
 /// The triangles of faces given as fans (see [`DrawFaces::Fans`]).
@@ -105,9 +167,9 @@ impl MeshArrays for DrawMesh {
         DrawMesh {
             material,
             positions: Vec::with_capacity(vertices),
-            normals: Vec::with_capacity(vertices),
-            uvs: Vec::with_capacity(vertices),
             // Most faces are quads: two triangles a face.
+            normals: DrawNormals::PerFace(Vec::with_capacity(triangles / 2)),
+            uvs: Vec::with_capacity(vertices),
             faces: DrawFaces::Fans(Vec::with_capacity(triangles / 2)),
             triangle_leaf: Vec::with_capacity(triangles),
         }
@@ -126,23 +188,41 @@ impl MeshArrays for DrawMesh {
                 .clone()
                 .map(|c| f32s(f.positions[f.mesh.corners[c] as usize].to_array())),
         );
-        let byte = |n: cga_geometry::DVec3| n.to_array().map(normal_byte);
-        match f.normals {
-            Some(normals) => self
-                .normals
-                .extend(corners.clone().map(|c| byte(normals[c]))),
-            None => self.normals.extend(std::iter::repeat_n(byte(f.normal), n)),
-        }
-        self.uvs.extend(corners.map(|c| {
+        self.uvs.extend(corners.clone().map(|c| {
             uvs.and_then(|u| u.get(c))
                 .map_or([0.0; 2], |t| f32s(t.to_array()))
         }));
+        // Corner counts before normals: a face that cannot be a fan
+        // makes the normals per vertex.
         match &mut self.faces {
             DrawFaces::Fans(sizes) if n <= u8::MAX as usize => sizes.push(n as u8),
             _ => {
                 let n = n as u32;
                 self.as_triangles()
                     .extend((1..n - 1).map(|k| [base, base + k, base + k + 1]));
+            }
+        }
+        let byte = |n: cga_geometry::DVec3| n.to_array().map(normal_byte);
+        // A face is flat where its corners' normals are one byte triple:
+        // every face without normals of its own, and most that have them
+        // (an inserted box's).
+        let flat = match f.normals {
+            None => Some(byte(f.normal)),
+            Some(own) => {
+                let mut bytes = corners.clone().map(|c| byte(own[c]));
+                let first = bytes.next();
+                first.filter(|b| bytes.all(|o| o == *b))
+            }
+        };
+        match (flat, &mut self.normals) {
+            (Some(b), DrawNormals::PerFace(normals)) => normals.push(b),
+            (Some(b), DrawNormals::PerVertex(normals)) => normals.extend(std::iter::repeat_n(b, n)),
+            (None, _) => {
+                // The face's count is in the fans already: the normals
+                // before it are made per vertex without it.
+                let own = f.normals.expect("only faces with normals are not flat");
+                let mine = self.normals_without_last_face();
+                mine.extend(corners.map(|c| byte(own[c])));
             }
         }
         self.triangle_leaf.extend(std::iter::repeat_n(leaf, n - 2));
@@ -159,14 +239,14 @@ impl MeshArrays for DrawMesh {
         self.as_triangles();
         let DrawMesh {
             positions,
-            normals,
+            normals: DrawNormals::PerVertex(normals),
             uvs: out_uvs,
             faces: DrawFaces::Triangles(indices),
             triangle_leaf,
             ..
         } = self
         else {
-            unreachable!("made indices above")
+            unreachable!("made indices and normals per vertex above")
         };
         each_triangle(
             f,
@@ -189,7 +269,9 @@ impl MeshArrays for DrawMesh {
 
     fn fit(&mut self) {
         fit(&mut self.positions);
-        fit(&mut self.normals);
+        match &mut self.normals {
+            DrawNormals::PerFace(v) | DrawNormals::PerVertex(v) => fit(v),
+        }
         fit(&mut self.uvs);
         match &mut self.faces {
             DrawFaces::Fans(v) => fit(v),
@@ -274,7 +356,7 @@ mod tests {
             let f32s = |v: &[[f64; 3]]| v.iter().map(|p| p.map(|c| c as f32)).collect::<Vec<_>>();
             assert_eq!(f32s(&p.positions), d.positions);
             let bytes: Vec<[i8; 3]> = p.normals.iter().map(|n| n.map(normal_byte)).collect();
-            assert_eq!(bytes, d.normals);
+            assert_eq!(bytes, d.vertex_normals());
             let uvs: Vec<[f32; 2]> = p.uvs.iter().map(|t| t.map(|c| c as f32)).collect();
             assert_eq!(uvs, d.uvs);
             assert_eq!(p.indices, d.indices());
@@ -291,6 +373,11 @@ mod tests {
         // Only fans: faces as corner counts.
         let draw = assert_rounded_plain(&[(cube.clone(), shift), (cube.clone(), turned)]);
         assert_eq!(draw.meshes[0].faces, DrawFaces::Fans(vec![4; 12]));
+        // Flat faces: a normal per face.
+        let DrawNormals::PerFace(n) = &draw.meshes[0].normals else {
+            panic!("{:?}", draw.meshes[0].normals)
+        };
+        assert_eq!(n.len(), 12);
         // A face that is no fan: every triangle as indices from then on,
         // those of the fans before it too.
         let draw = assert_rounded_plain(&[(cube.clone(), shift), (faces(), turned), (cube, shift)]);
@@ -298,11 +385,23 @@ mod tests {
             panic!("{:?}", draw.meshes[0].faces)
         };
         assert_eq!(t.len(), 12 + 3 + 2 + 6 + 8 + 1 + 12);
+        assert_eq!(
+            draw.meshes[0].normals,
+            DrawNormals::PerVertex(draw.meshes[0].vertex_normals())
+        );
         // The mesh's own normals, per corner.
         let mut sphere = cga_geometry::primitive::sphere(8, 6, DVec3::splat(3.0));
         assert!(sphere.normals.is_some());
         sphere.uvs[0] = None;
-        assert_rounded_plain(&[(sphere, turned)]);
+        assert_rounded_plain(&[(sphere.clone(), turned)]);
+        // Flat faces, then a face with normals of its own (the normals
+        // before it given to their vertices), then flat ones again.
+        let cube = cga_geometry::primitive::cube(DVec3::ONE);
+        let draw = assert_rounded_plain(&[(cube.clone(), shift), (sphere, shift), (cube, turned)]);
+        let DrawNormals::PerVertex(n) = &draw.meshes[0].normals else {
+            panic!("{:?}", draw.meshes[0].normals)
+        };
+        assert_eq!(n.len(), draw.meshes[0].positions.len());
     }
 
     #[test]

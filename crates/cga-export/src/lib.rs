@@ -51,7 +51,7 @@ use std::sync::Arc;
 
 use cga_world::World;
 
-pub use crate::draw::{normal_byte, DrawFaces, DrawMesh, DrawModel};
+pub use crate::draw::{normal_byte, DrawFaces, DrawMesh, DrawModel, DrawNormals};
 pub use crate::encode::{Encoded, Encoder};
 use crate::encode::{EncoderShared, MeshEncoder};
 pub use crate::gltf::{Output, DEFAULT_FLUSH_MIB};

@@ -35,7 +35,14 @@ fn main() {
     let mut times: Vec<f64> = (0..runs)
         .map(|_| {
             let t = Instant::now();
-            let model = cga_serve::encode::model(&results, [0.0; 3], &mut |p| Some(p.to_string()));
+            // Into the buffer of the run before, as the preview reuses
+            // its models' buffers.
+            let model = cga_serve::encode::model_into(
+                &results,
+                [0.0; 3],
+                &mut |p| Some(p.to_string()),
+                std::mem::take(&mut last),
+            );
             bytes = model.len();
             let took = t.elapsed().as_secs_f64() * 1e3;
             last = model;

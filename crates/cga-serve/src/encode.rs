@@ -6,7 +6,8 @@
 //! "CGAM"  u32 header length H  u32 data length D
 //! data (D bytes): per mesh, positions (u16 x 3 per vertex, quantised: see below),
 //!       texture coordinates (only for textured meshes: u16 x 2 quantised,
-//!       or f32 x 2: "uv_bytes"), normals (i8 x 3, x 127), then either
+//!       or f32 x 2: "uv_bytes"), normals (i8 x 3, x 127, per vertex or,
+//!       "face_normals", per face), then either
 //!       the corner counts of its faces (u8 per face: "fans", see below)
 //!       or indices (u16 or u32 x 3 per triangle: "index_bytes");
 //!       each array padded to 4 bytes
@@ -15,7 +16,7 @@
 //!
 //! The header: `{"origin": [x, y, z], "bounds": {"min", "max"} | null,
 //! "lots": [{"index", "name", "meshes": [{"mesh", "vertices",
-//! "triangles", "positions", "min", "extent", "normals", "uvs",
+//! "triangles", "positions", "min", "extent", "normals", "face_normals", "uvs",
 //! "uv_bytes", "uv_min", "uv_extent", "indices", "index_bytes", "fans", "color",
 //! "opacity", "material", "double_sided", "texture"}]}]}`,
 //! coordinates relative to `origin` (the lots' centre when they lie far
@@ -24,7 +25,8 @@
 //! 16-bit numbers `q`: one scale for all axes (the mesh's largest side),
 //! so that the page can draw the numbers as they are, scaled, without
 //! bending the normals; a step is the largest side / 65535 (1.5 mm for a
-//! building of 100 m). `bounds` are the model's exact bounds. The header
+//! building of 100 m). `bounds` are the model's bounds (of its positions
+//! as collected: `f32` relative to the origin). The header
 //! comes last because the boxes are known only once the positions have
 //! been read: each mesh is measured and written in one visit, while its
 //! arrays are in the cache. The meshes are the lots' [`cga::DrawModel`]s,
@@ -43,7 +45,11 @@
 //! each face (`"fans"`: how many faces; `"index_bytes"` 0) and the page
 //! makes the same triangles from them: a byte a face instead of 6 or 12
 //! bytes a triangle (Candler's street: 9.1 of its 33.5 MB were indices).
-//! Other meshes send their indices.
+//! Other meshes send their indices. A mesh of fans whose faces are all
+//! flat ([`cga::DrawNormals::PerFace`]) sends a normal per face
+//! (`"face_normals": true`) and the page gives it to the face's
+//! vertices: 3 bytes a quad instead of 12 (Candler's street: about 4 of
+//! its 25 MB).
 //!
 //! Texture coordinates with 2 bytes are `uv_min + q / 65535 * uv_extent` per
 //! axis, for meshes whose coordinates span at most [`UV_SPAN`] (a step
@@ -209,7 +215,7 @@ impl Uvs {
 /// quantised.
 struct Placed<'a> {
     lot: usize,
-    /// The mesh's number in its lot's plain model.
+    /// The mesh's number in its lot's drawing.
     number: usize,
     mesh: &'a cga::DrawMesh,
     material: Option<&'a cga::Material>,
@@ -219,7 +225,8 @@ struct Placed<'a> {
     min: [f64; 3],
     max: [f64; 3],
     uvs: Uvs,
-    normals: bool,
+    /// How many normals are sent: one per vertex, or per face.
+    normals: usize,
     short: bool,
     /// The faces' corner counts, sent instead of indices (see
     /// [`cga::DrawFaces::Fans`]).
@@ -257,6 +264,13 @@ impl Placed<'_> {
         (self.min, self.max) = bounds(&self.mesh.positions);
         let [positions, uvs, normals, indices, end] = self.at;
         let base = positions;
+        // The buffer may hold an earlier model: the padding of the arrays
+        // that have some is zeroed, their bytes written over it.
+        for (from, to) in [(positions, uvs), (normals, indices), (indices, end)] {
+            let region = &mut out[from - base..to - base];
+            let n = region.len();
+            region[n.saturating_sub(3)..].fill(0);
+        }
         let scale = STEPS / self.extent();
         let mesh = self.mesh;
         write_steps(
@@ -280,9 +294,8 @@ impl Placed<'_> {
             }
         }
         // Unit normals need no more than a byte per coordinate.
-        if self.normals {
-            write_normals(&mesh.normals, &mut out[normals - base..indices - base]);
-        }
+        let (cga::DrawNormals::PerFace(n) | cga::DrawNormals::PerVertex(n)) = &mesh.normals;
+        write_normals(n, &mut out[normals - base..indices - base]);
         let out = &mut out[indices - base..end - base];
         match &mesh.faces {
             cga::DrawFaces::Fans(fans) => out[..fans.len()].copy_from_slice(fans),
@@ -322,6 +335,18 @@ pub fn model(
     origin: [f64; 3],
     texture: &mut dyn FnMut(&str) -> Option<String>,
 ) -> Vec<u8> {
+    model_into(results, origin, texture, Vec::new())
+}
+
+/// [`model`], written into `out` (its contents replaced): a buffer kept
+/// from an earlier model is written without the page faults of fresh
+/// memory (tens of megabytes for a street).
+pub fn model_into(
+    results: &[LotResult],
+    origin: [f64; 3],
+    texture: &mut dyn FnMut(&str) -> Option<String>,
+    mut out: Vec<u8>,
+) -> Vec<u8> {
     // What each mesh sends, its texture coordinates' boxes (on all
     // cores), where everything goes; then the positions' boxes, the
     // arrays and the header: boxes and arrays on all cores (tens of
@@ -352,7 +377,9 @@ pub fn model(
                 min: [0.0; 3],
                 max: [0.0; 3],
                 uvs,
-                normals: mesh.normals.len() == vertices,
+                normals: match &mesh.normals {
+                    cga::DrawNormals::PerFace(n) | cga::DrawNormals::PerVertex(n) => n.len(),
+                },
                 short: vertices <= 1 << 16,
                 fans: match &mesh.faces {
                     cga::DrawFaces::Fans(sizes) => Some(sizes),
@@ -373,12 +400,7 @@ pub fn model(
         let positions = size;
         let uv_at = positions + (vertices * 6).next_multiple_of(4);
         let normal_at = uv_at + vertices * p.uvs.bytes();
-        let index_at = normal_at
-            + if p.normals {
-                (vertices * 3).next_multiple_of(4)
-            } else {
-                0
-            };
+        let index_at = normal_at + (p.normals * 3).next_multiple_of(4);
         let index_bytes = match &p.fans {
             Some(fans) => fans.len(),
             None => p.mesh.triangles() * 3 * p.index_bytes(),
@@ -386,7 +408,14 @@ pub fn model(
         size = index_at + index_bytes.next_multiple_of(4);
         p.at = [positions, uv_at, normal_at, index_at, size];
     }
-    let mut out = vec![0u8; 12 + size];
+    // Every byte of the data is written below (the padding by
+    // `Placed::write`): only room a reused buffer lacks is zeroed. Room
+    // for the header too, so that appending it does not copy the data.
+    let room = 12 + size + 512 * placed.len() + 4096;
+    if out.capacity() < room {
+        out = Vec::with_capacity(room);
+    }
+    out.resize(12 + size, 0);
     out[..4].copy_from_slice(b"CGAM");
     out[8..12].copy_from_slice(&(size as u32).to_le_bytes());
     // Each mesh's bytes, cut off the data in order, go with the mesh.
@@ -417,7 +446,8 @@ pub fn model(
                 "positions": positions,
                 "min": p.min,
                 "extent": p.extent(),
-                "normals": if p.normals { json!(normals) } else { Json::Null },
+                "normals": normals,
+                "face_normals": matches!(p.mesh.normals, cga::DrawNormals::PerFace(_)),
                 "uvs": if p.uvs == Uvs::None { Json::Null } else { json!(uvs) },
                 "uv_bytes": p.uvs.bytes() / 2,
                 "uv_min": match p.uvs { Uvs::Steps { min, .. } => json!(min), _ => Json::Null },
@@ -783,13 +813,20 @@ mod tests {
         assert_eq!(mesh["index_bytes"], 0);
         assert_eq!(mesh["fans"], 6);
         assert_eq!(&data[indices..], &[4, 4, 4, 4, 4, 4, 0, 0]);
+        // A normal per face: the six faces are flat.
         let normals = mesh["normals"].as_u64().unwrap() as usize;
-        assert_eq!(indices, normals + (vertices * 3).next_multiple_of(4));
-        let n: Vec<i8> = data[normals..normals + vertices * 3]
+        assert_eq!(mesh["face_normals"], json!(true));
+        assert_eq!(normals, (vertices * 6).next_multiple_of(4));
+        assert_eq!(indices, normals + (6 * 3usize).next_multiple_of(4));
+        let n: Vec<i8> = data[normals..normals + 6 * 3]
             .iter()
             .map(|&b| b as i8)
             .collect();
-        // Every normal a unit axis, scaled by 127.
+        // Every normal a unit axis, scaled by 127, each axis both ways.
+        let mut axes: Vec<Vec<i8>> = n.chunks(3).map(<[i8]>::to_vec).collect();
+        axes.sort();
+        axes.dedup();
+        assert_eq!(axes.len(), 6, "{n:?}");
         for v in n.chunks(3) {
             assert_eq!(
                 v.iter().map(|c| (*c as i32).abs()).sum::<i32>(),
@@ -798,6 +835,52 @@ mod tests {
             );
         }
         assert_eq!(mesh["texture"], Json::Null);
+    }
+
+    /// A model written into a buffer of an earlier one is the model
+    /// written anew: every byte, padding included, is written.
+    #[test]
+    fn a_model_written_into_a_used_buffer_is_the_same() {
+        let engine = cga::Engine::new(cga::MemoryWorld::new());
+        let rules = engine.load_text(
+            "/p/a.cga",
+            "Lot --> extrude(7) comp(f) { top : primitiveSphere() X | all : Y }\n",
+        );
+        let lots = [cga::lots::rect(10.0, 20.0), cga::lots::rect(3.0, 5.0)];
+        let (results, _) = both(&rules, &lots, &cga::Options::default(), [1.0, 0.0, 2.0]);
+        let fresh = model(&results, [1.0, 0.0, 2.0], &mut |_| None);
+        // The padding after each array is zeros.
+        let (header, data) = split(&fresh);
+        let mut padded = 0;
+        for lot in header["lots"].as_array().unwrap() {
+            for m in lot["meshes"].as_array().unwrap() {
+                let at = |k: &str| m[k].as_u64().unwrap() as usize;
+                let vertices = at("vertices");
+                let normals = if m["face_normals"] == json!(true) {
+                    at("fans")
+                } else {
+                    vertices
+                };
+                let indices = match m["fans"].as_u64() {
+                    Some(faces) => faces as usize,
+                    None => at("triangles") * 3 * at("index_bytes"),
+                };
+                for (start, len) in [
+                    (at("positions"), 6 * vertices),
+                    (at("normals"), 3 * normals),
+                    (at("indices"), indices),
+                ] {
+                    let pad = &data[start + len..start + len.next_multiple_of(4)];
+                    assert!(pad.iter().all(|&b| b == 0), "{m}");
+                    padded += pad.len();
+                }
+            }
+        }
+        assert!(padded > 0);
+        for used in [vec![0xAA; 10], vec![0x55; fresh.len() * 2]] {
+            let again = model_into(&results, [1.0, 0.0, 2.0], &mut |_| None, used);
+            assert_eq!(again, fresh);
+        }
     }
 
     #[test]
@@ -811,6 +894,8 @@ mod tests {
         let mesh = &header["lots"][0]["meshes"][0];
         let vertices = mesh["vertices"].as_u64().unwrap() as usize;
         let normals = mesh["normals"].as_u64().unwrap() as usize;
+        // The sphere's own normals: one per vertex.
+        assert_eq!(mesh["face_normals"], json!(false));
         assert_eq!(normals, (vertices * 6).next_multiple_of(4));
         let exact = &exact[0].model.meshes[0].normals;
         for (b, n) in data[normals..normals + vertices * 3].chunks(3).zip(exact) {

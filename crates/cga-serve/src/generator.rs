@@ -89,6 +89,36 @@ pub struct Preview {
     requests: tokio::sync::watch::Sender<u64>,
     watcher: Mutex<Option<notify::RecommendedWatcher>>,
     lot_notes: Vec<String>,
+    /// Buffers of models no longer sent, for the next models' bytes.
+    spare_models: Arc<Mutex<Vec<Vec<u8>>>>,
+}
+
+/// Buffers of models kept for reuse at most: the model shown and the one
+/// being made are the others.
+const SPARE_MODELS: usize = 2;
+
+/// A model's bytes, which go back to the spare buffers when the last
+/// request sending them is done with them.
+struct Pooled {
+    bytes: Vec<u8>,
+    spares: std::sync::Weak<Mutex<Vec<Vec<u8>>>>,
+}
+
+impl AsRef<[u8]> for Pooled {
+    fn as_ref(&self) -> &[u8] {
+        &self.bytes
+    }
+}
+
+impl Drop for Pooled {
+    fn drop(&mut self) {
+        if let Some(spares) = self.spares.upgrade() {
+            let mut spares = spares.lock().unwrap_or_else(|e| e.into_inner());
+            if spares.len() < SPARE_MODELS {
+                spares.push(std::mem::take(&mut self.bytes));
+            }
+        }
+    }
 }
 
 /// The folder a rule file's project is: the parent of a `rules` folder
@@ -155,6 +185,7 @@ impl Preview {
             events,
             requests,
             watcher: Mutex::new(None),
+            spare_models: Arc::default(),
             lot_notes: lot_set.warnings,
         });
         let worker = preview.clone();
@@ -414,11 +445,15 @@ impl Preview {
                         .or_insert_with(|| self.texture_url(path))
                         .clone()
                 };
-                (
-                    Bytes::from(encode::model(&m.results, self.origin, &mut texture)),
-                    version,
-                    Some(m),
-                )
+                // Written into a buffer of an earlier model, and given back
+                // when no request sends it any more.
+                let spare = self.spare_models.lock().unwrap().pop().unwrap_or_default();
+                let bytes = encode::model_into(&m.results, self.origin, &mut texture, spare);
+                let pooled = Pooled {
+                    bytes,
+                    spares: Arc::downgrade(&self.spare_models),
+                };
+                (Bytes::from_owner(pooled), version, Some(m))
             }
             None => (
                 previous.model.clone(),
@@ -688,6 +723,30 @@ fn lot_outlines(engine: &Engine, root: &Path, lots: &[Lot], origin: [f64; 3]) ->
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A model's buffer goes back to the spares when the last copy of its
+    /// bytes is dropped, and no more than a few are kept.
+    #[test]
+    fn model_buffers_come_back_when_no_one_sends_them() {
+        let spares: Arc<Mutex<Vec<Vec<u8>>>> = Arc::default();
+        let pooled = |n: usize| {
+            Bytes::from_owner(Pooled {
+                bytes: vec![7u8; n],
+                spares: Arc::downgrade(&spares),
+            })
+        };
+        let a = pooled(100);
+        let sent = a.clone();
+        drop(a);
+        assert!(spares.lock().unwrap().is_empty());
+        assert_eq!(&sent[..3], &[7, 7, 7]);
+        drop(sent);
+        assert_eq!(spares.lock().unwrap().len(), 1);
+        assert_eq!(spares.lock().unwrap()[0].len(), 100);
+        let more: Vec<Bytes> = (0..SPARE_MODELS + 2).map(|_| pooled(10)).collect();
+        drop(more);
+        assert_eq!(spares.lock().unwrap().len(), SPARE_MODELS);
+    }
 
     /// A writer's close ends a save; its other steps and renames may be
     /// followed by more; opening or reading changes nothing.

@@ -56,8 +56,8 @@ pub use error::{Error, ExportError};
 pub use generate::{LotWriters, Scene, Target};
 pub use lots::{Axes, CrsOption, GeoOrigin, InvalidPolicy, Lot, LotOptions, LotSet};
 pub use model::{
-    write_plain, DrawFaces, DrawMesh, DrawModel, LeafOrigin, LotResult, Material, PlainMesh,
-    PlainModel, Provenance, Summary,
+    write_plain, DrawFaces, DrawMesh, DrawModel, DrawNormals, LeafOrigin, LotResult, Material,
+    PlainMesh, PlainModel, Provenance, Summary,
 };
 pub use options::{Cancel, Limits, Options};
 pub use rules::{Engine, ProgramSize, RuleInfo, RuleRef, Rules};

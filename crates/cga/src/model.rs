@@ -2,7 +2,7 @@
 
 use std::sync::Arc;
 
-pub use cga_export::{DrawFaces, DrawMesh, DrawModel, PlainMesh, PlainModel};
+pub use cga_export::{DrawFaces, DrawMesh, DrawModel, DrawNormals, PlainMesh, PlainModel};
 pub use cga_geometry::Material;
 use cga_value::Value;
 

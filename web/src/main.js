@@ -193,6 +193,29 @@ function indices(buffer, data, m) {
   return out;
 }
 
+// A mesh's normals, a vertex's three bytes each: sent so, or
+// (`face_normals`, meshes of flat fans) one per face, given here to the
+// face's vertices (3 bytes a quad on the wire instead of 12).
+function normals(buffer, data, m) {
+  if (!m.face_normals) return new Int8Array(buffer, data + m.normals, m.vertices * 3);
+  const corners = new Uint8Array(buffer, data + m.indices, m.fans);
+  const faces = new Int8Array(buffer, data + m.normals, m.fans * 3);
+  const out = new Int8Array(m.vertices * 3);
+  let at = 0;
+  for (let f = 0; f < corners.length; f++) {
+    const x = faces[3 * f];
+    const y = faces[3 * f + 1];
+    const z = faces[3 * f + 2];
+    for (let k = corners[f]; k > 0; k--) {
+      out[at] = x;
+      out[at + 1] = y;
+      out[at + 2] = z;
+      at += 3;
+    }
+  }
+  return out;
+}
+
 // Colour maps by URL, loaded once; a texture that changes on disk is
 // seen after a reload of the page.
 const textures = new Map();
@@ -265,12 +288,8 @@ function buildMeshes(buffer, group, { lots = false } = {}) {
       // server's encode.rs): read as normalised, scaled by the box's
       // largest side and moved to its corner.
       geometry.setAttribute('position', new THREE.BufferAttribute(new Uint16Array(buffer, data + m.positions, m.vertices * 3), 3, true));
-      if (m.normals !== null) {
-        // Bytes scaled by 127, read as normalised.
-        geometry.setAttribute('normal', new THREE.BufferAttribute(new Int8Array(buffer, data + m.normals, m.vertices * 3), 3, true));
-      } else {
-        geometry.computeVertexNormals();
-      }
+      // Bytes scaled by 127, read as normalised.
+      geometry.setAttribute('normal', new THREE.BufferAttribute(normals(buffer, data, m), 3, true));
       let map = null;
       if (m.uvs !== null) {
         // 16-bit steps across the box are read as normalised, and the

@@ -1,5 +1,6 @@
 //! Models as plain arrays, for programs that use the geometry themselves
-//! (a Python user's numpy arrays, a viewer's buffers) instead of a file.
+//! (a Python user's numpy arrays) instead of a file, and the collector
+//! they share with meshes to draw (`draw.rs`: a viewer's buffers).
 //!
 //! Faces are placed, triangulated and left out exactly as the file writers
 //! do (`prepare`): a [`PlainModel`] holds the triangles a GLB of the same

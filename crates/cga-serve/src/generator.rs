@@ -316,8 +316,8 @@ impl Preview {
                 // An editor saves in steps (truncate, write, close or
                 // rename): the events of one save come within
                 // milliseconds, and a file read between them would be
-                // half-written. The wait ends early when a writer closes
-                // its file (the save of most editors, `cat >`, a
+                // half-written. The wait ends early when the rule file's
+                // writer closes it (the save of most editors, `cat >`, a
                 // program's write).
                 let settle = Instant::now() + SETTLE;
                 while r.reload && !r.settled && !r.stop {

@@ -9,7 +9,9 @@
 
 use cga_geometry::DVec2;
 
-use crate::plain::{each_triangle, fan_corners, fit, MeshArrays, PlainModel};
+use crate::plain::{
+    corner_position, corner_uv, each_triangle, fan_corners, fit, MeshArrays, PlainModel,
+};
 use crate::FaceData;
 
 /// A [`DrawMesh`] per material.
@@ -183,15 +185,10 @@ impl MeshArrays for DrawMesh {
         let corners = fan_corners(f, first);
         let n = f.mesh.face_loops(f.face)[0].len as usize;
         let base = self.positions.len() as u32;
-        self.positions.extend(
-            corners
-                .clone()
-                .map(|c| f32s(f.positions[f.mesh.corners[c] as usize].to_array())),
-        );
-        self.uvs.extend(corners.clone().map(|c| {
-            uvs.and_then(|u| u.get(c))
-                .map_or([0.0; 2], |t| f32s(t.to_array()))
-        }));
+        self.positions
+            .extend(corners.clone().map(|c| f32s(corner_position(f, c))));
+        self.uvs
+            .extend(corners.clone().map(|c| f32s(corner_uv(uvs, c))));
         // Corner counts before normals: a face that cannot be a fan
         // makes the normals per vertex.
         match &mut self.faces {
@@ -253,12 +250,10 @@ impl MeshArrays for DrawMesh {
             corner_vertex,
             next,
             |c| {
-                let p = f.positions[f.mesh.corners[c] as usize];
                 let n = f.normals.map_or(f.normal, |n| n[c]);
-                let uv = uvs.and_then(|u| u.get(c)).copied();
-                positions.push(f32s(p.to_array()));
+                positions.push(f32s(corner_position(f, c)));
                 normals.push(n.to_array().map(normal_byte));
-                out_uvs.push(uv.map_or([0.0; 2], |t| f32s(t.to_array())));
+                out_uvs.push(f32s(corner_uv(uvs, c)));
             },
             |ids| {
                 indices.push(ids);
@@ -284,56 +279,9 @@ impl MeshArrays for DrawMesh {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::plain::tests::sample_faces;
     use crate::{DrawCollector, PlainCollector};
     use cga_geometry::{DAffine3, DVec3, Mesh};
-
-    /// A convex pentagon, a quad, a U-shaped octagon (not a fan), a
-    /// square with a hole and a triangle, with texture coordinates.
-    fn faces() -> Mesh {
-        let mut m = Mesh::new();
-        let p = |x: f64, z: f64| DVec3::new(x, 0.0, z);
-        m.positions.extend(
-            [
-                (0.0, 0.0),
-                (2.0, 0.0),
-                (3.0, -1.0),
-                (1.0, -2.0),
-                (-1.0, -1.0),
-                (10.0, 0.0),
-                (12.0, 0.0),
-                (12.0, -2.0),
-                (10.0, -2.0),
-                (20.0, 0.0),
-                (26.0, 0.0),
-                (26.0, -4.0),
-                (24.0, -4.0),
-                (24.0, -1.0),
-                (22.0, -1.0),
-                (22.0, -4.0),
-                (20.0, -4.0),
-                (30.0, 0.0),
-                (34.0, 0.0),
-                (34.0, -4.0),
-                (30.0, -4.0),
-                (31.0, -1.0),
-                (31.0, -3.0),
-                (33.0, -3.0),
-                (33.0, -1.0),
-            ]
-            .map(|(x, z)| p(x, z)),
-        );
-        m.add_face(&[&[0, 1, 2, 3, 4]], 0);
-        m.add_face(&[&[5, 6, 7, 8]], 0);
-        m.add_face(&[&[9, 10, 11, 12, 13, 14, 15, 16]], 0);
-        m.add_face(&[&[17, 18, 19, 20], &[21, 22, 23, 24]], 0);
-        m.add_face(&[&[0, 1, 3]], 0);
-        m.uvs[0] = Some(
-            (0..m.corners.len())
-                .map(|c| DVec2::new(c as f64 * 0.25, 0.5))
-                .collect(),
-        );
-        m
-    }
 
     /// What a draw collector holds is what a plain collector holds of the
     /// same leaves, rounded: vertex for vertex, triangle for triangle.
@@ -380,7 +328,11 @@ mod tests {
         assert_eq!(n.len(), 12);
         // A face that is no fan: every triangle as indices from then on,
         // those of the fans before it too.
-        let draw = assert_rounded_plain(&[(cube.clone(), shift), (faces(), turned), (cube, shift)]);
+        let draw = assert_rounded_plain(&[
+            (cube.clone(), shift),
+            (sample_faces(), turned),
+            (cube, shift),
+        ]);
         let DrawFaces::Triangles(t) = &draw.meshes[0].faces else {
             panic!("{:?}", draw.meshes[0].faces)
         };

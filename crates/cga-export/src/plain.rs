@@ -142,6 +142,18 @@ pub(crate) fn fan_corners(f: &FaceData, first: u32) -> impl Iterator<Item = usiz
         .map(move |i| s + i)
 }
 
+/// The placed position of a face's corner `c`.
+pub(crate) fn corner_position(f: &FaceData, c: usize) -> [f64; 3] {
+    f.positions[f.mesh.corners[c] as usize].to_array()
+}
+
+/// The texture coordinates of corner `c` in `uvs` (the face's UV set 0),
+/// (0, 0) where it has none.
+pub(crate) fn corner_uv(uvs: Option<&[DVec2]>, c: usize) -> [f64; 2] {
+    uvs.and_then(|u| u.get(c))
+        .map_or([0.0; 2], |t| t.to_array())
+}
+
 /// Calls `vertex` for each corner of a triangle of `f` not seen before in
 /// this face (its corner number), in the order the triangles first use
 /// them, and `triangle` with each triangle's vertex numbers (`next` is
@@ -191,11 +203,8 @@ impl MeshArrays for PlainMesh {
         let corners = fan_corners(f, first);
         let n = f.mesh.face_loops(f.face)[0].len as usize;
         let base = self.positions.len() as u32;
-        self.positions.extend(
-            corners
-                .clone()
-                .map(|c| f.positions[f.mesh.corners[c] as usize].to_array()),
-        );
+        self.positions
+            .extend(corners.clone().map(|c| corner_position(f, c)));
         match f.normals {
             Some(normals) => self
                 .normals
@@ -204,10 +213,7 @@ impl MeshArrays for PlainMesh {
                 .normals
                 .extend(std::iter::repeat_n(f.normal.to_array(), n)),
         }
-        self.uvs.extend(corners.map(|c| {
-            uvs.and_then(|u| u.get(c))
-                .map_or([0.0; 2], |t| t.to_array())
-        }));
+        self.uvs.extend(corners.map(|c| corner_uv(uvs, c)));
         self.indices
             .extend((1..n as u32 - 1).map(|k| [base, base + k, base + k + 1]));
         self.triangle_leaf.extend(std::iter::repeat_n(leaf, n - 2));
@@ -233,12 +239,9 @@ impl MeshArrays for PlainMesh {
             corner_vertex,
             positions.len() as u32,
             |c| {
-                let p = f.positions[f.mesh.corners[c] as usize];
-                let n = f.normals.map_or(f.normal, |n| n[c]);
-                let uv = uvs.and_then(|u| u.get(c)).copied();
-                positions.push(p.to_array());
-                normals.push(n.to_array());
-                out_uvs.push(uv.map_or([0.0; 2], |t| t.to_array()));
+                positions.push(corner_position(f, c));
+                normals.push(f.normals.map_or(f.normal, |n| n[c]).to_array());
+                out_uvs.push(corner_uv(uvs, c));
             },
             |ids| {
                 indices.push(ids);
@@ -412,7 +415,7 @@ impl<M: MeshArrays> Collector<M> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use cga_geometry::DVec3;
 
@@ -454,16 +457,13 @@ mod tests {
         assert!(c.take().meshes.is_empty());
     }
 
-    /// Faces whose triangles are fans take the short path, which gives
-    /// exactly what the general one gives; other faces take the general.
-    #[test]
-    fn fans_are_collected_as_the_general_path_collects_them() {
+    /// A convex pentagon (a fan from the corner the triangulation picks), a
+    /// quad cut along its other diagonal (a fan from its second corner: its
+    /// first three are in line), a U-shaped octagon, a square with a hole,
+    /// a triangle; texture coordinates (corner number, 0.5).
+    pub(crate) fn sample_faces() -> Mesh {
         let mut m = Mesh::new();
         let p = |x: f64, z: f64| DVec3::new(x, 0.0, z);
-        // A convex pentagon (a fan from the corner the triangulation
-        // picks), a quad cut along its other diagonal (a fan from its
-        // second corner: its first three are in line), a U-shaped
-        // octagon, a square with a hole, a triangle.
         m.positions.extend([
             p(0.0, 0.0),
             p(2.0, 0.0),
@@ -501,6 +501,14 @@ mod tests {
                 .map(|c| DVec2::new(c as f64, 0.5))
                 .collect(),
         );
+        m
+    }
+
+    /// Faces whose triangles are fans take the short path, which gives
+    /// exactly what the general one gives; other faces take the general.
+    #[test]
+    fn fans_are_collected_as_the_general_path_collects_them() {
+        let m = sample_faces();
         let transform = DAffine3::from_translation(DVec3::new(5.0, 1.0, 2.0));
         let mut prep = FacePrep::default();
         let mut fans = PlainMesh::with_capacity(0, 0, 0);

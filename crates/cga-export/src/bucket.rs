@@ -121,6 +121,22 @@ impl Bucket {
         self.max = [f32::NEG_INFINITY; 3];
     }
 
+    /// A copy of the data in arrays of exactly its size.
+    pub fn exact_copy(&self) -> Bucket {
+        Bucket {
+            positions: self.positions.to_vec(),
+            normals: self.normals.to_vec(),
+            sets: self.sets.clone(),
+            coords: self.coords.iter().map(|c| c.to_vec()).collect(),
+            tex_coords: self.tex_coords.clone(),
+            tangents: self.tangents.as_ref().map(|t| t.to_vec()),
+            indices: self.indices.to_vec(),
+            features: self.features.to_vec(),
+            min: self.min,
+            max: self.max,
+        }
+    }
+
     /// Room for `n` more vertices.
     pub fn reserve(&mut self, n: usize) {
         self.positions.reserve(n);

@@ -9,7 +9,7 @@
 //! names its materials by value; the writer gives them their ids, in the
 //! order of first appearance, as if it had seen the faces itself.
 
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use cga_geometry::mesh::SharedVec;
 use cga_geometry::{DAffine3, DVec2, DVec3, Material, Mesh, UV_SETS};
@@ -40,13 +40,16 @@ pub struct Encoded {
     pub(crate) error: Option<ExportError>,
     /// Assets placed as instances, in order (see `instances`).
     pub(crate) instances: Vec<Pending>,
-    /// Emptied buckets of an earlier use of this batch, whose room new
-    /// materials take.
-    spare: Vec<Bucket>,
-    /// The encoders that made the batch, whose pool takes its room back
-    /// once appended (also when appended to another writer's model).
-    pub(crate) home: Option<Arc<EncoderShared>>,
+    /// In an encoder's working batch: emptied buckets of its earlier
+    /// batches, with the material each held, whose room new materials
+    /// take: the same material's bucket where there is one (its arrays are
+    /// the size that material needs; a lot's materials come again in every
+    /// batch), else the last.
+    spare: Vec<(Material, Bucket)>,
 }
+
+/// Spare buckets up to which a new material looks for its own.
+const MATCHED_SPARES: usize = 32;
 
 impl Encoded {
     /// Whether nothing was encoded (and nothing failed).
@@ -59,8 +62,20 @@ impl Encoded {
 
     /// A bucket for a new material of the batch, in the room of an old one
     /// if there is one.
-    fn new_bucket(&mut self, sets: Vec<usize>, tangents: bool) {
-        let bucket = match self.spare.pop() {
+    fn new_bucket(&mut self, material: &Material, sets: Vec<usize>, tangents: bool) {
+        // A batch of many materials (a colour per building) would compare
+        // each new one with every spare: beyond a few, any bucket does.
+        let same = (self.spare.len() <= MATCHED_SPARES).then(|| {
+            self.spare
+                .iter()
+                .rposition(|(m, _)| crate::materials::same_material(m, material))
+        });
+        let same = same.flatten();
+        let spare = match same {
+            Some(k) => Some(self.spare.swap_remove(k)),
+            None => self.spare.pop(),
+        };
+        let bucket = match spare.map(|(_, b)| b) {
             Some(mut b) => {
                 b.relayout(sets, tangents);
                 b
@@ -70,17 +85,36 @@ impl Encoded {
         self.buckets.push(bucket);
     }
 
-    /// Empties the batch (its buckets were emptied by appending them),
-    /// keeping its room.
-    fn recycle(&mut self) {
-        self.materials.clear();
-        self.spare.append(&mut self.buckets);
-        self.faces = 0;
-        self.triangles = 0;
-        self.skipped_non_finite = 0;
-        self.bytes = 0;
-        self.error = None;
-        self.instances.clear();
+    /// The batch's data, in arrays of exactly its size, leaving the batch
+    /// empty with its room (each bucket kept with `materials`, the
+    /// materials of its buckets in order).
+    ///
+    /// Batches wait to be appended (a worker's lot waits for the lots
+    /// before it), so their arrays are what the model holds in flight.
+    /// Sending the working arrays themselves and reusing appended batches
+    /// made every bucket of every batch in flight grow, by reallocation
+    /// into fresh memory, to the most any material ever needed: about 2.5
+    /// times the data, and the kernel's zeroing of those pages was a fifth
+    /// of a Candler model's time. A copy costs less.
+    fn take_exact(&mut self, materials: Vec<Material>) -> Encoded {
+        let out = Encoded {
+            buckets: self.buckets.iter().map(Bucket::exact_copy).collect(),
+            materials,
+            faces: std::mem::take(&mut self.faces),
+            triangles: std::mem::take(&mut self.triangles),
+            skipped_non_finite: std::mem::take(&mut self.skipped_non_finite),
+            bytes: std::mem::take(&mut self.bytes),
+            error: self.error.take(),
+            instances: std::mem::take(&mut self.instances),
+            spare: Vec::new(),
+        };
+        let kept = out.materials.iter().cloned().zip(self.buckets.drain(..));
+        self.spare.extend(kept.map(|(m, mut b)| {
+            b.clear();
+            (m, b)
+        }));
+        self.buckets.clear();
+        out
     }
 }
 
@@ -93,9 +127,6 @@ pub(crate) struct EncoderShared {
     pub origin: Option<DVec3>,
     /// Whether assets are placed as instances (`ExportOptions::instances`).
     pub instancing: bool,
-    /// Batches the writer has appended, for encoders to fill again: their
-    /// arrays keep their room, so a running model allocates no more.
-    pool: Mutex<Vec<Encoded>>,
 }
 
 impl EncoderShared {
@@ -108,18 +139,7 @@ impl EncoderShared {
             probe,
             origin,
             instancing,
-            pool: Mutex::new(Vec::new()),
         }
-    }
-
-    fn pool(&self) -> std::sync::MutexGuard<'_, Vec<Encoded>> {
-        self.pool.lock().unwrap_or_else(|e| e.into_inner())
-    }
-
-    /// Takes back a batch that was appended.
-    pub(crate) fn recycle(&self, mut batch: Encoded) {
-        batch.recycle();
-        self.pool().push(batch);
     }
 }
 
@@ -223,7 +243,7 @@ impl Buckets for BatchBuckets<'_> {
                 &mut Vec::new(),
             );
             let (sets, tangents) = bucket_layout(&uses);
-            self.batch.new_bucket(sets, tangents);
+            self.batch.new_bucket(m, sets, tangents);
         }
         id
     }
@@ -343,10 +363,7 @@ impl Encoder {
     /// The meshes encoded since the last call, as one batch; the encoder
     /// starts an empty one.
     pub fn take(&mut self) -> Encoded {
-        let fresh = self.shared.pool().pop().unwrap_or_default();
-        let mut batch = std::mem::replace(&mut self.batch, fresh);
-        batch.materials = self.table.take_materials();
-        batch.home = Some(self.shared.clone());
+        let batch = self.batch.take_exact(self.table.take_materials());
         // Slot ids name this batch's materials.
         self.mesh.forget_ids();
         batch
@@ -564,4 +581,68 @@ fn own_vertices(
         coords.extend(corners.clone().map(|c| uv_at(*src, c)));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ExportOptions;
+
+    fn material(name: &str, r: f64) -> SharedVec<Material> {
+        let m = Material {
+            name: name.into(),
+            color: [r, 0.5, 0.5],
+            ..Material::default()
+        };
+        SharedVec::from(vec![m])
+    }
+
+    /// The address and room of the positions of the encoder's bucket for
+    /// material `id` of the batch being filled.
+    fn room(e: &Encoder, id: usize) -> (*const [f32; 3], usize) {
+        let p = &e.batch.buckets[id].positions;
+        (p.as_ptr(), p.capacity())
+    }
+
+    /// A batch holds exactly its data; the encoder keeps its arrays for its
+    /// next batches, each material in the bucket it had before (here the
+    /// materials come in the other order the second time), so that a
+    /// running model reallocates nothing.
+    #[test]
+    fn batches_are_exact_and_each_material_keeps_its_room() {
+        let mut e = Encoder::for_export(&ExportOptions::default());
+        let big = cga_geometry::primitive::cube(DVec3::new(2.0, 3.0, 4.0));
+        let small = Mesh::polygon(&[DVec3::ZERO, DVec3::X, DVec3::Z]);
+        let (wall, roof) = (material("wall", 0.25), material("roof", 0.75));
+        for _ in 0..20 {
+            e.add_placed(&big, None, &wall);
+        }
+        e.add_placed(&small, None, &roof);
+        let wall_room = room(&e, 0);
+        let roof_room = room(&e, 1);
+        assert!(
+            wall_room.1 >= 20 * 24 && roof_room.1 >= 3,
+            "{wall_room:?} {roof_room:?}"
+        );
+        let batch = e.take();
+        assert_eq!(batch.materials.len(), 2);
+        assert_eq!(batch.faces, 20 * 6 + 1);
+        for b in &batch.buckets {
+            assert_eq!(b.positions.capacity(), b.positions.len());
+            assert_eq!(b.normals.capacity(), b.normals.len());
+            assert_eq!(b.indices.capacity(), b.indices.len());
+        }
+        assert_eq!(batch.buckets[0].positions.len(), 20 * 24);
+        assert_eq!(batch.buckets[1].indices.len(), 1);
+        assert_eq!(e.bytes(), 0);
+
+        e.add_placed(&small, None, &roof);
+        for _ in 0..20 {
+            e.add_placed(&big, None, &wall);
+        }
+        assert_eq!(room(&e, 0), roof_room, "roof in the roof's bucket");
+        assert_eq!(room(&e, 1), wall_room, "wall in the wall's bucket");
+        let again = e.take();
+        assert_eq!(again.buckets[1].positions, batch.buckets[0].positions);
+    }
 }

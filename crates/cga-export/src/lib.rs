@@ -651,8 +651,7 @@ impl ModelWriter {
 
     /// Adds a batch of meshes an [`Encoder`] of this writer encoded: the
     /// output is what adding the same meshes here, in the same order, gives.
-    /// Fails if a mesh in it was invalid. The batch's room goes back to the
-    /// encoders.
+    /// Fails if a mesh in it was invalid.
     pub fn append(&mut self, mut batch: Encoded) -> Result<(), ExportError> {
         if let Some(e) = batch.error.take() {
             return Err(e);
@@ -680,10 +679,6 @@ impl ModelWriter {
         self.skipped_non_finite += batch.skipped_non_finite;
         for p in batch.instances.drain(..) {
             self.place(p)?;
-        }
-        match batch.home.take() {
-            Some(home) => home.recycle(batch),
-            None => self.encoders.recycle(batch),
         }
         Ok(())
     }

@@ -62,7 +62,7 @@ impl PartialEq for Key {
 
 /// Equality by value, as [`Key`] defines it; the most discriminating fields
 /// are compared first.
-fn same_material(a: &Material, b: &Material) -> bool {
+pub(crate) fn same_material(a: &Material, b: &Material) -> bool {
     same3(&a.color, &b.color)
         && same(a.opacity, b.opacity)
         && a.name == b.name

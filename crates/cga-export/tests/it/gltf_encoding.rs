@@ -170,7 +170,7 @@ fn encoded_batches_write_what_added_meshes_write() {
 }
 
 #[test]
-fn batches_reuse_the_room_of_appended_ones() {
+fn equal_chunks_encode_to_equal_batches() {
     let dir = out_dir("gltf_encoding_reuse");
     let model = placed_model();
     let path = dir.join("model.glb");
@@ -184,8 +184,8 @@ fn batches_reuse_the_room_of_appended_ones() {
         sizes.push(e.bytes());
         w.append(e.take()).unwrap();
     }
-    // Equal chunks encode to equal sizes, whether in fresh or reused room
-    // (the walls of the second half have UVs).
+    // Equal chunks encode to equal sizes, whether in the encoder's fresh
+    // or kept room (the walls of the second half have UVs).
     assert_eq!(sizes.len(), 20);
     let (first, second) = sizes.split_at(10);
     assert!(first.iter().all(|&s| s == first[0]), "{sizes:?}");

@@ -162,8 +162,13 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
         .map(|&i| mesh.positions[i as usize])
         .collect();
     // Top vertex of every corner: shared between corners of the same base
-    // vertex moved by the same vector.
-    let mut tops_of: Vec<Vec<(DVec3, u32)>> = vec![Vec::new(); weld.count];
+    // vertex moved by the same vector. The tops made for a base vertex are
+    // a chain in `tops` (vector, top vertex, next entry), searched in the
+    // order they were made; most vertices have one, so a flat array
+    // replaces a list per vertex.
+    const END: u32 = u32::MAX;
+    let mut first_top = vec![END; weld.count];
+    let mut tops: Vec<(DVec3, u32, u32)> = Vec::with_capacity(weld.count);
     let mut top_of_corner = vec![0u32; mesh.corners.len()];
     let vtol = tol.max(1e-9 * distance.abs());
     for f in 0..mesh.faces.len() {
@@ -171,16 +176,27 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
             for c in mesh.loop_corners(l) {
                 let v = vid(c);
                 let w = vec_of_corner[c];
-                let list = &mut tops_of[v as usize];
-                let t = match list
-                    .iter()
-                    .find(|(x, _)| (*x - w).abs().max_element() <= vtol)
-                {
-                    Some(&(_, t)) => t,
+                let (mut e, mut last) = (first_top[v as usize], END);
+                let found = loop {
+                    let Some(&(x, t, next)) = tops.get(e as usize) else {
+                        break None;
+                    };
+                    if (x - w).abs().max_element() <= vtol {
+                        break Some(t);
+                    }
+                    (last, e) = (e, next);
+                };
+                let t = match found {
+                    Some(t) => t,
                     None => {
                         let t = out.positions.len() as u32;
                         out.positions.push(out.positions[v as usize] + w);
-                        list.push((w, t));
+                        let entry = tops.len() as u32;
+                        tops.push((w, t, END));
+                        match last {
+                            END => first_top[v as usize] = entry,
+                            _ => tops[last as usize].2 = entry,
+                        }
                         t
                     }
                 };

@@ -438,13 +438,19 @@ struct EmitEntry {
 const EMIT_CACHE_SIZE: usize = 8;
 
 /// Facts about shared meshes (inserted assets), computed once per lot
-/// instead of once per insertion: the asset's bounding box, and the texture
-/// measures `tileUV` needs of it placed by a given map. Entries hold their
-/// mesh, so an address names the same mesh as long as it is here.
+/// instead of once per insertion: the asset a path names, the asset's
+/// bounding box, and the texture measures `tileUV` needs of it placed by a
+/// given map. Entries hold their mesh, so an address names the same mesh
+/// as long as it is here.
 #[derive(Default)]
 pub(crate) struct MeshMemo {
+    /// Assets found by rule file and path as written: the lot's inserts
+    /// ask the shared [`Assets`] (two locks each, whose cache lines the
+    /// deriving threads pass between them) once per asset.
+    assets: Vec<(cga_syntax::FileId, Arc<str>, Arc<Mesh>)>,
     bounds: Vec<(Arc<Mesh>, Bounds)>,
     uv: Vec<UvMemo>,
+    next_asset: usize,
     next_bounds: usize,
     next_uv: usize,
 }
@@ -465,6 +471,34 @@ struct UvMemo {
 const MEMO_SIZE: usize = 16;
 
 impl MeshMemo {
+    /// [`Assets::mesh`] of `path` written in rule file `from`, asked once
+    /// per lot for each asset found (a missing asset is asked every time:
+    /// it warns once per place anyway).
+    pub(crate) fn asset(
+        &mut self,
+        assets: &Assets,
+        from: cga_syntax::FileId,
+        path: &str,
+    ) -> Result<Arc<Mesh>, String> {
+        if let Some((_, _, m)) = self
+            .assets
+            .iter()
+            .find(|(f, p, _)| *f == from && **p == *path)
+        {
+            return Ok(m.clone());
+        }
+        let mesh = assets.mesh(from, path)?;
+        let entry = (from, Arc::from(path), mesh.clone());
+        remember(&mut self.assets, &mut self.next_asset, entry);
+        Ok(mesh)
+    }
+
+    /// Whether `mesh` is an asset this lot found (see [`Assets::is_asset`],
+    /// which the others ask): told without its lock.
+    pub(crate) fn is_asset(&self, mesh: &Arc<Mesh>) -> bool {
+        self.assets.iter().any(|(_, _, m)| Arc::ptr_eq(m, mesh))
+    }
+
     /// The bounding box of the positions `mesh`'s faces use.
     pub(crate) fn bounds(&mut self, mesh: &Arc<Mesh>) -> Bounds {
         if Arc::strong_count(mesh) == 1 {
@@ -948,7 +982,7 @@ impl<'a> Interp<'a> {
         let materials = self.leaf_materials(shape, &mesh.materials);
         if self.keep_leaves {
             let leaf = Leaf {
-                asset: self.assets.is_asset(mesh),
+                asset: self.memo.is_asset(mesh) || self.assets.is_asset(mesh),
                 mesh: mesh.clone(),
                 transform: shape.object_transform(),
                 materials,

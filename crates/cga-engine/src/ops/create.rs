@@ -175,7 +175,7 @@ fn insert(cx: &mut Interp, shape: &mut Shape, call: &OpCall, args: &[Arg]) -> Re
     if let Some(a) = args.get(3) {
         selector(a, &["numericalCleanup", "noCleanup"])?;
     }
-    let asset = cx.assets.mesh(call.span.file, path);
+    let asset = cx.memo.asset(cx.assets, call.span.file, path);
     match asset {
         Ok(mut mesh) => {
             if up_z {

@@ -153,7 +153,7 @@ fn insert_along(
         Some(a) => selector(a, &["alignPosition", "keepPosition"])? == "keepPosition",
         None => false,
     };
-    let asset = match cx.assets.mesh(call.span.file, path) {
+    let asset = match cx.memo.asset(cx.assets, call.span.file, path) {
         Ok(a) => a,
         Err(message) => {
             // As with `i`: a missing asset must not lose the model.

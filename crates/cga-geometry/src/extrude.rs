@@ -161,6 +161,8 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
         .iter()
         .map(|&i| mesh.positions[i as usize])
         .collect();
+    // Room for a top per base vertex, the usual case.
+    out.positions.reserve(weld.count);
     // Top vertex of every corner: shared between corners of the same base
     // vertex moved by the same vector. The tops made for a base vertex are
     // a chain in `tops` (vector, top vertex, next entry), searched in the
@@ -243,8 +245,19 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
     }
     let mut edge_out: Vec<u32> = Vec::new();
     let mut vertex_out: Vec<u32> = Vec::new();
-    let mut roles = Vec::new();
-    let mut loop_buf: Vec<(u32, u32)> = Vec::new(); // (position, source corner)
+    // Every corner gives at most a bottom, a top and the four corners of
+    // a side (an edge shape's quad too): room for all of it at once, not
+    // by doubling.
+    let corners = mesh.corners.len();
+    out.corners.reserve(6 * corners);
+    out.loops.reserve(2 * mesh.loops.len() + corners);
+    out.faces.reserve(2 * mesh.faces.len() + corners);
+    for &k in &has_uv {
+        uv_out[k].reserve(6 * corners);
+    }
+    let mut roles = Vec::with_capacity(2 * mesh.faces.len() + corners);
+    // One side's loop of (position, source corner), refilled per side.
+    let mut side: [Vec<(u32, u32)>; 1] = [Vec::with_capacity(4)];
     let mut emit =
         |out: &mut Mesh, uv_out: &mut Vec<Vec<DVec2>>, loops: &[Vec<(u32, u32)>], f: usize| {
             let first_loop = out.loops.len() as u32;
@@ -357,13 +370,14 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
                 if a == b || sides.contains_key(&(b, a, tb, ta)) {
                     continue; // zero-length or internal edge
                 }
-                loop_buf.clear();
+                let quad = &mut side[0];
+                quad.clear();
                 if flip {
-                    loop_buf.extend([(b, n as u32), (a, c as u32), (ta, c as u32), (tb, n as u32)]);
+                    quad.extend([(b, n as u32), (a, c as u32), (ta, c as u32), (tb, n as u32)]);
                 } else {
-                    loop_buf.extend([(a, c as u32), (b, n as u32), (tb, n as u32), (ta, c as u32)]);
+                    quad.extend([(a, c as u32), (b, n as u32), (tb, n as u32), (ta, c as u32)]);
                 }
-                emit(&mut out, &mut uv_out, &[loop_buf.clone()], f);
+                emit(&mut out, &mut uv_out, &side, f);
                 let et = mesh.edge_tag_index(c);
                 if et != 0 {
                     // The side emanates from a tagged edge.

@@ -37,6 +37,8 @@ pub(super) struct Bufs {
     pub(super) split: SplitBufs,
     pub(super) caps: CapBufs,
     pub(super) build: BuildBufs,
+    /// Cuts of small meshes, for replay (kept by `trim`).
+    pub(super) replays: replay::Replays,
 }
 
 #[derive(Default)]

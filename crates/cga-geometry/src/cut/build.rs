@@ -8,7 +8,10 @@ use crate::mesh::{Face, Loop, Mesh};
 use super::*;
 
 impl<'m, 'b> Cutter<'m, 'b> {
-    pub(super) fn build(&mut self) -> Vec<Mesh> {
+    /// The parts' meshes; with `record`, also each part's plan for
+    /// replaying the cut (see `replay`).
+    pub(super) fn build(&mut self, record: Option<&mut Vec<replay::PartPlan>>) -> Vec<Mesh> {
+        let mut record = record;
         let mesh = self.mesh;
         let closed =
             self.only_part.is_none() && (self.bufs.planes.is_empty() || self.input_is_closed());
@@ -144,50 +147,72 @@ impl<'m, 'b> Cutter<'m, 'b> {
             for &v in touched.iter() {
                 remap[v as usize] = NONE;
             }
-            // Per-corner attributes.
-            for (set, src) in mesh.uvs.iter().enumerate() {
-                if let Some(uv) = src {
-                    let get = |i: u32| uv.get(i as usize).copied().unwrap_or(DVec2::ZERO);
-                    m.uvs[set] = Some(
-                        sources
-                            .iter()
-                            .map(|s| {
-                                if s.a == CAP {
-                                    DVec2::ZERO
-                                } else if s.t == 0.0 {
-                                    get(s.a)
-                                } else {
-                                    get(s.a).lerp(get(s.b), s.t)
-                                }
-                            })
-                            .collect(),
-                    );
-                }
+            carry_corner_attributes(mesh, &mut m, sources, cap_normals);
+            if let Some(plans) = record.as_deref_mut() {
+                plans.push(replay::PartPlan {
+                    positions: m.positions.clone(),
+                    corners: m.corners.clone(),
+                    loops: m.loops.clone(),
+                    faces: m.faces.clone(),
+                    sources: sources.clone(),
+                    cap_normals: cap_normals.clone(),
+                });
             }
-            if let Some(nrm) = &mesh.normals {
-                let get = |i: u32| nrm.get(i as usize).copied().unwrap_or(DVec3::ZERO);
-                m.normals = Some(
-                    sources
-                        .iter()
-                        .map(|s| {
-                            if s.a == CAP {
-                                cap_normals[s.v as usize]
-                            } else if s.t == 0.0 {
-                                get(s.a)
-                            } else {
-                                get(s.a).lerp(get(s.b), s.t).normalize_or_zero()
-                            }
-                        })
-                        .collect(),
-                );
-            }
-            carry_corner_tags(mesh, &mut m, sources);
             out.push(m);
         }
         self.bufs.build = bb;
         self.bufs.caps = cb;
         out
     }
+}
+
+/// The per-corner attributes of a part `m` whose corners come from
+/// `sources` (see [`WCorner`]): texture coordinates and normals
+/// interpolated along the original edge (caps: (0, 0) and their
+/// `cap_normals`), and edge and vertex tags (`carry_corner_tags`).
+pub(super) fn carry_corner_attributes(
+    mesh: &Mesh,
+    m: &mut Mesh,
+    sources: &[WCorner],
+    cap_normals: &[DVec3],
+) {
+    for (set, src) in mesh.uvs.iter().enumerate() {
+        if let Some(uv) = src {
+            let get = |i: u32| uv.get(i as usize).copied().unwrap_or(DVec2::ZERO);
+            m.uvs[set] = Some(
+                sources
+                    .iter()
+                    .map(|s| {
+                        if s.a == CAP {
+                            DVec2::ZERO
+                        } else if s.t == 0.0 {
+                            get(s.a)
+                        } else {
+                            get(s.a).lerp(get(s.b), s.t)
+                        }
+                    })
+                    .collect(),
+            );
+        }
+    }
+    if let Some(nrm) = &mesh.normals {
+        let get = |i: u32| nrm.get(i as usize).copied().unwrap_or(DVec3::ZERO);
+        m.normals = Some(
+            sources
+                .iter()
+                .map(|s| {
+                    if s.a == CAP {
+                        cap_normals[s.v as usize]
+                    } else if s.t == 0.0 {
+                        get(s.a)
+                    } else {
+                        get(s.a).lerp(get(s.b), s.t).normalize_or_zero()
+                    }
+                })
+                .collect(),
+        );
+    }
+    carry_corner_tags(mesh, m, sources);
 }
 
 /// Edge and vertex tags of a piece's corners from their sources: a corner

@@ -59,7 +59,13 @@
 //! hashing. The common split (a polygon without holes crossing the plane at
 //! two edges, no vertex on it: every convex face) takes a direct path,
 //! `Cutter::split_simple`, that gives exactly the general path's result;
-//! the tests compare both. `benches/cut.rs` measures the typical calls.
+//! the tests compare both. And a facade's tiles are the same small mesh
+//! again and again but for their texture coordinates: a split of a mesh of
+//! up to 32 corners is remembered per thread as its parts' geometry and
+//! each corner's source, and replayed for the next mesh with the same
+//! positions, faces and planes, carrying that mesh's attributes by the
+//! same rule (`replay`; a test compares replayed and fresh cuts).
+//! `benches/cut.rs` measures the typical calls.
 
 use std::cell::RefCell;
 
@@ -82,6 +88,7 @@ mod crossings;
 mod cutter;
 mod pieces;
 mod polygon;
+mod replay;
 mod split;
 #[cfg(test)]
 pub(crate) mod tests;
@@ -159,10 +166,22 @@ fn cut_with(mesh: &Mesh, normal: DVec3, offsets: &[f64], only_part: Option<usize
     // `try_borrow_mut` never fails (nothing here calls back into a cut);
     // both fall back to fresh buffers rather than panic.
     let run = |bufs: &mut Bufs| {
+        // All parts of a small mesh: replayed if cut before (see `replay`).
+        let key = match only_part {
+            None => replay::Key::of(mesh, normal, offsets),
+            Some(_) => None,
+        };
+        if let Some(out) = key.as_ref().and_then(|k| bufs.replays.replay(k, mesh)) {
+            return out;
+        }
+        let mut plans = Vec::new();
         let mut cutter = Cutter::new(mesh, normal, offsets, bufs);
         cutter.only_part = only_part;
         cutter.run();
-        let out = cutter.build();
+        let out = cutter.build(key.is_some().then_some(&mut plans));
+        if let Some(key) = key {
+            bufs.replays.remember(key, plans);
+        }
         bufs.trim();
         out
     };
@@ -176,6 +195,13 @@ fn cut_with(mesh: &Mesh, normal: DVec3, offsets: &[f64], only_part: Option<usize
 
 thread_local! {
     static SCRATCH: RefCell<Bufs> = RefCell::new(Bufs::default());
+}
+
+/// Forgets this thread's remembered cuts, so that the next cut runs the
+/// cutter (tests comparing its paths).
+#[cfg(test)]
+pub(crate) fn forget_replays() {
+    SCRATCH.with(|c| c.borrow_mut().replays = Default::default());
 }
 
 /// An empty mesh with the same material slots and groups as `mesh`.

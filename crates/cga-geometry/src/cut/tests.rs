@@ -578,9 +578,12 @@ proptest! {
 /// `split_along_axis` by the general path only, and the number of
 /// splits the fast path did in the normal run.
 fn split_both_ways(m: &Mesh, axis: usize, cuts: &[f64]) -> (Vec<Mesh>, Vec<Mesh>, usize) {
+    // Each run cuts: neither replays an earlier cut of the same mesh.
+    forget_replays();
     SIMPLE_SPLITS.with(|c| c.set(0));
     let fast = split_along_axis(m, axis, cuts);
     let used = SIMPLE_SPLITS.with(|c| c.get());
+    forget_replays();
     GENERAL_PATH_ONLY.with(|g| g.set(true));
     let general = split_along_axis(m, axis, cuts);
     GENERAL_PATH_ONLY.with(|g| g.set(false));
@@ -663,6 +666,13 @@ proptest! {
         cuts.sort_by(f64::total_cmp);
         let (fast, general, _) = split_both_ways(&m, axis, &cuts);
         prop_assert_eq!(fast, general);
+        // The same quad with other texture coordinates: replayed from the
+        // cut just done, it is what cutting it anew gives.
+        let mut other = m.clone();
+        other.uvs[0] = Some((0..4).map(|i| DVec2::new(0.3 - i as f64, 2.0 * i as f64)).collect());
+        let replayed = split_along_axis(&other, axis, &cuts);
+        forget_replays();
+        prop_assert_eq!(replayed, split_along_axis(&other, axis, &cuts));
     }
 
     /// Boxes, axis-aligned or rotated, split along any axis.
@@ -691,4 +701,81 @@ proptest! {
         let (fast, general, _) = split_both_ways(&b, axis, &cuts);
         prop_assert_eq!(fast, general);
     }
+}
+
+/// A facade tile with texture coordinates in two sets, normals, and edge
+/// and vertex tags, all shifted by `k` (its geometry stays the same).
+fn tagged_tile(k: f64) -> Mesh {
+    let mut q = Mesh::polygon(&[
+        v(0., 0., 0.),
+        v(3.55, 0., 0.),
+        v(3.55, 3.5, 0.),
+        v(0., 3.5, 0.),
+    ]);
+    let uv = |i: usize| DVec2::new(0.1 * i as f64 + k, 0.7 * k - 0.2 * i as f64);
+    q.uvs[0] = Some((0..4).map(uv).collect());
+    q.uvs[2] = Some((0..4).map(|i| uv(i) * 3.0).collect());
+    q.normals = Some(
+        (0..4)
+            .map(|i| v(0.1 * i as f64, k, 1.0).normalize())
+            .collect(),
+    );
+    let a = q.intern_tags(crate::tags::TagSet::from_names(["edge.a"]));
+    let b = q.intern_tags(crate::tags::TagSet::from_names(["vertex.b"]));
+    let pick = if k > 0.5 { [a, 0, a, 0] } else { [0, a, 0, a] };
+    q.edge_tags = Some(pick.to_vec());
+    q.vertex_tags = Some(vec![b, 0, 0, b]);
+    q
+}
+
+/// A cut replayed from an earlier cut of the same geometry gives what
+/// cutting gives, whatever the corners' attributes: a tile split into
+/// three (texture coordinates, normals, tags interpolated or carried), and
+/// a closed box cut into floors (caps and their normals).
+#[test]
+fn replayed_cuts_equal_cutting_anew() {
+    let replays = || replay::REPLAYED.with(|r| r.get());
+    forget_replays();
+    let cuts = [0.3, 1.0, 2.5, 3.25];
+    let first = split_along_axis(&tagged_tile(0.25), 0, &cuts);
+    let before = replays();
+    let replayed = split_along_axis(&tagged_tile(0.75), 0, &cuts);
+    assert_eq!(replays(), before + 1);
+    forget_replays();
+    let anew = split_along_axis(&tagged_tile(0.75), 0, &cuts);
+    assert_eq!(replayed, anew);
+    assert_eq!(replayed.len(), 5);
+    // The attributes are the second tile's, not the first's.
+    assert_ne!(first[2].uvs[0], replayed[2].uvs[0]);
+    assert_ne!(first[2].edge_tags, replayed[2].edge_tags);
+    assert_eq!(first[2].positions, replayed[2].positions);
+
+    let mut mass = unit_box();
+    let n = mass.corners.len();
+    let shifted = |m: &Mesh, k: f64| {
+        let mut m = m.clone();
+        m.uvs[0] = Some((0..n).map(|i| DVec2::new(k, i as f64)).collect());
+        m
+    };
+    let floors = [0.25, 0.5, 0.75];
+    forget_replays();
+    mass = shifted(&mass, 1.0);
+    let _ = split_along_axis(&mass, 1, &floors);
+    let other = shifted(&mass, 2.0);
+    let replayed = split_along_axis(&other, 1, &floors);
+    forget_replays();
+    let anew = split_along_axis(&other, 1, &floors);
+    assert_eq!(replayed, anew);
+    assert!(replayed.iter().all(closed));
+    // Larger meshes are not remembered.
+    let big = prism(
+        &star(&[1.0, 0.5, 1.0, 0.5, 1.0, 0.5, 1.0, 0.5, 1.0, 0.5], 3.0),
+        &[],
+        2.0,
+    );
+    assert!(big.corners.len() > 32);
+    let before = replays();
+    let _ = split_along_axis(&big, 1, &[1.0]);
+    let _ = split_along_axis(&big, 1, &[1.0]);
+    assert_eq!(replays(), before);
 }

@@ -37,7 +37,7 @@ pub(super) struct Bufs {
     pub(super) split: SplitBufs,
     pub(super) caps: CapBufs,
     pub(super) build: BuildBufs,
-    /// Cuts of small meshes, for replay (kept by `trim`).
+    /// Cuts of small meshes remembered for replay (`trim` keeps them).
     pub(super) replays: replay::Replays,
 }
 

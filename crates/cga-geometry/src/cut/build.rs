@@ -10,8 +10,7 @@ use super::*;
 impl<'m, 'b> Cutter<'m, 'b> {
     /// The parts' meshes; with `record`, also each part's plan for
     /// replaying the cut (see `replay`).
-    pub(super) fn build(&mut self, record: Option<&mut Vec<replay::PartPlan>>) -> Vec<Mesh> {
-        let mut record = record;
+    pub(super) fn build(&mut self, mut record: Option<&mut Vec<replay::PartPlan>>) -> Vec<Mesh> {
         let mesh = self.mesh;
         let closed =
             self.only_part.is_none() && (self.bufs.planes.is_empty() || self.input_is_closed());

@@ -65,12 +65,13 @@ impl Encoded {
     fn new_bucket(&mut self, material: &Material, sets: Vec<usize>, tangents: bool) {
         // A batch of many materials (a colour per building) would compare
         // each new one with every spare: beyond a few, any bucket does.
-        let same = (self.spare.len() <= MATCHED_SPARES).then(|| {
-            self.spare
-                .iter()
-                .rposition(|(m, _)| crate::materials::same_material(m, material))
-        });
-        let same = same.flatten();
+        let same = (self.spare.len() <= MATCHED_SPARES)
+            .then(|| {
+                self.spare
+                    .iter()
+                    .rposition(|(m, _)| crate::materials::same_material(m, material))
+            })
+            .flatten();
         let spare = match same {
             Some(k) => Some(self.spare.swap_remove(k)),
             None => self.spare.pop(),
@@ -114,7 +115,6 @@ impl Encoded {
             b.clear();
             (m, b)
         }));
-        self.buckets.clear();
         out
     }
 }

@@ -8,7 +8,8 @@
 #
 # Candler (rect:20,30, its footprint, its footprint with Mode=3DPrint), the
 # other oracle rule packages and the example city, as OBJ, GLB and glTF, with
-# one and two workers; prints and reports are kept too. The speed
+# one and two workers, and without a model (reports only); prints and
+# reports are kept too. The speed
 # benchmarks (20 Candler buildings, envelope2002 on 20 lots) as GLB with and
 # without instances.
 set -euo pipefail
@@ -27,6 +28,9 @@ run() { # name dir args...
             --report "$out/$name.$ext.report.json" >"$out/$name.$ext.stdout" 2>"$out/$name.$ext.stderr") || echo "$name.$ext failed" >&2
     done
     (cd "$dir" && "$cga" generate "$@" --jobs 2 -o "$out/$name.j2.glb" >/dev/null 2>&1) || echo "$name.j2 failed" >&2
+    # Reports alone (no model): counts, prints and reports as above.
+    (cd "$dir" && "$cga" generate "$@" --jobs 1 --report "$out/$name.none.report.json" \
+        >"$out/$name.none.stdout" 2>"$out/$name.none.stderr") || echo "$name.none failed" >&2
     # The messages name the output folder.
     sed -i "s|$out|OUT|g" "$out/$name".*.stderr
 }

@@ -97,7 +97,11 @@ impl ContextUse {
     pub fn of(program: &Program) -> ContextUse {
         let mut u = ContextUse::default();
         Walker {
-            query: &mut |f, args| u.query(f, args),
+            shape_fn: &mut |f, args| {
+                if let ShapeFn::Context(c) = f {
+                    u.query(*c, args)
+                }
+            },
             op: &mut |_| {},
             rule: &mut |_| {},
         }
@@ -149,7 +153,7 @@ pub(crate) fn rules_reaching(
         let mut found = false;
         let mut calls = Vec::new();
         Walker {
-            query: &mut |_, _| {},
+            shape_fn: &mut |_, _| {},
             op: &mut |call| found |= direct(call),
             rule: &mut |callee| calls.push(callee),
         }
@@ -174,16 +178,16 @@ pub(crate) fn rules_reaching(
     reaches
 }
 
-/// Visits every context query, operation and rule call of a program's
-/// rules, functions and attributes.
+/// Visits every shape function call (context queries among them),
+/// operation and rule call of a program's rules, functions and attributes.
 pub(crate) struct Walker<'f> {
-    pub query: &'f mut dyn FnMut(ContextFn, &[RExpr]),
+    pub shape_fn: &'f mut dyn FnMut(&ShapeFn, &[RExpr]),
     pub op: &'f mut dyn FnMut(&crate::expr::OpCall),
     pub rule: &'f mut dyn FnMut(crate::program::RuleId),
 }
 
 impl Walker<'_> {
-    fn program(&mut self, program: &Program) {
+    pub(crate) fn program(&mut self, program: &Program) {
         for r in &program.rules {
             for l in &r.locals {
                 self.expr(l);
@@ -205,9 +209,7 @@ impl Walker<'_> {
         match &e.kind {
             RExprKind::Const(_) | RExprKind::Local(_) | RExprKind::Attr(_) => {}
             RExprKind::Shape(f, args) => {
-                if let ShapeFn::Context(c) = f {
-                    (self.query)(*c, args);
-                }
+                (self.shape_fn)(f, args);
                 args.iter().for_each(|a| self.expr(a));
             }
             RExprKind::Func(_, args)
@@ -366,7 +368,10 @@ impl FirstPass {
         // The labels the queries ask about (`None`: not known).
         let mut asked: Option<Vec<Arc<str>>> = Some(Vec::new());
         Walker {
-            query: &mut |_, args| {
+            shape_fn: &mut |f, args| {
+                if !matches!(f, ShapeFn::Context(_)) {
+                    return;
+                }
                 // An explicit target comes first (as `Interp::context_query`
                 // reads the arguments); `contextCount("x")` has none.
                 let first = args.first().map(|e| &e.kind);
@@ -404,7 +409,7 @@ impl FirstPass {
         }
         let (mut labels, mut calls) = (false, false);
         Walker {
-            query: &mut |_, _| {},
+            shape_fn: &mut |_, _| {},
             op: &mut |call| labels |= labels_asked(call, &self.asked),
             rule: &mut |r| calls |= self.applies(r),
         }

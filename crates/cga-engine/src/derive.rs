@@ -279,6 +279,8 @@ pub struct LotOutput {
     pub warnings: Vec<Diagnostic>,
     /// Number of shapes created.
     pub shapes: usize,
+    /// Number of leaves emitted (leaves without geometry are not).
+    pub leaf_count: usize,
 }
 
 /// Facts about the initial shape that rules can read.
@@ -378,6 +380,12 @@ pub struct Interp<'a> {
     pub cancel: Option<Arc<std::sync::atomic::AtomicBool>>,
     /// Emit leaves unbaked into `out.leaves` instead of `out.meshes`.
     pub keep_leaves: bool,
+    /// Texture coordinate sets not computed: nobody keeps or reads them
+    /// (see `crate::uv_use`; bit `k`: set `k`).
+    pub uv_skip: crate::uv_use::UvSets,
+    /// Leaves are only counted (`LotOutput::leaf_count`): nobody keeps
+    /// their geometry.
+    pub count_leaves_only: bool,
     /// With `keep_leaves`: hand each leaf to this as it is emitted instead
     /// of collecting them (an exporter on another thread writes the model
     /// while the derivation goes on).
@@ -658,6 +666,8 @@ impl<'a> Interp<'a> {
             current_rule: None,
             cancel: None,
             keep_leaves: false,
+            uv_skip: 0,
+            count_leaves_only: false,
             leaf_sink: None,
             emitted: EmitCache::default(),
             arg_pool: Vec::new(),
@@ -977,6 +987,10 @@ impl<'a> Interp<'a> {
             if self.context_collecting() {
                 return;
             }
+        }
+        self.out.leaf_count += 1;
+        if self.count_leaves_only {
+            return;
         }
         let (mesh, _) = shape.geometry.raw();
         let materials = self.leaf_materials(shape, &mesh.materials);

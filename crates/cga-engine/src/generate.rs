@@ -42,6 +42,15 @@ pub struct GenerateOptions {
     /// it, a lot's first pass is run by [`generate_lot`] itself and inter
     /// queries find no other lots.
     pub scene: Option<Arc<SceneContext>>,
+    /// The texture coordinate sets the caller does not keep (bit `k`: set
+    /// `k`; [`crate::uv_use::ALL_UV_SETS`] for reports only, all but set 0
+    /// for plain meshes). Operations that only compute coordinates of such
+    /// a set are skipped unless the rules read it (see `crate::uv_use`).
+    pub uv_sets_unused: crate::uv_use::UvSets,
+    /// Leaves are only counted (`LotOutput::leaf_count`), neither kept nor
+    /// handed to a sink: the caller wants reports, prints and diagnostics
+    /// alone.
+    pub count_leaves_only: bool,
 }
 
 /// Derives one lot with `rule`. The output holds everything generated,
@@ -219,6 +228,13 @@ fn derive<'a>(
     interp.keep_leaves = options.leaves || sink.is_some();
     interp.leaf_sink = sink;
     interp.context = context;
+    // The first pass of context queries keeps no geometry at all.
+    let unused = match interp.context_collecting() {
+        true => crate::uv_use::ALL_UV_SETS,
+        false => options.uv_sets_unused,
+    };
+    interp.uv_skip = unused & !program.uv_sets_read();
+    interp.count_leaves_only = options.count_leaves_only;
     let mut error = None;
     // Lot attributes (GeoJSON properties) first, command-line values win.
     let lot_attrs = lot

@@ -21,6 +21,7 @@ pub mod shape;
 pub mod shape_fns;
 pub mod split_layout;
 pub mod trim;
+pub mod uv_use;
 pub mod values;
 
 pub use derive::{InitialInfo, Interp, Limits, LotOutput, RtError};

@@ -108,9 +108,19 @@ pub struct Program {
     /// Per rule, whether it can reach an operation that uses trim planes
     /// (see `ops::comp::uses_trim_planes`), worked out on first use.
     pub(crate) trim_rules: std::sync::OnceLock<Vec<bool>>,
+    /// The texture coordinate sets the rules can read (see
+    /// `crate::uv_use`), worked out on first use.
+    pub(crate) uv_sets_read: std::sync::OnceLock<crate::uv_use::UvSets>,
 }
 
 impl Program {
+    /// The texture coordinate sets the rules can read (see `crate::uv_use`).
+    pub fn uv_sets_read(&self) -> crate::uv_use::UvSets {
+        *self
+            .uv_sets_read
+            .get_or_init(|| crate::uv_use::sets_read(self))
+    }
+
     /// The attribute of the main file called `name`.
     pub fn main_attr(&self, name: &str) -> Option<AttrId> {
         self.main_attrs

@@ -188,6 +188,16 @@ impl Rules {
             Target::Writer(w) => (Out::One(w), None),
             Target::PerLot(w) => (Out::PerLot(w), None),
         };
+        // Texture coordinates of sets nobody keeps are not computed (see
+        // `cga_engine::uv_use`): reports alone keep none, plain meshes and
+        // meshes to draw set 0, model files all.
+        engine_options.uv_sets_unused = match (&out, &keep) {
+            (Out::None, None) => cga_engine::uv_use::ALL_UV_SETS,
+            (Out::None, Some(_)) => cga_engine::uv_use::ALL_UV_SETS & !1,
+            _ => 0,
+        };
+        // Reports alone: the leaves are counted, not made.
+        engine_options.count_leaves_only = matches!((&out, &keep), (Out::None, None));
         // Leaves go to the calling thread in batches as they are emitted,
         // so that writing the model overlaps deriving it, even for a single
         // lot. For glTF and GLB with several workers, the workers encode
@@ -298,7 +308,6 @@ impl Rules {
             if let Some(o) = origin(i) {
                 batcher.set_origin(o);
             }
-            let mut leaves = 0usize;
             let mut origins = Vec::new();
             let (out, error) = generate_lot_streaming(
                 program,
@@ -308,7 +317,6 @@ impl Rules {
                 lot_index(i),
                 &engine_options,
                 |leaf| {
-                    leaves += 1;
                     batcher.add_origin(&leaf, program, &mut origins);
                     batcher.add(leaf, send)
                 },
@@ -330,7 +338,6 @@ impl Rules {
             Done {
                 out,
                 error,
-                leaves,
                 model,
                 drawing,
                 origins,
@@ -530,7 +537,6 @@ impl Rules {
         let Done {
             out,
             error,
-            leaves,
             model,
             drawing,
             origins,
@@ -540,6 +546,7 @@ impl Rules {
             reports,
             warnings,
             shapes,
+            leaf_count,
             ..
         } = out;
         LotResult {
@@ -548,7 +555,7 @@ impl Rules {
             model,
             drawing,
             leaves: origins,
-            leaf_count: leaves,
+            leaf_count,
             prints,
             reports,
             warnings: warnings
@@ -598,7 +605,6 @@ impl Rules {
 struct Done {
     out: LotOutput,
     error: Option<RtError>,
-    leaves: usize,
     model: PlainModel,
     drawing: DrawModel,
     origins: Vec<LeafOrigin>,

@@ -1322,7 +1322,7 @@ fn uses_trim_planes(program: &crate::program::Program, body: &crate::expr::RBody
     let mut op_found = false;
     let mut rule_found = false;
     crate::context::Walker {
-        query: &mut |_, _| {},
+        shape_fn: &mut |_, _| {},
         op: &mut |call| op_found |= direct(call),
         rule: &mut |r| rule_found |= rules.get(r as usize).copied().unwrap_or(true),
     }

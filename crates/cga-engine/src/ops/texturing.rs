@@ -61,11 +61,17 @@ pub fn exec(
     args: &[Arg],
 ) -> Result<(), RtError> {
     let shape = &mut st.shape;
+    // Sets nobody keeps or reads are not computed (`crate::uv_use`): the
+    // operations that only write their coordinates stop once their
+    // arguments are read.
+    let uv_skip = cx.uv_skip;
+    let skipped = |set: usize| uv_skip & (1 << set) != 0;
     match op {
         TextureOp::SetupProjection => setup_projection(cx, shape, call, args),
         TextureOp::ProjectUV => {
             let set = uv_set(&args[0])?;
             match shape.projections.as_ref().and_then(|p| p[set]) {
+                Some(_) if skipped(set) => {}
                 Some(p) => project_uv(shape, set, &p),
                 None => cx.warn_once(call.span, || {
                     format!("projectUV({set}): no projection was set up for uv set {set} (setupProjection); the shape is left unchanged")
@@ -76,12 +82,18 @@ pub fn exec(
         TextureOp::TranslateUV => {
             let set = uv_set(&args[0])?;
             let d = DVec2::new(args[1].num()?, args[2].num()?);
+            if skipped(set) {
+                return Ok(());
+            }
             edit_uvs(shape, set, |_, uvs| uvs.iter_mut().for_each(|t| *t += d));
             Ok(())
         }
         TextureOp::ScaleUV => {
             let set = uv_set(&args[0])?;
             let f = DVec2::new(args[1].num()?, args[2].num()?);
+            if skipped(set) {
+                return Ok(());
+            }
             edit_uvs(shape, set, |_, uvs| uvs.iter_mut().for_each(|t| *t *= f));
             Ok(())
         }
@@ -89,6 +101,9 @@ pub fn exec(
             let set = uv_set(&args[0])?;
             // Counter-clockwise about (0, 0), in degrees.
             let (s, c) = args[1].num()?.to_radians().sin_cos();
+            if skipped(set) {
+                return Ok(());
+            }
             edit_uvs(shape, set, |_, uvs| {
                 for t in uvs.iter_mut() {
                     *t = DVec2::new(c * t.x - s * t.y, s * t.x + c * t.y);
@@ -107,15 +122,19 @@ pub fn exec(
                 "u" => Normalize::U,
                 _ => Normalize::V,
             };
+            if skipped(set) {
+                return Ok(());
+            }
             edit_uvs(shape, set, |mesh, uvs| {
                 normalize_uvs(mesh, uvs, mode, per_face)
             });
             Ok(())
         }
+        TextureOp::TileUV if skipped(uv_set(&args[0])?) => Ok(()),
         TextureOp::TileUV => tile_uv(cx, shape, call, args),
         TextureOp::DeleteUV => {
             let set = uv_set(&args[0])?;
-            if shape.geometry.raw().0.uvs[set].is_some() {
+            if !skipped(set) && shape.geometry.raw().0.uvs[set].is_some() {
                 shape.geometry.local_mut().uvs[set] = None;
             }
             Ok(())
@@ -124,7 +143,7 @@ pub fn exec(
             let from = uv_set(&args[0])?;
             let to = uv_set(&args[1])?;
             let mesh = shape.geometry.raw().0;
-            if from != to && mesh.uvs[from] != mesh.uvs[to] {
+            if !skipped(to) && from != to && mesh.uvs[from] != mesh.uvs[to] {
                 let m = shape.geometry.local_mut();
                 m.uvs[to] = m.uvs[from].clone();
             }

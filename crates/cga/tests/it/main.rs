@@ -3,3 +3,4 @@
 
 mod facade;
 mod plain;
+mod skipped_work;

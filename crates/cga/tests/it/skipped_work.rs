@@ -1,0 +1,158 @@
+//! Work a generation skips because nobody keeps its result: texture
+//! coordinates of sets the target does not write and the rules do not
+//! read, and leaves that a report table only counts. What the caller gets
+//! (reports, prints, warnings, shape and leaf counts, the meshes kept) is
+//! the same as when everything is computed.
+
+use cga::{Engine, LotResult, MemoryWorld, ModelWriter, Options, Target};
+
+/// Facades with coordinates in sets 0 and 2, tiled, scaled, rotated and
+/// copied; reports read set 2 and set 0, a print asks whether set 3 is
+/// there, and the roof copies set 4 (read nowhere else) into set 0.
+const RULES: &str = "\
+Lot --> extrude(10) comp(f) { side : Facade | top : Roof }
+Facade --> setupProjection(0, scope.xy, 2, 2) projectUV(0)
+    setupProjection(2, scope.xy, '1, '1) projectUV(2) tileUV(2, 5, 5)
+    report(\"u2\", geometry.uMax(2)) report(\"du0\", geometry.du(0, uvSpace))
+    split(x) { ~4 : Tile }*
+Tile --> scaleUV(0, 2, 1) rotateUV(2, 90) translateUV(2, 1, 0)
+    setupProjection(3, scope.xy, 1, 1) projectUV(3) print(geometry.hasUVs(3)) T.
+Roof --> setupProjection(4, scope.xy, 4, 4) projectUV(4) copyUV(4, 0) R.
+";
+
+fn results(rules: &cga::Rules, target: Target<'_>) -> (Vec<LotResult>, cga::Summary) {
+    let lots = [cga::lots::rect(20.0, 30.0), cga::lots::rect(12.0, 8.0)];
+    let mut out = Vec::new();
+    let summary = rules
+        .generate_lots(&lots, &Options::default().jobs(1), target, |r| out.push(r))
+        .unwrap();
+    (out, summary)
+}
+
+/// What a caller sees of a lot apart from its geometry.
+fn seen(r: &LotResult) -> (Vec<String>, String, Vec<String>, usize, usize) {
+    (
+        r.prints.clone(),
+        format!("{:?}", r.reports),
+        r.warnings.iter().map(|w| w.message.clone()).collect(),
+        r.shapes,
+        r.leaf_count,
+    )
+}
+
+#[test]
+fn reports_and_plain_meshes_match_a_generation_that_computes_every_set() {
+    let rules = Engine::new(MemoryWorld::new()).load_text("/p/rules/r.cga", RULES);
+    assert!(!rules.has_errors(), "{}", rules.render_diagnostics());
+    let (nothing, nothing_sum) = results(&rules, Target::Nothing);
+    let (meshes, meshes_sum) = results(&rules, Target::Meshes);
+    let mut writer = ModelWriter::glb_in_memory(rules.export_options()).unwrap();
+    let (written, written_sum) = results(&rules, Target::Writer(&mut writer));
+    let (_, stats) = writer.finish_bytes().unwrap();
+
+    for (a, b) in [(&nothing, &written), (&meshes, &written)] {
+        let a: Vec<_> = a.iter().map(seen).collect();
+        let b: Vec<_> = b.iter().map(seen).collect();
+        assert_eq!(a, b);
+    }
+    // 20 x 30 lot: four facades of 5 and 4 tiles, a roof; 12 x 8: 3 and 2.
+    assert_eq!(nothing_sum.leaves, 2 * (5 + 8) + 1 + 2 * (3 + 2) + 1);
+    assert_eq!(nothing_sum.leaves, written_sum.leaves);
+    assert_eq!(meshes_sum.leaves, written_sum.leaves);
+    assert_eq!(nothing_sum.shapes, written_sum.shapes);
+    // Set 2 is read: tiled by 5 m, the facades span 4 and 6 (and 2.4, 1.6)
+    // in u. Set 0 projected 2 m to the unit: 10 m high is 5 in v, and du
+    // is the width over 2.
+    let numbers = |r: &LotResult, key: &str| -> Vec<f64> {
+        let mut v: Vec<f64> = r
+            .reports
+            .iter()
+            .filter(|(k, _)| k == key)
+            .map(|(_, v)| match v {
+                cga::Value::Float(x) => (x * 1e9).round() / 1e9,
+                other => panic!("{key}: {other:?}"),
+            })
+            .collect();
+        v.sort_by(f64::total_cmp);
+        v
+    };
+    assert_eq!(numbers(&nothing[0], "u2"), [4.0, 4.0, 6.0, 6.0]);
+    assert_eq!(numbers(&nothing[1], "u2"), [1.6, 1.6, 2.4, 2.4]);
+    assert_eq!(numbers(&nothing[0], "du0"), [10.0, 10.0, 15.0, 15.0]);
+    // Set 3 is read (hasUVs), so it is there in every tile.
+    assert!(
+        nothing[0].prints.iter().all(|p| p == "true"),
+        "{:?}",
+        nothing[0].prints
+    );
+    assert_eq!(nothing[0].prints.len(), 2 * (5 + 8));
+
+    // The plain meshes hold set 0 as the model file does: the roof's
+    // coordinates come from set 4 (copied), so set 4 is computed.
+    assert_eq!(
+        meshes.iter().map(|r| r.model.triangles()).sum::<usize>() as u64,
+        stats.triangles
+    );
+    let lot = &meshes[0];
+    let roof_uvs: Vec<[f64; 2]> = lot
+        .model
+        .meshes
+        .iter()
+        .flat_map(|m| {
+            m.indices
+                .iter()
+                .zip(&m.triangle_leaf)
+                .filter(|(_, &leaf)| &*lot.leaves[leaf as usize].shape == "R")
+                .flat_map(|(t, _)| t.map(|v| m.uvs[v as usize]))
+        })
+        .collect();
+    // The roof's two triangles.
+    assert_eq!(roof_uvs.len(), 6);
+    let (lo, hi) = roof_uvs
+        .iter()
+        .fold(([f64::MAX; 2], [f64::MIN; 2]), |(lo, hi), t| {
+            (
+                [lo[0].min(t[0]), lo[1].min(t[1])],
+                [hi[0].max(t[0]), hi[1].max(t[1])],
+            )
+        });
+    // 20 x 30 m projected 4 m to the unit.
+    let mut spans = [hi[0] - lo[0], hi[1] - lo[1]];
+    spans.sort_by(f64::total_cmp);
+    assert!(
+        (spans[0] - 5.0).abs() < 1e-9 && (spans[1] - 7.5).abs() < 1e-9,
+        "{lo:?} {hi:?}"
+    );
+}
+
+#[test]
+fn a_report_table_of_candler_counts_what_its_model_holds() {
+    let Some(rule) = cga_testkit::oracle_rule("candler", "candler.cga") else {
+        return;
+    };
+    let Some(oracle) = cga_testkit::oracle() else {
+        return;
+    };
+    let rules = Engine::new(cga::DiskWorld).load(&rule);
+    assert!(!rules.has_errors(), "{}", rules.render_diagnostics());
+    let spec = oracle.join("lots/candler_footprint.obj");
+    let lots = cga::lots::read(&[spec.to_str().unwrap()]).unwrap().lots;
+    let options = Options::default();
+    let nothing = rules
+        .generate_lots(&lots, &options, Target::Nothing, |_| {})
+        .unwrap();
+    let mut plain = Vec::new();
+    let meshes = rules
+        .generate_lots(&lots, &options, Target::Meshes, |r| plain.push(r))
+        .unwrap();
+    let mut writer = ModelWriter::glb_in_memory(rules.export_options()).unwrap();
+    let written = rules
+        .generate_lots(&lots, &options, Target::Writer(&mut writer), |_| {})
+        .unwrap();
+    let (_, stats) = writer.finish_bytes().unwrap();
+    assert_eq!(nothing.shapes, written.shapes);
+    assert_eq!(nothing.leaves, written.leaves);
+    assert_eq!(meshes.leaves, written.leaves);
+    assert!(nothing.leaves > 4000, "{}", nothing.leaves);
+    assert_eq!(plain[0].model.triangles() as u64, stats.triangles);
+}

@@ -898,6 +898,23 @@ impl<'a> Interp<'a> {
         c
     }
 
+    /// What the trim of the geometry `call` leaves (`i()`, a primitive,
+    /// `trim()`) has to give: without a model, and with nothing reading
+    /// that geometry afterwards (`crate::geometry_use`), only whether it is
+    /// empty. Leaves collected by `inline`, `modify` and the booleans, and
+    /// shapes of programs with context queries, are read.
+    pub(crate) fn trim_need(&self, call: &crate::expr::OpCall) -> crate::trim::Need {
+        if self.count_leaves_only
+            && self.collected.is_none()
+            && self.context.is_none()
+            && !self.program.geometry_use().read_after(call)
+        {
+            crate::trim::Need::Emptiness
+        } else {
+            crate::trim::Need::Geometry
+        }
+    }
+
     /// Fails with the shape limit's error if `n` more shapes would exceed
     /// it: an operation about to create that many parts (a split into
     /// hundreds of thousands of slabs) stops before doing the work.

@@ -9,6 +9,7 @@ pub mod expr;
 pub mod file_fns;
 pub mod generate;
 pub mod geo;
+pub mod geometry_use;
 pub mod gis;
 pub mod locate;
 pub mod lot;

@@ -111,6 +111,9 @@ pub struct Program {
     /// The texture coordinate sets the rules can read (see
     /// `crate::uv_use`), worked out on first use.
     pub(crate) uv_sets_read: std::sync::OnceLock<crate::uv_use::UvSets>,
+    /// Which operations leave geometry nothing reads (see
+    /// `crate::geometry_use`), worked out on first use.
+    pub(crate) geometry_use: std::sync::OnceLock<crate::geometry_use::GeometryUse>,
 }
 
 impl Program {
@@ -119,6 +122,13 @@ impl Program {
         *self
             .uv_sets_read
             .get_or_init(|| crate::uv_use::sets_read(self))
+    }
+
+    /// Where the rules can read a shape's geometry (see
+    /// `crate::geometry_use`).
+    pub fn geometry_use(&self) -> &crate::geometry_use::GeometryUse {
+        self.geometry_use
+            .get_or_init(|| crate::geometry_use::GeometryUse::of(self))
     }
 
     /// The attribute of the main file called `name`.

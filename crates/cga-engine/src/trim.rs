@@ -94,9 +94,18 @@ pub fn bisecting_plane(a: DVec3, b: DVec3, m_face: DVec3, m_other: DVec3) -> Opt
 }
 
 /// `trim()`: applies the shape's active trim planes to its geometry.
-pub fn exec(_cx: &mut Interp, st: &mut ShapeState, _call: &OpCall) -> Result<(), RtError> {
-    apply(&mut st.shape, None);
+pub fn exec(cx: &mut Interp, st: &mut ShapeState, call: &OpCall) -> Result<(), RtError> {
+    apply(&mut st.shape, None, cx.trim_need(call));
     Ok(())
+}
+
+/// What a trim has to give: the trimmed geometry, or only a geometry that
+/// is empty when the trimmed one would be (a leaf of a generation without
+/// a model whose geometry nothing reads: see `crate::geometry_use`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Need {
+    Geometry,
+    Emptiness,
 }
 
 /// Cuts the shape's geometry with its active trim planes, keeping the part
@@ -104,7 +113,11 @@ pub fn exec(_cx: &mut Interp, st: &mut ShapeState, _call: &OpCall) -> Result<(),
 /// scope-local coordinates if the caller knows it (inserts do), so that
 /// planes that do not touch the geometry cost nothing and the geometry is
 /// not even transformed.
-pub fn apply(shape: &mut Shape, bounds: Option<(DVec3, DVec3)>) {
+///
+/// With [`Need::Emptiness`], a geometry with a face that keeps some area
+/// inside every cutting plane is left as it is (its trimmed part is not
+/// empty).
+pub fn apply(shape: &mut Shape, bounds: Option<(DVec3, DVec3)>, need: Need) {
     let Some(planes) = shape.trim.planes.clone() else {
         return;
     };
@@ -160,6 +173,9 @@ pub fn apply(shape: &mut Shape, bounds: Option<(DVec3, DVec3)>) {
     if cutting.is_empty() {
         return;
     }
+    if need == Need::Emptiness && keeps_a_face(shape, &cutting, tol) {
+        return;
+    }
     // The first cut reads the shape's mesh, each later one the last cut's.
     let source = shape.geometry.local().clone();
     let mut cut: Option<Mesh> = None;
@@ -177,6 +193,59 @@ pub fn apply(shape: &mut Shape, bounds: Option<(DVec3, DVec3)>) {
     }
     if let Some(mesh) = cut {
         shape.set_local_mesh(mesh);
+    }
+}
+
+/// Whether the part of the shape's geometry (scope-local, read through its
+/// pending map without baking it) more than `tol` inside every plane of
+/// `cutting` has area: a face without holes clipped by the planes keeps a
+/// polygon. Then the trimmed geometry is not empty.
+fn keeps_a_face(shape: &Shape, cutting: &[(DVec3, f64)], tol: f64) -> bool {
+    let (mesh, to_scope) = shape.geometry.raw();
+    let at = |c: u32| {
+        let p = mesh.positions[mesh.corners[c as usize] as usize];
+        to_scope.map_or(p, |t| t.transform_point3(p))
+    };
+    let (mut poly, mut next) = (Vec::new(), Vec::new());
+    (0..mesh.faces.len()).any(|f| {
+        let [outer] = mesh.face_loops(f) else {
+            return false;
+        };
+        poly.clear();
+        poly.extend((outer.start..outer.start + outer.len).map(at));
+        for &(n, offset) in cutting {
+            clip(&poly, n, offset + tol, &mut next);
+            std::mem::swap(&mut poly, &mut next);
+            if poly.len() < 3 {
+                return false;
+            }
+        }
+        // Twice the polygon's area (fan from its first point).
+        let o = poly[0];
+        let twice = poly
+            .windows(2)
+            .fold(DVec3::ZERO, |acc, w| acc + (w[0] - o).cross(w[1] - o));
+        twice.length() > 2.0 * tol * tol
+    })
+}
+
+/// The part of the polygon `poly` with `n · p >= offset` (Sutherland and
+/// Hodgman), into `out`.
+fn clip(poly: &[DVec3], n: DVec3, offset: f64, out: &mut Vec<DVec3>) {
+    out.clear();
+    let Some(&last) = poly.last() else {
+        return;
+    };
+    let (mut a, mut da) = (last, n.dot(last) - offset);
+    for &b in poly {
+        let db = n.dot(b) - offset;
+        if (da >= 0.0) != (db >= 0.0) {
+            out.push(a + (b - a) * (da / (da - db)));
+        }
+        if db >= 0.0 {
+            out.push(b);
+        }
+        (a, da) = (b, db);
     }
 }
 

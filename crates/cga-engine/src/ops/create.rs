@@ -185,7 +185,7 @@ fn insert(cx: &mut Interp, shape: &mut Shape, call: &OpCall, args: &[Arg]) -> Re
                 mesh = Arc::new(m);
             }
             let bounds = cx.memo.bounds(&mesh);
-            insert_fitted_in(shape, mesh, bounds, mode);
+            insert_fitted_in(shape, mesh, bounds, mode, cx.trim_need(call));
         }
         Err(message) => {
             // A missing asset must not lose the model: warn and go on.
@@ -213,7 +213,7 @@ pub enum InsertMode {
 /// does, including the rules for scope sizes that are zero.
 pub fn insert_fitted(shape: &mut Shape, asset: Arc<Mesh>, mode: InsertMode) {
     let bounds = local_bounds(&asset);
-    insert_fitted_in(shape, asset, bounds, mode)
+    insert_fitted_in(shape, asset, bounds, mode, crate::trim::Need::Geometry)
 }
 
 /// [`insert_fitted`] with the asset's bounds (`local_bounds`) known.
@@ -222,6 +222,7 @@ fn insert_fitted_in(
     asset: Arc<Mesh>,
     bounds: Option<(DVec3, DVec3)>,
     mode: InsertMode,
+    trim: crate::trim::Need,
 ) {
     let Some((lo, hi)) = bounds else {
         shape.set_local_mesh(Mesh::new());
@@ -289,7 +290,7 @@ fn insert_fitted_in(
     if shape.trim.planes.is_some() {
         // Inserted geometry is cut by the trim planes of a component split
         // (op_i.md); it fills the box [0, size] of the new scope.
-        crate::trim::apply(shape, Some((DVec3::ZERO.min(s), DVec3::ZERO.max(s))));
+        crate::trim::apply(shape, Some((DVec3::ZERO.min(s), DVec3::ZERO.max(s))), trim);
     }
 }
 

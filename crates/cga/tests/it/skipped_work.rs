@@ -156,3 +156,50 @@ fn a_report_table_of_candler_counts_what_its_model_holds() {
     assert!(nothing.leaves > 4000, "{}", nothing.leaves);
     assert_eq!(plain[0].model.triangles() as u64, stats.triangles);
 }
+
+/// Cubes inserted on the facades, wider than their tiles, mitred at the
+/// corners by the trim planes of the component split; some moved past the
+/// corner so that nothing is left of them; some measured after the insert.
+const TRIMMED: &str = "\
+Lot --> extrude(6) comp(f) { side : Side }
+Side --> split(x) { 2 : Piece }* Beyond Measured
+Piece --> s('1.5, '1, 0.5) center(x) i(\"builtin:cube\") color(\"#808080\") T.
+Beyond --> t(scope.sx + 5, 0, 0) s(1, '1, 0.5) i(\"builtin:cube\") B.
+Measured --> s('1.2, 1, 1) center(x) i(\"builtin:cube\") report(\"area\", geometry.area) M.
+";
+
+#[test]
+fn trimmed_inserts_count_and_measure_alike_with_and_without_a_model() {
+    let rules = Engine::new(MemoryWorld::new()).load_text("/p/rules/r.cga", TRIMMED);
+    assert!(!rules.has_errors(), "{}", rules.render_diagnostics());
+    let (nothing, nothing_sum) = results(&rules, Target::Nothing);
+    let mut writer = ModelWriter::glb_in_memory(rules.export_options()).unwrap();
+    let (written, written_sum) = results(&rules, Target::Writer(&mut writer));
+    let a: Vec<_> = nothing.iter().map(seen).collect();
+    let b: Vec<_> = written.iter().map(seen).collect();
+    assert_eq!(a, b);
+    // 20 x 30: 10 + 15 pieces per pair of sides, one measured cube per
+    // side; 12 x 8: 6 + 4 and one per side. The cubes past the corners are
+    // trimmed away and not counted.
+    assert_eq!(nothing_sum.leaves, 2 * (10 + 15) + 4 + 2 * (6 + 4) + 4);
+    assert_eq!(nothing_sum.leaves, written_sum.leaves);
+    // The measured cubes are trimmed (their geometry is read).
+    let areas: Vec<f64> = nothing[0]
+        .reports
+        .iter()
+        .map(|(_, v)| match v {
+            cga::Value::Float(a) => *a,
+            other => panic!("{other:?}"),
+        })
+        .collect();
+    assert_eq!(areas.len(), 4);
+    let mut areas = areas;
+    areas.sort_by(f64::total_cmp);
+    // Untrimmed, 24 x 1 x 1 and 36 x 1 x 1 boxes have 98 and 146; mitred
+    // at both corners and open there, 84 and 124.
+    let want = [84.0, 84.0, 124.0, 124.0];
+    assert!(
+        areas.iter().zip(want).all(|(a, w)| (a - w).abs() < 1e-9),
+        "{areas:?}"
+    );
+}

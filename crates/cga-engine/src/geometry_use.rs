@@ -22,8 +22,6 @@
 //! value reads geometry, and programs with context queries, are taken as
 //! reading everywhere.
 
-use std::collections::HashSet;
-
 use crate::expr::{OpCall, RBlock, RBody, RExpr, RExprKind, RPart, RStmt};
 use crate::ops::{AttrOp, CreateOp, Op, TextureOp};
 use crate::program::Program;
@@ -33,8 +31,9 @@ use crate::shape_fns::ShapeFn;
 #[derive(Debug, Default)]
 pub struct GeometryUse {
     /// Addresses of the `i()`, primitive and `trim()` operations after
-    /// which the shape's geometry is not read (only whether it is empty).
-    unread_after: HashSet<usize>,
+    /// which the shape's geometry is not read (only whether it is empty),
+    /// sorted: a rule file has a few dozen, asked at every insert.
+    unread_after: Vec<usize>,
 }
 
 impl GeometryUse {
@@ -59,6 +58,7 @@ impl GeometryUse {
         for rule in &program.rules {
             out.visit(&reads, &rule.body);
         }
+        out.unread_after.sort_unstable();
         out
     }
 
@@ -66,9 +66,9 @@ impl GeometryUse {
     /// it (by a later operation or rule, an expression, or the model); only
     /// asked of `i()`, the primitives and `trim()`.
     pub fn read_after(&self, call: &OpCall) -> bool {
-        !self
-            .unread_after
-            .contains(&(call as *const OpCall as usize))
+        self.unread_after
+            .binary_search(&(call as *const OpCall as usize))
+            .is_err()
     }
 
     /// Records the unread trimming operations of `body` and of the bodies
@@ -86,7 +86,7 @@ impl GeometryUse {
                                 Op::Trim | Op::Create(CreateOp::Insert | CreateOp::Primitive(_))
                             );
                             if trims && !later {
-                                self.unread_after.insert(call as *const OpCall as usize);
+                                self.unread_after.push(call as *const OpCall as usize);
                             }
                             for block in [&call.block, &call.remainder_block].into_iter().flatten()
                             {

@@ -915,6 +915,18 @@ impl<'a> Interp<'a> {
         }
     }
 
+    /// Whether the parts of a split entry running `body` need their
+    /// geometry and scope: not without a model when nothing in `body` and
+    /// the rules it calls reads anything of them (`crate::geometry_use`);
+    /// then only their count, their split or component information and
+    /// whether they are empty shows.
+    pub(crate) fn builds_parts(&self, body: &crate::expr::RBody) -> bool {
+        !(self.count_leaves_only
+            && self.collected.is_none()
+            && self.context.is_none()
+            && !self.program.geometry_use().body_reads_shape(body))
+    }
+
     /// Fails with the shape limit's error if `n` more shapes would exceed
     /// it: an operation about to create that many parts (a split into
     /// hundreds of thousands of slabs) stops before doing the work.

@@ -23,7 +23,7 @@
 //! reading everywhere.
 
 use crate::expr::{OpCall, RBlock, RBody, RExpr, RExprKind, RPart, RStmt};
-use crate::ops::{AttrOp, CreateOp, Op, TextureOp};
+use crate::ops::{AttrOp, CleanupOp, CreateOp, Op, TextureOp};
 use crate::program::Program;
 use crate::shape_fns::ShapeFn;
 
@@ -34,6 +34,12 @@ pub struct GeometryUse {
     /// which the shape's geometry is not read (only whether it is empty),
     /// sorted: a rule file has a few dozen, asked at every insert.
     unread_after: Vec<usize>,
+    /// Per user function and per rule, whether it can read anything of its
+    /// shape's geometry, scope or pivot (empty: not worked out, as in
+    /// programs with context queries; then everything reads).
+    functions_shape: Vec<bool>,
+    rules_shape: Vec<bool>,
+    uv_ops_read: bool,
 }
 
 impl GeometryUse {
@@ -42,24 +48,58 @@ impl GeometryUse {
         if crate::context::ContextUse::of(program).any() {
             return out;
         }
-        let functions = functions_reading(program);
+        let uv_ops_read = program.uv_sets_read() != 0;
+        let functions = functions_reading(program, false);
         let reads = Reads {
             functions: &functions,
-            rules: Vec::new(),
-            uv_ops_read: program.uv_sets_read() != 0,
+            rules: &[],
+            uv_ops_read,
+            shape: false,
         };
         if program.attrs.iter().any(|a| reads.expr(&a.default)) {
             return out;
         }
+        let rules = rules_reading(program, &reads);
         let reads = Reads {
-            rules: rules_reading(program, &reads),
+            rules: &rules,
             ..reads
         };
         for rule in &program.rules {
             out.visit(&reads, &rule.body);
         }
         out.unread_after.sort_unstable();
+        // The same for anything of the shape: geometry, scope and pivot.
+        let functions_shape = functions_reading(program, true);
+        let reads = Reads {
+            functions: &functions_shape,
+            rules: &[],
+            uv_ops_read,
+            shape: true,
+        };
+        if program.attrs.iter().any(|a| reads.expr(&a.default)) {
+            return out;
+        }
+        out.rules_shape = rules_reading(program, &reads);
+        out.functions_shape = functions_shape;
+        out.uv_ops_read = uv_ops_read;
         out
+    }
+
+    /// Whether `body` (the operations of a component split's entry), and
+    /// the rules it calls, can read anything of its shape's geometry, scope
+    /// or pivot: if not, nothing but the part's count, its component or
+    /// split information, its material and its attributes shows.
+    pub fn body_reads_shape(&self, body: &RBody) -> bool {
+        if self.rules_shape.is_empty() {
+            return true;
+        }
+        Reads {
+            functions: &self.functions_shape,
+            rules: &self.rules_shape,
+            uv_ops_read: self.uv_ops_read,
+            shape: true,
+        }
+        .body(body)
     }
 
     /// Whether the geometry `call` leaves on its shape can be read after
@@ -133,10 +173,13 @@ impl GeometryUse {
 /// rules are being worked out: then a rule call reads nothing by itself).
 struct Reads<'a> {
     functions: &'a [bool],
-    rules: Vec<bool>,
+    rules: &'a [bool],
     /// Whether the texture coordinate operations count as reading (the
     /// rules read some set, so they are computed).
     uv_ops_read: bool,
+    /// Whether reading the scope or the pivot counts too (and operations
+    /// count by whether anything of the shape shows after them).
+    shape: bool,
 }
 
 impl Reads<'_> {
@@ -149,7 +192,13 @@ impl Reads<'_> {
             }
             RExprKind::Pure(_, args) => any(args),
             RExprKind::Shape(f, args) => {
-                matches!(f, ShapeFn::Geometry(_) | ShapeFn::Context(_)) || any(args)
+                let scope = matches!(
+                    f,
+                    ShapeFn::Scope(_) | ShapeFn::ScopeElevation | ShapeFn::Pivot(_)
+                );
+                matches!(f, ShapeFn::Geometry(_) | ShapeFn::Context(_))
+                    || (self.shape && scope)
+                    || any(args)
             }
             RExprKind::CompFn { .. } | RExprKind::CompSelector(..) => true,
             RExprKind::Unary { operand, .. } => self.expr(operand),
@@ -170,6 +219,8 @@ impl Reads<'_> {
                 branches.iter().any(|(c, v)| self.expr(c) || self.expr(v))
                     || otherwise.as_deref().is_some_and(|o| self.expr(o))
             }
+            // `'x` is relative to the scope.
+            RExprKind::Relative(_) if self.shape => true,
             RExprKind::Relative(inner) | RExprKind::Floating(inner) => self.expr(inner),
             RExprKind::WithLocals { locals, body } => any(locals) || self.expr(body),
             RExprKind::CompHead { expr, .. } => self.expr(expr),
@@ -214,6 +265,19 @@ impl Reads<'_> {
     /// Operations that neither read the shape's geometry nor change it in
     /// a way a later reader could see other than by reading it.
     fn leaves_geometry_alone(&self, op: Op) -> bool {
+        if self.shape {
+            // Changes of the scope and of the faces' winding show only to
+            // a reader; texture coordinates nobody reads are not made.
+            return match op {
+                Op::Transform(_)
+                | Op::Attr(AttrOp::Color | AttrOp::Set(_) | AttrOp::Print | AttrOp::Report)
+                | Op::Texturing(TextureOp::Texture)
+                | Op::Cleanup(CleanupOp::ReverseNormals) => true,
+                Op::Texturing(TextureOp::InsertAlongUV) => false,
+                Op::Texturing(_) => !self.uv_ops_read,
+                _ => false,
+            };
+        }
         match op {
             Op::Transform(_)
             | Op::Attr(AttrOp::Color | AttrOp::Set(_) | AttrOp::Print | AttrOp::Report) => true,
@@ -228,7 +292,7 @@ impl Reads<'_> {
 
 /// Per user function, whether its value reads geometry (through its body,
 /// its locals or the functions it calls).
-fn functions_reading(program: &Program) -> Vec<bool> {
+fn functions_reading(program: &Program, shape: bool) -> Vec<bool> {
     let n = program.functions.len();
     let mut reading = vec![false; n];
     // Until nothing changes: a function reads if its body reads with the
@@ -236,8 +300,9 @@ fn functions_reading(program: &Program) -> Vec<bool> {
     loop {
         let reads = Reads {
             functions: &reading,
-            rules: Vec::new(),
+            rules: &[],
             uv_ops_read: true,
+            shape,
         };
         let next: Vec<bool> = program
             .functions
@@ -257,8 +322,9 @@ fn rules_reading(program: &Program, base: &Reads) -> Vec<bool> {
     loop {
         let reads = Reads {
             functions: base.functions,
-            rules: reading.clone(),
+            rules: &reading,
             uv_ops_read: base.uv_ops_read,
+            shape: base.shape,
         };
         let next: Vec<bool> = program
             .rules

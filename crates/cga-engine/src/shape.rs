@@ -397,6 +397,23 @@ fn empty_mesh() -> Arc<Mesh> {
         .unwrap_or_else(|_| Arc::new(Mesh::new()))
 }
 
+impl Geometry {
+    /// A stand-in for geometry nothing will read but that is not empty (a
+    /// part of a generation without a model whose rules read nothing of
+    /// it: only whether it is empty shows, in the count of leaves): one
+    /// shared triangle per thread.
+    pub fn unread() -> Geometry {
+        thread_local! {
+            static TRIANGLE: Arc<Mesh> = Arc::new(Mesh::polygon(&[DVec3::ZERO, DVec3::X, DVec3::Y]));
+        }
+        Geometry::new(
+            TRIANGLE
+                .try_with(|m| m.clone())
+                .unwrap_or_else(|_| Arc::new(Mesh::polygon(&[DVec3::ZERO, DVec3::X, DVec3::Y]))),
+        )
+    }
+}
+
 /// Bounding box of the positions a mesh's faces use.
 pub fn local_bounds(mesh: &Mesh) -> Option<(DVec3, DVec3)> {
     let mut it = mesh.corners.iter().map(|&c| mesh.positions[c as usize]);

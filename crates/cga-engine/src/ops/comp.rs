@@ -1378,12 +1378,19 @@ pub(crate) fn run(
         // The first pass of context queries needs only the shapes on the
         // way to a label a query asks about.
         let skip = cx.context_skips_body(entry.body);
+        // Without a model, face components whose rules read nothing of
+        // their shape are not built: one is never empty, and nothing else
+        // of its geometry shows.
+        let build = kind != Kind::Faces || cx.builds_parts(entry.body);
         for (i, set) in sets.iter().enumerate() {
             let mut child = cx.child(&st.shape, entry.head.span)?;
             if skip {
                 continue;
             }
-            comps.fill_shape(&mut child, set, align, trim, upward);
+            match build {
+                true => comps.fill_shape(&mut child, set, align, trim, upward),
+                false => child.geometry = crate::shape::Geometry::unread(),
+            }
             child.comp = Some(Arc::new(CompInfo {
                 sel: text.clone(),
                 index: i as f64,

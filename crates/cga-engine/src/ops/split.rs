@@ -71,14 +71,23 @@ pub fn exec(
     let total = placed.len() as f64;
     for (part, piece) in placed.iter().zip(pieces) {
         let mut child = cx.child(&st.shape, call.span)?;
-        place_part(
-            &mut child,
-            piece,
-            axis,
-            sign * part.start,
-            sign * (part.end - part.start),
-            adjust,
-        );
+        if cx.builds_parts(bodies[part.part]) {
+            place_part(
+                &mut child,
+                piece,
+                axis,
+                sign * part.start,
+                sign * (part.end - part.start),
+                adjust,
+            );
+        } else {
+            // Without a model, a part whose rules read nothing of it shows
+            // only whether it is empty.
+            child.geometry = match piece.faces.is_empty() {
+                true => crate::shape::Geometry::empty(),
+                false => crate::shape::Geometry::unread(),
+            };
+        }
         child.split_index = part.index as f64;
         child.split_total = total;
         let mut cst = ShapeState::new(child);

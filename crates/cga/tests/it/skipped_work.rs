@@ -203,3 +203,38 @@ fn trimmed_inserts_count_and_measure_alike_with_and_without_a_model() {
         "{areas:?}"
     );
 }
+
+/// Facades split into windows and walls; the windows' openings broken into
+/// faces. Walls, jambs and glass only take a colour, a texture and a
+/// report: without a model their parts are not built.
+const UNBUILT: &str = "\
+Lot --> extrude(9) comp(f) { side : Facade | top : Roof. }
+Facade --> split(y) { 3 : Floor }*
+Floor --> split(x) { 2 : Wall | 3 : Win }*
+Win --> extrude(-0.3) comp(f) { front : reverseNormals Glass | side = color(\"#888888\") Jamb. }
+Glass --> texture(\"glass.png\") color(\"#99aaff\") report(\"glass\", comp.index) G.
+Wall --> color(\"#ffffff\") report(\"walls\", split.index) W.
+";
+
+#[test]
+fn parts_nothing_reads_count_and_report_alike_with_and_without_a_model() {
+    let rules = Engine::new(MemoryWorld::new()).load_text("/p/rules/r.cga", UNBUILT);
+    assert!(!rules.has_errors(), "{}", rules.render_diagnostics());
+    let (nothing, nothing_sum) = results(&rules, Target::Nothing);
+    let mut writer = ModelWriter::glb_in_memory(rules.export_options()).unwrap();
+    let (written, written_sum) = results(&rules, Target::Writer(&mut writer));
+    let a: Vec<_> = nothing.iter().map(seen).collect();
+    let b: Vec<_> = written.iter().map(seen).collect();
+    assert_eq!(a, b);
+    assert_eq!(nothing_sum.leaves, written_sum.leaves);
+    assert_eq!(nothing_sum.shapes, written_sum.shapes);
+    // 20 x 30 lot, three floors: per floor, a 20 m facade has 4 walls
+    // and 4 windows, a 30 m one 6 and 6; each window a glass and one jamb
+    // (its four sides in one part).
+    let count = |r: &LotResult, key: &str| r.reports.iter().filter(|(k, _)| k == key).count();
+    assert_eq!(count(&nothing[0], "glass"), 3 * 2 * (4 + 6));
+    assert_eq!(count(&nothing[0], "walls"), 3 * 2 * (4 + 6));
+    // Walls, glass, jambs and the roof.
+    assert_eq!(nothing[0].leaf_count, 60 + 60 + 60 + 1);
+    assert_eq!(nothing_sum.leaves, written_sum.leaves);
+}

@@ -49,38 +49,24 @@ impl GeometryUse {
             return out;
         }
         let uv_ops_read = program.uv_sets_read() != 0;
-        let functions = functions_reading(program, false);
+        let Some((functions, rules)) = analyse(program, uv_ops_read, false) else {
+            return out;
+        };
         let reads = Reads {
             functions: &functions,
-            rules: &[],
+            rules: &rules,
             uv_ops_read,
             shape: false,
-        };
-        if program.attrs.iter().any(|a| reads.expr(&a.default)) {
-            return out;
-        }
-        let rules = rules_reading(program, &reads);
-        let reads = Reads {
-            rules: &rules,
-            ..reads
         };
         for rule in &program.rules {
             out.visit(&reads, &rule.body);
         }
         out.unread_after.sort_unstable();
         // The same for anything of the shape: geometry, scope and pivot.
-        let functions_shape = functions_reading(program, true);
-        let reads = Reads {
-            functions: &functions_shape,
-            rules: &[],
-            uv_ops_read,
-            shape: true,
-        };
-        if program.attrs.iter().any(|a| reads.expr(&a.default)) {
-            return out;
+        if let Some((functions, rules)) = analyse(program, uv_ops_read, true) {
+            out.functions_shape = functions;
+            out.rules_shape = rules;
         }
-        out.rules_shape = rules_reading(program, &reads);
-        out.functions_shape = functions_shape;
         out.uv_ops_read = uv_ops_read;
         out
     }
@@ -290,6 +276,24 @@ impl Reads<'_> {
     }
 }
 
+/// Per user function and per rule, whether it reads geometry (with
+/// `shape`, anything of the shape); `None` when an attribute's value does
+/// (attributes are evaluated where first used, so everything reads).
+fn analyse(program: &Program, uv_ops_read: bool, shape: bool) -> Option<(Vec<bool>, Vec<bool>)> {
+    let functions = functions_reading(program, shape);
+    let reads = Reads {
+        functions: &functions,
+        rules: &[],
+        uv_ops_read,
+        shape,
+    };
+    if program.attrs.iter().any(|a| reads.expr(&a.default)) {
+        return None;
+    }
+    let rules = rules_reading(program, &reads);
+    Some((functions, rules))
+}
+
 /// Per user function, whether its value reads geometry (through its body,
 /// its locals or the functions it calls).
 fn functions_reading(program: &Program, shape: bool) -> Vec<bool> {
@@ -342,18 +346,10 @@ fn rules_reading(program: &Program, base: &Reads) -> Vec<bool> {
 mod tests {
     use super::*;
 
-    fn program(src: &str) -> Program {
-        let world = cga_world::MemoryWorld::new().with("/r/rules.cga", src);
-        let mut sources = cga_syntax::SourceMap::new();
-        let loaded = crate::load(&world, std::path::Path::new("/r/rules.cga"), &mut sources);
-        assert!(!loaded.has_errors(), "{:?}", loaded.diagnostics);
-        loaded.program
-    }
-
     /// For each rule of `src` whose body starts with `i()` or `trim()`, its
     /// name and whether the geometry that operation leaves can be read.
     fn first_ops(src: &str) -> Vec<(String, bool)> {
-        let p = program(src);
+        let p = Program::from_text(src);
         let usage = p.geometry_use();
         p.rules
             .iter()

@@ -131,6 +131,16 @@ impl Program {
             .get_or_init(|| crate::geometry_use::GeometryUse::of(self))
     }
 
+    /// The program of one rule file's text (tests of analyses).
+    #[cfg(test)]
+    pub(crate) fn from_text(src: &str) -> Program {
+        let world = cga_world::MemoryWorld::new().with("/r/rules.cga", src);
+        let mut sources = cga_syntax::SourceMap::new();
+        let loaded = crate::load(&world, std::path::Path::new("/r/rules.cga"), &mut sources);
+        assert!(!loaded.has_errors(), "{:?}", loaded.diagnostics);
+        loaded.program
+    }
+
     /// The attribute of the main file called `name`.
     pub fn main_attr(&self, name: &str) -> Option<AttrId> {
         self.main_attrs

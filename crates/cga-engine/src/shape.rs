@@ -92,6 +92,21 @@ impl Geometry {
         Geometry::new(empty_mesh())
     }
 
+    /// A stand-in for geometry nothing will read but that is not empty (a
+    /// part of a generation without a model whose rules read nothing of
+    /// it: only whether it is empty shows, in the count of leaves): one
+    /// shared triangle per thread.
+    pub fn unread() -> Geometry {
+        thread_local! {
+            static TRIANGLE: Arc<Mesh> = Arc::new(Mesh::polygon(&[DVec3::ZERO, DVec3::X, DVec3::Y]));
+        }
+        Geometry::new(
+            TRIANGLE
+                .try_with(|m| m.clone())
+                .unwrap_or_else(|_| Arc::new(Mesh::polygon(&[DVec3::ZERO, DVec3::X, DVec3::Y]))),
+        )
+    }
+
     /// Applies `m` (scope-local → scope-local) after the current map.
     pub fn transform(&mut self, m: DAffine3) {
         self.to_scope = Some(match self.to_scope {
@@ -395,23 +410,6 @@ fn empty_mesh() -> Arc<Mesh> {
     EMPTY
         .try_with(|m| m.clone())
         .unwrap_or_else(|_| Arc::new(Mesh::new()))
-}
-
-impl Geometry {
-    /// A stand-in for geometry nothing will read but that is not empty (a
-    /// part of a generation without a model whose rules read nothing of
-    /// it: only whether it is empty shows, in the count of leaves): one
-    /// shared triangle per thread.
-    pub fn unread() -> Geometry {
-        thread_local! {
-            static TRIANGLE: Arc<Mesh> = Arc::new(Mesh::polygon(&[DVec3::ZERO, DVec3::X, DVec3::Y]));
-        }
-        Geometry::new(
-            TRIANGLE
-                .try_with(|m| m.clone())
-                .unwrap_or_else(|_| Arc::new(Mesh::polygon(&[DVec3::ZERO, DVec3::X, DVec3::Y]))),
-        )
-    }
 }
 
 /// Bounding box of the positions a mesh's faces use.

@@ -89,33 +89,25 @@ pub fn sets_read(program: &Program) -> UvSets {
 mod tests {
     use super::*;
 
-    fn program(src: &str) -> Program {
-        let world = cga_world::MemoryWorld::new().with("/r/rules.cga", src);
-        let mut sources = cga_syntax::SourceMap::new();
-        let loaded = crate::load(&world, std::path::Path::new("/r/rules.cga"), &mut sources);
-        assert!(!loaded.has_errors(), "{:?}", loaded.diagnostics);
-        loaded.program
-    }
-
     #[test]
     fn sets_read_by_functions_copies_and_uv_splits() {
-        let p = program("Lot --> projectUV(0) scaleUV(2, 1, 1) X\nX --> NIL");
+        let p = Program::from_text("Lot --> projectUV(0) scaleUV(2, 1, 1) X\nX --> NIL");
         assert_eq!(sets_read(&p), 0);
-        let p = program("Lot --> report(\"u\", geometry.uMax(3)) X\nX --> NIL");
+        let p = Program::from_text("Lot --> report(\"u\", geometry.uMax(3)) X\nX --> NIL");
         assert_eq!(sets_read(&p), 1 << 3);
-        let p = program("Lot --> report(\"u\", geometry.vMin) X\nX --> NIL");
+        let p = Program::from_text("Lot --> report(\"u\", geometry.vMin) X\nX --> NIL");
         assert_eq!(sets_read(&p), 1);
-        let p = program("Lot --> report(\"t\", geometry.hasUVs) X\nX --> NIL");
+        let p = Program::from_text("Lot --> report(\"t\", geometry.hasUVs) X\nX --> NIL");
         assert_eq!(sets_read(&p), ALL_UV_SETS);
-        let p = program("Lot --> copyUV(5, 0) X\nX --> NIL");
+        let p = Program::from_text("Lot --> copyUV(5, 0) X\nX --> NIL");
         assert_eq!(sets_read(&p), 1 << 5);
-        let p = program("attr k = 2\nLot --> copyUV(k, 0) X\nX --> NIL");
+        let p = Program::from_text("attr k = 2\nLot --> copyUV(k, 0) X\nX --> NIL");
         assert_eq!(sets_read(&p), ALL_UV_SETS);
-        let p = program("Lot --> split(v, unitSpace, 4) { 0.5 : X }*\nX --> NIL");
+        let p = Program::from_text("Lot --> split(v, unitSpace, 4) { 0.5 : X }*\nX --> NIL");
         assert_eq!(sets_read(&p), 1 << 4);
-        let p = program("Lot --> split(x) { 0.5 : X }*\nX --> NIL");
+        let p = Program::from_text("Lot --> split(x) { 0.5 : X }*\nX --> NIL");
         assert_eq!(sets_read(&p), 0);
-        let p = program("f = geometry.du(1, unitSpace)\nLot --> print(f) X\nX --> NIL");
+        let p = Program::from_text("f = geometry.du(1, unitSpace)\nLot --> print(f) X\nX --> NIL");
         assert_eq!(sets_read(&p), 1 << 1);
     }
 }

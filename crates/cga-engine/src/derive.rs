@@ -415,7 +415,22 @@ pub struct Interp<'a> {
     tree_children: u32,
     /// Rule applications so far (the time limit is checked every 64).
     rules_applied: u64,
+    /// Subtrees remembered by key, in generations that only count leaves
+    /// (see `crate::subtree_memo`; `None`: not remembering).
+    pub(crate) subtrees: Option<Box<crate::subtree_memo::Remembered>>,
+    /// Subtrees being derived to be remembered, outermost first.
+    subtrees_open: u32,
+    /// What the trims have met of the trim planes of the subtrees being
+    /// remembered (see `trim::PlaneLog`).
+    pub(crate) plane_logs: Vec<crate::trim::PlaneLog>,
+    /// The deepest generation applied so far (how deep a remembered
+    /// subtree goes: the depth limit).
+    deepest: usize,
 }
+
+/// Subtrees being remembered inside one another at most (see
+/// `Interp::remembered`).
+const MAX_OPEN_SUBTREES: u32 = 8;
 
 /// A shape that ended while leaves were being collected (`Interp::collected`).
 pub(crate) struct Collected {
@@ -680,6 +695,10 @@ impl<'a> Interp<'a> {
             tree_key: Arc::from(""),
             tree_children: 0,
             rules_applied: 0,
+            subtrees: None,
+            subtrees_open: 0,
+            plane_logs: Vec::new(),
+            deepest: 0,
         }
     }
 
@@ -773,6 +792,84 @@ impl<'a> Interp<'a> {
     /// Applies a rule to its shape: the rule's operations run now, the rule
     /// calls among them are queued behind everything already waiting.
     fn run_rule(&mut self, p: PendingRule) -> Result<(), RtError> {
+        match self.remembered(p)? {
+            Some(p) => self.apply_rule(p),
+            None => Ok(()),
+        }
+    }
+
+    /// The counts of `p`'s subtree when it has been derived before for a
+    /// shape with the same key (`crate::subtree_memo`); else, if its rule
+    /// may be remembered, derives it now, remembers what it added and
+    /// returns `None`; `Some(p)` when it is to be applied as usual.
+    fn remembered(&mut self, p: PendingRule) -> Result<Option<PendingRule>, RtError> {
+        let Some(table) = self.subtrees.as_deref_mut() else {
+            return Ok(Some(p));
+        };
+        let Some(needs) = self.program.subtree_memo().rule(p.rule) else {
+            return Ok(Some(p));
+        };
+        // Each subtree being remembered nests a derivation (and a stack
+        // frame or two): a handful is plenty.
+        if self.subtrees_open >= MAX_OPEN_SUBTREES
+            || self.collected.is_some()
+            || !table.worth_trying(p.rule, self.program.rules.len())
+        {
+            return Ok(Some(p));
+        }
+        let Some(key) = crate::subtree_memo::key(p.rule, needs, &p.args, &p.shape) else {
+            return Ok(Some(p));
+        };
+        if let Some(e) = table.find(&key) {
+            if p.generation + e.depth > self.limits.max_depth {
+                return Ok(Some(p)); // to meet the limit where it is met
+            }
+            let (shapes, leaves, depth) = (e.shapes, e.leaves, e.depth);
+            if let Some(planes) = &p.shape.trim.planes {
+                for (i, slack) in e.slack_at(key.offsets()).enumerate() {
+                    for log in self.plane_logs.iter_mut() {
+                        log.met(planes, i, slack);
+                    }
+                }
+            }
+            self.check_shape_budget(shapes, p.span)?;
+            self.out.shapes += shapes;
+            self.out.leaf_count += leaves;
+            self.deepest = self.deepest.max(p.generation + depth);
+            let mut frame = p.args;
+            frame.clear();
+            self.frame_pool.push(frame);
+            return Ok(None);
+        }
+        let before = (
+            self.out.shapes,
+            self.out.leaf_count,
+            self.out.warnings.len(),
+        );
+        let generation = p.generation;
+        let outer_deepest = std::mem::replace(&mut self.deepest, generation);
+        self.plane_logs
+            .push(crate::trim::PlaneLog::new(p.shape.trim.planes.clone()));
+        self.subtrees_open += 1;
+        let r = self.derive_all_now(|cx| cx.apply_rule(p));
+        self.subtrees_open -= 1;
+        let log = self.plane_logs.pop().map(|l| l.slack).unwrap_or_default();
+        let depth = self.deepest - generation;
+        self.deepest = self.deepest.max(outer_deepest);
+        r?;
+        // A subtree that warned is derived again next time (and warns no
+        // more: warnings are given once), then remembered.
+        if self.out.warnings.len() == before.2 {
+            if let Some(table) = self.subtrees.as_deref_mut() {
+                let (shapes, leaves) = (self.out.shapes - before.0, self.out.leaf_count - before.1);
+                table.store(key, log, shapes, leaves, depth);
+            }
+        }
+        Ok(None)
+    }
+
+    /// Applies a rule to its shape (see `run_rule`).
+    fn apply_rule(&mut self, p: PendingRule) -> Result<(), RtError> {
         let PendingRule {
             rule,
             args: mut frame,
@@ -803,6 +900,7 @@ impl<'a> Interp<'a> {
         if self.rules_applied.is_multiple_of(64) {
             self.check_time(call_span)?;
         }
+        self.deepest = self.deepest.max(generation);
         let outer_generation = std::mem::replace(&mut self.generation, generation);
         let outer_key = key.map(|k| {
             (

@@ -235,6 +235,10 @@ fn derive<'a>(
     };
     interp.uv_skip = unused & !program.uv_sets_read();
     interp.count_leaves_only = options.count_leaves_only;
+    // Without a model the counts of repeated subtrees are remembered.
+    if options.count_leaves_only && interp.context.is_none() && program.subtree_memo().any() {
+        interp.subtrees = Some(Default::default());
+    }
     let mut error = None;
     // Lot attributes (GeoJSON properties) first, command-line values win.
     let lot_attrs = lot

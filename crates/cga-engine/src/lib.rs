@@ -21,6 +21,7 @@ pub mod selectors;
 pub mod shape;
 pub mod shape_fns;
 pub mod split_layout;
+pub mod subtree_memo;
 pub mod trim;
 pub mod uv_use;
 pub mod values;

@@ -114,6 +114,9 @@ pub struct Program {
     /// Which operations leave geometry nothing reads (see
     /// `crate::geometry_use`), worked out on first use.
     pub(crate) geometry_use: std::sync::OnceLock<crate::geometry_use::GeometryUse>,
+    /// Which rules' subtrees may be derived once per key (see
+    /// `crate::subtree_memo`), worked out on first use.
+    pub(crate) subtree_memo: std::sync::OnceLock<crate::subtree_memo::SubtreeMemo>,
 }
 
 impl Program {
@@ -129,6 +132,13 @@ impl Program {
     pub fn geometry_use(&self) -> &crate::geometry_use::GeometryUse {
         self.geometry_use
             .get_or_init(|| crate::geometry_use::GeometryUse::of(self))
+    }
+
+    /// Which rules' subtrees may be derived once per key (see
+    /// `crate::subtree_memo`).
+    pub fn subtree_memo(&self) -> &crate::subtree_memo::SubtreeMemo {
+        self.subtree_memo
+            .get_or_init(|| crate::subtree_memo::SubtreeMemo::of(self))
     }
 
     /// The program of one rule file's text (tests of analyses).

@@ -70,6 +70,32 @@ impl TrimPlane {
 /// The trim planes of a shape (shared between a shape and its successors).
 pub type TrimPlanes = Arc<[TrimPlane]>;
 
+/// How close the trims of a subtree being remembered came to the trim
+/// planes of its root (`crate::subtree_memo`): per plane, how far it could
+/// move towards the geometry before one of them would cut (+∞: none met
+/// it; -∞: one was cut by it).
+pub struct PlaneLog {
+    planes: Option<TrimPlanes>,
+    pub slack: Vec<f64>,
+}
+
+impl PlaneLog {
+    pub fn new(planes: Option<TrimPlanes>) -> PlaneLog {
+        let n = planes.as_ref().map_or(0, |p| p.len());
+        PlaneLog {
+            planes,
+            slack: vec![f64::INFINITY; n],
+        }
+    }
+
+    /// A trim met plane `i` of `planes` with `slack` to spare.
+    pub fn met(&mut self, planes: &TrimPlanes, i: usize, slack: f64) {
+        if self.planes.as_ref().is_some_and(|p| Arc::ptr_eq(p, planes)) {
+            self.slack[i] = self.slack[i].min(slack);
+        }
+    }
+}
+
 /// Below this angle (degrees) between the generating edge and the pivot's
 /// xz-plane a plane is horizontal.
 pub const HORIZONTAL_LIMIT_DEGREES: f64 = 40.0;
@@ -95,7 +121,8 @@ pub fn bisecting_plane(a: DVec3, b: DVec3, m_face: DVec3, m_other: DVec3) -> Opt
 
 /// `trim()`: applies the shape's active trim planes to its geometry.
 pub fn exec(cx: &mut Interp, st: &mut ShapeState, call: &OpCall) -> Result<(), RtError> {
-    apply(&mut st.shape, None, cx.trim_need(call));
+    let need = cx.trim_need(call);
+    apply(&mut st.shape, None, need, &mut cx.plane_logs);
     Ok(())
 }
 
@@ -117,7 +144,11 @@ pub enum Need {
 /// With [`Need::Emptiness`], a geometry with a face that keeps some area
 /// inside every cutting plane is left as it is (its trimmed part is not
 /// empty).
-pub fn apply(shape: &mut Shape, bounds: Option<(DVec3, DVec3)>, need: Need) {
+///
+/// `logs` of remembered subtrees (`crate::subtree_memo`) whose root has
+/// these planes learn how far each plane tested could move towards the
+/// geometry before it cut it.
+pub fn apply(shape: &mut Shape, bounds: Option<(DVec3, DVec3)>, need: Need, logs: &mut [PlaneLog]) {
     let Some(planes) = shape.trim.planes.clone() else {
         return;
     };
@@ -143,7 +174,7 @@ pub fn apply(shape: &mut Shape, bounds: Option<(DVec3, DVec3)>, need: Need) {
     let tol = 1e-9 * scale;
     // Planes in scope-local coordinates that actually cut the box.
     let mut cutting: Vec<(DVec3, f64)> = Vec::new();
-    for p in planes.iter() {
+    for (i, p) in planes.iter().enumerate() {
         if !(if p.is_vertical(pivot_y) { use_v } else { use_h }) {
             continue;
         }
@@ -156,8 +187,20 @@ pub fn apply(shape: &mut Shape, bounds: Option<(DVec3, DVec3)>, need: Need) {
             min += x.min(y);
             max += x.max(y);
         }
-        if min >= offset - tol {
-            continue; // entirely kept
+        let kept = min >= offset - tol;
+        for log in logs.iter_mut() {
+            log.met(
+                &planes,
+                i,
+                if kept {
+                    min - offset + tol
+                } else {
+                    f64::NEG_INFINITY
+                },
+            );
+        }
+        if kept {
+            continue;
         }
         if max <= offset + tol {
             // Entirely on the trimmed side: nothing is left.

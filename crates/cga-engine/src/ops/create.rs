@@ -21,7 +21,7 @@ pub fn exec(
     let shape = &mut st.shape;
     match op {
         CreateOp::Extrude => extrude(shape, args),
-        CreateOp::Primitive(kind) => primitive(shape, kind, args),
+        CreateOp::Primitive(kind) => primitive(shape, kind, args, &mut cx.plane_logs),
         CreateOp::Insert => insert(cx, shape, call, args),
     }
 }
@@ -43,7 +43,12 @@ fn count(arg: Option<&Arg>, default: usize, min: usize) -> Result<usize, RtError
     }
 }
 
-fn primitive(shape: &mut Shape, op: Primitive, args: &[Arg]) -> Result<(), RtError> {
+fn primitive(
+    shape: &mut Shape,
+    op: Primitive,
+    args: &[Arg],
+    logs: &mut [crate::trim::PlaneLog],
+) -> Result<(), RtError> {
     use cga_geometry::primitive as p;
     let unit = DVec3::ONE;
     // With dimensions: that size, centred in x and z, standing on y = 0;
@@ -127,7 +132,15 @@ fn primitive(shape: &mut Shape, op: Primitive, args: &[Arg]) -> Result<(), RtErr
         (true, None) => InsertMode::KeepSizeAlign,
         (false, _) => InsertMode::Fit,
     };
-    insert_fitted(shape, Arc::new(mesh), mode);
+    let bounds = local_bounds(&mesh);
+    insert_fitted_in(
+        shape,
+        Arc::new(mesh),
+        bounds,
+        mode,
+        crate::trim::Need::Geometry,
+        logs,
+    );
     Ok(())
 }
 
@@ -185,7 +198,8 @@ fn insert(cx: &mut Interp, shape: &mut Shape, call: &OpCall, args: &[Arg]) -> Re
                 mesh = Arc::new(m);
             }
             let bounds = cx.memo.bounds(&mesh);
-            insert_fitted_in(shape, mesh, bounds, mode, cx.trim_need(call));
+            let need = cx.trim_need(call);
+            insert_fitted_in(shape, mesh, bounds, mode, need, &mut cx.plane_logs);
         }
         Err(message) => {
             // A missing asset must not lose the model: warn and go on.
@@ -209,20 +223,16 @@ pub enum InsertMode {
     Centred([bool; 3]),
 }
 
-/// Places `asset` (in its own coordinates) into the scope as CGA's insert
-/// does, including the rules for scope sizes that are zero.
-pub fn insert_fitted(shape: &mut Shape, asset: Arc<Mesh>, mode: InsertMode) {
-    let bounds = local_bounds(&asset);
-    insert_fitted_in(shape, asset, bounds, mode, crate::trim::Need::Geometry)
-}
-
-/// [`insert_fitted`] with the asset's bounds (`local_bounds`) known.
+/// Places `asset` (in its own coordinates, with `bounds`: its
+/// `local_bounds`) into the scope as CGA's insert does, including the
+/// rules for scope sizes that are zero.
 fn insert_fitted_in(
     shape: &mut Shape,
     asset: Arc<Mesh>,
     bounds: Option<(DVec3, DVec3)>,
     mode: InsertMode,
     trim: crate::trim::Need,
+    logs: &mut [crate::trim::PlaneLog],
 ) {
     let Some((lo, hi)) = bounds else {
         shape.set_local_mesh(Mesh::new());
@@ -290,7 +300,8 @@ fn insert_fitted_in(
     if shape.trim.planes.is_some() {
         // Inserted geometry is cut by the trim planes of a component split
         // (op_i.md); it fills the box [0, size] of the new scope.
-        crate::trim::apply(shape, Some((DVec3::ZERO.min(s), DVec3::ZERO.max(s))), trim);
+        let box_ = Some((DVec3::ZERO.min(s), DVec3::ZERO.max(s)));
+        crate::trim::apply(shape, box_, trim, logs);
     }
 }
 

@@ -85,8 +85,10 @@ fn deep_rule_recursion_and_nesting_on_a_small_thread() {
 
 #[test]
 fn a_cancelled_generation_returns_within_100_ms() {
-    // Endless: every generation doubles the shapes, under generous limits.
-    let rules = memory_rules("Lot --> split(x) { ~1 : Lot | ~1 : Lot }\n");
+    // Endless: every generation doubles the shapes (each half scaled back
+    // to the whole, so that they never get too small to split), under
+    // generous limits.
+    let rules = memory_rules("Lot --> s('2, '1, '1) split(x) { ~1 : Lot | ~1 : Lot }\n");
     let cancel = cga::Cancel::new();
     let options = Options::default().cancel(cancel.clone()).limits(Limits {
         max_depth: 1_000_000,

@@ -305,9 +305,12 @@ def test_prints_and_progress(box):
     assert seen[-1] == (5, 5)
 
 
+# Four million shapes. The condition reads where each shape stands, so
+# that every one is derived: without geometry, subtrees that repeat
+# elsewhere are otherwise derived once (docs/performance.md).
 SLOW = """
 Lot --> Grow(0)
-Grow(n) --> case n < 22 : split(x) { '0.5 : Grow(n + 1) | '0.5 : Grow(n + 1) } else : X.
+Grow(n) --> case n < 22 && scope.tx >= 0 : split(x) { '0.5 : Grow(n + 1) | '0.5 : Grow(n + 1) } else : X.
 """
 
 

@@ -798,10 +798,11 @@ impl<'a> Interp<'a> {
         }
     }
 
-    /// The counts of `p`'s subtree when it has been derived before for a
-    /// shape with the same key (`crate::subtree_memo`); else, if its rule
-    /// may be remembered, derives it now, remembers what it added and
-    /// returns `None`; `Some(p)` when it is to be applied as usual.
+    /// Adds the counts of `p`'s subtree when one was derived before for a
+    /// shape with the same key (`crate::subtree_memo`) and returns `None`.
+    /// Else, if its rule may be remembered, derives a copy of it to its end
+    /// at once, and if that gave no warning, takes and remembers its counts
+    /// (`None` again). `Some(p)`: `p` is to be applied as usual.
     fn remembered(&mut self, p: PendingRule) -> Result<Option<PendingRule>, RtError> {
         let Some(table) = self.subtrees.as_deref_mut() else {
             return Ok(Some(p));
@@ -841,30 +842,62 @@ impl<'a> Interp<'a> {
             self.frame_pool.push(frame);
             return Ok(None);
         }
-        let before = (
-            self.out.shapes,
-            self.out.leaf_count,
-            self.out.warnings.len(),
-        );
+        // Derived to its end now, on a copy, into outputs of its own. If
+        // that gave a warning (or failed), the shape is derived as usual
+        // instead, in its turn, so that warnings come in the order they
+        // always do (and the next shape with its key tries again).
+        let copy = PendingRule {
+            rule: p.rule,
+            args: p.args.clone(),
+            shape: p.shape.clone(),
+            span: p.span,
+            generation: p.generation,
+            key: None,
+        };
+        let counts = LotOutput {
+            shapes: self.out.shapes,
+            leaf_count: self.out.leaf_count,
+            ..LotOutput::default()
+        };
+        let outer = std::mem::replace(&mut self.out, counts);
+        let warned = self.warned.clone();
         let generation = p.generation;
         let outer_deepest = std::mem::replace(&mut self.deepest, generation);
         self.plane_logs
             .push(crate::trim::PlaneLog::new(p.shape.trim.planes.clone()));
         self.subtrees_open += 1;
-        let r = self.derive_all_now(|cx| cx.apply_rule(p));
+        let r = self.derive_all_now(|cx| cx.apply_rule(copy));
         self.subtrees_open -= 1;
         let log = self.plane_logs.pop().map(|l| l.slack).unwrap_or_default();
         let depth = self.deepest - generation;
-        self.deepest = self.deepest.max(outer_deepest);
-        r?;
-        // A subtree that warned is derived again next time (and warns no
-        // more: warnings are given once), then remembered.
-        if self.out.warnings.len() == before.2 {
-            if let Some(table) = self.subtrees.as_deref_mut() {
-                let (shapes, leaves) = (self.out.shapes - before.0, self.out.leaf_count - before.1);
-                table.store(key, log, shapes, leaves, depth);
+        let copied = std::mem::replace(&mut self.out, outer);
+        if let Err(e) = &r {
+            // Cancelled, or out of time: so is the shape's own derivation.
+            let out_of_time = self.started.elapsed().as_secs_f64() > self.limits.max_seconds;
+            if e.kind == RtErrorKind::Cancelled || out_of_time {
+                self.deepest = outer_deepest;
+                self.warned = warned;
+                return Err(self.time_limit_error(p.span));
             }
         }
+        let quiet =
+            copied.warnings.is_empty() && copied.prints.is_empty() && copied.reports.is_empty();
+        if r.is_err() || !quiet {
+            self.deepest = outer_deepest;
+            self.warned = warned;
+            return Ok(Some(p));
+        }
+        self.deepest = self.deepest.max(outer_deepest);
+        let shapes = copied.shapes - self.out.shapes;
+        let leaves = copied.leaf_count - self.out.leaf_count;
+        self.out.shapes = copied.shapes;
+        self.out.leaf_count = copied.leaf_count;
+        if let Some(table) = self.subtrees.as_deref_mut() {
+            table.store(key, log, shapes, leaves, depth);
+        }
+        let mut frame = p.args;
+        frame.clear();
+        self.frame_pool.push(frame);
         Ok(None)
     }
 

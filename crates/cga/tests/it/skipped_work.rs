@@ -288,3 +288,31 @@ fn random_and_indexed_tiles_count_alike_with_and_without_a_model() {
     let (_, sum) = alike_with_and_without_a_model(VARIED);
     assert!(sum.leaves > 100, "{}", sum.leaves);
 }
+
+/// Missing assets deep in the facades' repeated tiles and on the roof:
+/// the roof's warning comes first (a generation earlier), with a model
+/// and without, where the tiles are counted from memory.
+const WARNING: &str = "\
+Lot --> extrude(6) comp(f) { side : Facade | top : Roof }
+Facade --> split(x) { 2 : Tile }*
+Tile --> split(y) { 1 : Deep }*
+Deep --> i(\"missing_deep.obj\") D.
+Roof --> Later
+Later --> i(\"missing_roof.obj\") R.
+";
+
+#[test]
+fn warnings_of_repeated_subtrees_come_in_their_order_with_and_without_a_model() {
+    let (nothing, _) = alike_with_and_without_a_model(WARNING);
+    let messages: Vec<&str> = nothing[0]
+        .warnings
+        .iter()
+        .map(|w| w.message.as_str())
+        .collect();
+    assert_eq!(messages.len(), 2, "{messages:?}");
+    assert!(messages[0].contains("missing_roof.obj"), "{messages:?}");
+    assert!(messages[1].contains("missing_deep.obj"), "{messages:?}");
+    // 20 x 30 lot, 6 m high: 10 + 15 tiles of 6 rows per pair of sides,
+    // each row a leaf (the shape keeps its geometry), and the roof.
+    assert_eq!(nothing[0].leaf_count, 2 * (10 + 15) * 6 + 1);
+}

@@ -822,8 +822,11 @@ impl<'a> Interp<'a> {
             return Ok(Some(p));
         };
         if let Some(e) = table.find(&key) {
-            if p.generation + e.depth > self.limits.max_depth {
-                return Ok(Some(p)); // to meet the limit where it is met
+            // To meet a limit where it is met: derived as usual.
+            if p.generation + e.depth > self.limits.max_depth
+                || self.out.shapes.saturating_add(e.shapes) > self.limits.max_shapes
+            {
+                return Ok(Some(p));
             }
             let (shapes, leaves, depth) = (e.shapes, e.leaves, e.depth);
             if let Some(planes) = &p.shape.trim.planes {
@@ -833,7 +836,6 @@ impl<'a> Interp<'a> {
                     }
                 }
             }
-            self.check_shape_budget(shapes, p.span)?;
             self.out.shapes += shapes;
             self.out.leaf_count += leaves;
             self.deepest = self.deepest.max(p.generation + depth);

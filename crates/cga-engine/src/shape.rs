@@ -388,6 +388,38 @@ impl Shape {
         }
     }
 
+    /// The map from the stored mesh's coordinates to object coordinates
+    /// without the scope's translation: the geometry turned as it stands
+    /// in object space, but around the scope's origin. Measures and
+    /// extrusions (which do not depend on where a shape stands) are taken
+    /// there, so that shapes alike but for their place give the same
+    /// results to the last bit (and coordinates far from the origin lose
+    /// no precision on the way).
+    pub fn oriented_transform(&self) -> DAffine3 {
+        let turn = DAffine3::from_mat3(self.scope.frame.axes);
+        match self.geometry.raw().1 {
+            Some(m) => turn * *m,
+            None => turn,
+        }
+    }
+
+    /// The geometry in [`oriented_transform`](Shape::oriented_transform)'s
+    /// coordinates.
+    pub fn oriented_mesh(&self) -> Mesh {
+        transformed(self.geometry.raw().0, &self.oriented_transform())
+    }
+
+    /// [`oriented_mesh`](Shape::oriented_mesh), taking the mesh out of the
+    /// shape (no copy when no other shape shares it); the shape is left
+    /// without geometry, for an operation that replaces it.
+    pub fn take_oriented_mesh(&mut self) -> Mesh {
+        let t = self.oriented_transform();
+        let g = std::mem::replace(&mut self.geometry, Geometry::empty());
+        let mut m = Arc::try_unwrap(g.mesh).unwrap_or_else(|shared| (*shared).clone());
+        transform_in_place(&mut m, &t);
+        m
+    }
+
     /// [`object_mesh`](Shape::object_mesh), taking the mesh out of the shape
     /// (no copy when no other shape shares it); the shape is left without
     /// geometry, for an operation that replaces it.

@@ -490,9 +490,11 @@ mod eval {
                 // No coordinates needed: the stored mesh serves.
                 return self.stored_mesh_fn(g, args, shape, at);
             }
-            // Measures are taken in object coordinates: scaling is lazy, so the
-            // stored mesh alone would give wrong areas.
-            let mesh = shape.object_mesh();
+            // Measures are taken in object orientation and scale: scaling is
+            // lazy, so the stored mesh alone would give wrong areas. Around
+            // the scope's origin (see `Shape::oriented_transform`): none
+            // depends on where the shape stands.
+            let mesh = shape.oriented_mesh();
             let fl = Value::Float;
             let uv_set = |i: usize| -> Result<usize, RtError> {
                 match args.get(i) {

@@ -27,8 +27,17 @@
 //! condition, a split size, an operation's argument, a stochastic rule;
 //! not in the arguments of `color`, `texture`, material settings and the
 //! texture coordinate operations (which then compute nothing), nor in a
-//! rule's parameter used only there. Candler's windows pick a random tile
-//! of their texture: their counts do not depend on it.
+//! rule's parameter used only there, as long as the random value there is
+//! a number made by arithmetic and rounding (so that whether the
+//! operation warns or fails is the same for every draw: a random choice
+//! between a colour and no colour counts). Candler's windows pick a
+//! random tile of their texture: their counts do not depend on it.
+//!
+//! Extrusions and geometry measures are computed around the scope's origin
+//! (`Shape::oriented_transform`), not in object coordinates, so that two
+//! shapes alike but for their place give the same sizes and areas to the
+//! last bit; which projections are set up is in the key (`projectUV`
+//! warns without one).
 //!
 //! The key (built by the interpreter, `derive.rs`) holds the rule, its
 //! arguments, the scope's size, angles and axes, the pivot's axes, the
@@ -48,6 +57,7 @@ use crate::selectors::Selector;
 use crate::shape::Shape;
 use crate::shape_fns::{GeometryFn, ShapeFn};
 use cga_geometry::DVec3;
+use cga_syntax::ast::BinaryOp;
 use cga_value::Value;
 
 /// What the key of a rule's subtree must hold beyond what every key does.
@@ -79,10 +89,11 @@ impl SubtreeMemo {
             return off;
         }
         let functions = function_facts(program);
+        let none = Params::default();
         // Attributes and constants are evaluated where first used: one that
         // reads the shape would take its value from whichever shape that is.
         let reads_shape = |e: &RExpr| {
-            let mut s = Scan::new(&functions, &[], 0);
+            let mut s = Scan::new(&functions, &none, usize::MAX);
             s.expr(e, true);
             s.facts.reads_shape()
         };
@@ -100,7 +111,7 @@ impl SubtreeMemo {
         let mut facts: Vec<Facts> = Vec::with_capacity(program.rules.len());
         let mut callees: Vec<Vec<u32>> = Vec::with_capacity(program.rules.len());
         for (r, def) in program.rules.iter().enumerate() {
-            let mut s = Scan::new(&functions, &params, params[r].len());
+            let mut s = Scan::new(&functions, &params, r);
             s.rule(def);
             facts.push(s.facts);
             callees.push(s.callees);
@@ -192,7 +203,8 @@ fn function_facts(program: &Program) -> Vec<Facts> {
             .functions
             .iter()
             .map(|f| {
-                let mut s = Scan::new(&facts, &[], 0);
+                let none = Params::default();
+                let mut s = Scan::new(&facts, &none, usize::MAX);
                 for l in &f.locals {
                     s.expr(l, true);
                 }
@@ -208,45 +220,190 @@ fn function_facts(program: &Program) -> Vec<Facts> {
 }
 
 /// Per rule and parameter, whether the parameter's value can matter to
-/// the counts (see the module docs), until nothing changes.
-fn relevant_params(program: &Program, functions: &[Facts]) -> Vec<Vec<bool>> {
-    let mut params: Vec<Vec<bool>> = program.rules.iter().map(|r| vec![false; r.arity]).collect();
+/// the counts (see the module docs), and whether a value that depends on
+/// the random stream can reach it (through a parameter that does not
+/// matter), until nothing changes.
+fn relevant_params(program: &Program, functions: &[Facts]) -> Params {
+    let blank =
+        || -> Vec<Vec<bool>> { program.rules.iter().map(|r| vec![false; r.arity]).collect() };
+    let mut params = Params {
+        relevant: blank(),
+        random: blank(),
+    };
     loop {
-        let mut changed = false;
+        let mut next = Params {
+            relevant: blank(),
+            random: params.random.clone(),
+        };
         for (r, def) in program.rules.iter().enumerate() {
-            let mut s = Scan::new(functions, &params, def.arity);
+            let mut s = Scan::new(functions, &params, r);
             s.rule(def);
-            if s.relevant != params[r] {
-                params[r] = s.relevant;
-                changed = true;
+            next.relevant[r] = s.relevant;
+            for (c, i) in s.random_args {
+                if let Some(slot) = next.random.get_mut(c as usize).and_then(|p| p.get_mut(i)) {
+                    *slot = true;
+                }
             }
         }
-        if !changed {
+        if next.relevant == params.relevant && next.random == params.random {
             return params;
         }
+        params = next;
     }
 }
+
+/// Per rule and parameter: whether its value matters, and whether it can
+/// carry a random value (to places where it does not matter).
+#[derive(Default)]
+struct Params {
+    relevant: Vec<Vec<bool>>,
+    random: Vec<Vec<bool>>,
+}
+
+/// Built-in functions that give a finite number for finite numbers, and
+/// fail for no value of one: a random value through them still cannot
+/// make an operation warn or fail where another would not.
+const SAFE_BUILTINS: &[&str] = &["floor", "ceil", "round", "rint", "abs", "min", "max"];
 
 /// One pass over a rule or an expression.
 struct Scan<'a> {
     functions: &'a [Facts],
-    /// Relevant parameters of every rule, as known so far.
-    params: &'a [Vec<bool>],
+    /// Parameters of every rule, as known so far.
+    params: &'a Params,
+    /// The rule scanned (`usize::MAX`: an attribute or a function).
+    rule: usize,
     facts: Facts,
     /// The parameters of the rule scanned whose values matter.
     relevant: Vec<bool>,
+    /// (rule, parameter) that a random value reaches from here.
+    random_args: Vec<(u32, usize)>,
     callees: Vec<u32>,
 }
 
 impl<'a> Scan<'a> {
-    fn new(functions: &'a [Facts], params: &'a [Vec<bool>], arity: usize) -> Scan<'a> {
+    fn new(functions: &'a [Facts], params: &'a Params, rule: usize) -> Scan<'a> {
+        let arity = params.relevant.get(rule).map_or(0, Vec::len);
         Scan {
             functions,
             params,
+            rule,
             facts: Facts::default(),
             relevant: vec![false; arity],
+            random_args: Vec::new(),
             callees: Vec::new(),
         }
+    }
+
+    /// Whether `e` depends on the random stream (a random function, a
+    /// parameter that can carry a random value, a function that draws),
+    /// and if so whether it is safe where its value does not matter: a
+    /// number or a truth value made from it by arithmetic (a division
+    /// only by something that does not depend on it), comparisons and the
+    /// built-ins of [`SAFE_BUILTINS`], so that whether the operation
+    /// taking it warns or fails is the same for every draw. Strings
+    /// (`+` with a string names another texture), conditional values and
+    /// anything else are not safe.
+    fn random(&self, e: &RExpr) -> (bool, bool) {
+        let all = |es: &[RExpr]| {
+            es.iter()
+                .map(|x| self.random(x))
+                .fold((false, true), |(t, s), (t2, s2)| (t || t2, s && s2))
+        };
+        match &e.kind {
+            RExprKind::Const(_) | RExprKind::Attr(_) => (false, true),
+            RExprKind::Local(k) => {
+                let random = self
+                    .params
+                    .random
+                    .get(self.rule)
+                    .and_then(|p| p.get(*k as usize))
+                    .copied()
+                    .unwrap_or(false);
+                (random, true)
+            }
+            // A number (or a truth value) of the stream.
+            RExprKind::Shape(ShapeFn::Rand | ShapeFn::P | ShapeFn::Seedian, args) => {
+                let (_, s) = all(args);
+                (true, s)
+            }
+            RExprKind::Shape(_, args) => {
+                let (t, s) = all(args);
+                (t, s && !t)
+            }
+            RExprKind::Pure(b, args) => {
+                let (t, s) = all(args);
+                (t, s && (!t || SAFE_BUILTINS.contains(&b.name)))
+            }
+            RExprKind::Func(f, args) => {
+                let draws = self.functions.get(*f as usize).is_none_or(|f| f.rng);
+                let (t, _) = all(args);
+                (t || draws, !(t || draws))
+            }
+            RExprKind::Unary { operand, .. } => self.random(operand),
+            RExprKind::Binary { op, lhs, rhs, .. } => {
+                let (lt, ls) = self.random(lhs);
+                let (rt, rs) = self.random(rhs);
+                let t = lt || rt;
+                // `+` of a string and a random number is a random string.
+                let numeric = |x: &RExpr, random: bool| {
+                    random || matches!(x.kind, RExprKind::Const(cga_value::Value::Float(_)))
+                };
+                let safe = ls
+                    && rs
+                    && match op {
+                        BinaryOp::Add => !t || (numeric(lhs, lt) && numeric(rhs, rt)),
+                        BinaryOp::Div | BinaryOp::Rem => !rt,
+                        _ => true,
+                    };
+                (t, safe)
+            }
+            RExprKind::Relative(inner) | RExprKind::Floating(inner) => self.random(inner),
+            _ => {
+                let any = self.walk_random(e);
+                (any, !any)
+            }
+        }
+    }
+
+    /// Whether anything in `e` depends on the random stream.
+    fn walk_random(&self, e: &RExpr) -> bool {
+        let any = |es: &mut dyn Iterator<Item = &RExpr>| {
+            let mut found = false;
+            for x in es {
+                found = found || self.walk_random(x);
+            }
+            found
+        };
+        match &e.kind {
+            RExprKind::Case {
+                branches,
+                otherwise,
+            } => any(&mut branches
+                .iter()
+                .flat_map(|(c, v)| [c, v])
+                .chain(otherwise.as_deref())),
+            RExprKind::Stochastic { .. } | RExprKind::CompFn { .. } => true,
+            RExprKind::Index { base, indices } => any(&mut std::iter::once(&**base).chain(indices)),
+            RExprKind::Range { base, step, limit } => {
+                any(&mut [&**base, &**limit].into_iter().chain(step.as_deref()))
+            }
+            RExprKind::WithLocals { locals, body } => any(&mut locals.iter().chain([&**body])),
+            RExprKind::CompSelector(_, args) => any(&mut args.iter()),
+            RExprKind::Array(rows) => any(&mut rows.iter().flatten()),
+            RExprKind::CompHead { expr, .. } => self.walk_random(expr),
+            _ => self.random(e).0,
+        }
+    }
+
+    /// An expression in a place where its value does not matter: only if
+    /// it is safe there (see [`random`](Self::random)) is the random
+    /// stream left out of the key.
+    fn inert(&mut self, e: &RExpr) {
+        let (random, safe) = self.random(e);
+        if random && !safe {
+            self.facts.rng = true;
+        }
+        self.expr(e, false);
     }
 
     fn rule(&mut self, def: &crate::program::RuleDef) {
@@ -426,11 +583,24 @@ impl<'a> Scan<'a> {
                 self.facts.creates = true;
                 self.facts.bad |= rc.dynamic;
                 self.callees.push(rc.rule);
-                let relevant = self.params.get(rc.rule as usize);
+                let relevant = self.params.relevant.get(rc.rule as usize);
                 for (i, a) in rc.args.iter().enumerate() {
                     // Before the parameters are known (functions, attributes): all matter.
                     let r = relevant.is_none_or(|p| p.get(i).copied().unwrap_or(true));
-                    self.expr(a, r);
+                    if r {
+                        self.expr(a, true);
+                        continue;
+                    }
+                    // A random value passed where it does not matter: the
+                    // parameter carries it on, if it is safe to.
+                    let (random, safe) = self.random(a);
+                    if random && safe {
+                        self.random_args.push((rc.rule, i));
+                    }
+                    if random && !safe {
+                        self.facts.rng = true;
+                    }
+                    self.expr(a, false);
                 }
                 for (_, e) in &rc.attr_overrides {
                     self.expr(e, true);
@@ -489,7 +659,12 @@ impl<'a> Scan<'a> {
         if matches!(call.op, Op::Split | Op::Comp) {
             self.facts.creates = true;
         }
-        self.exprs(&call.args, relevant);
+        for a in &call.args {
+            match relevant {
+                true => self.expr(a, true),
+                false => self.inert(a),
+            }
+        }
         for block in [&call.block, &call.remainder_block].into_iter().flatten() {
             self.block(block);
         }
@@ -581,9 +756,7 @@ impl Remembered {
                         |((&o, &now), &slack)| {
                             // Margin for the rounding of the positions derived
                             // from a scope elsewhere.
-                            slack == f64::INFINITY
-                                || o.to_bits() == now.to_bits()
-                                || now - o <= slack - (1e-6 + 1e-9 * now.abs())
+                            slack == f64::INFINITY || now - o <= slack - (1e-6 + 1e-9 * now.abs())
                         },
                     )
             })?;
@@ -648,6 +821,13 @@ pub(crate) fn key(rule: u32, needs: Needs, args: &[Value], shape: &Shape) -> Opt
         }
     }
     w.push(shape.trim.horizontal as u64 | (shape.trim.vertical as u64) << 1);
+    // Which texture projections are set up (`projectUV` warns without).
+    let projections = shape.projections.as_ref().map_or(0u64, |p| {
+        p.iter()
+            .enumerate()
+            .fold(0, |m, (k, x)| m | ((x.is_some() as u64) << k))
+    });
+    w.push(projections);
     let mut offsets = Vec::new();
     if let Some(planes) = &shape.trim.planes {
         w.push(planes.len() as u64);

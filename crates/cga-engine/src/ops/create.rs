@@ -344,7 +344,8 @@ fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {
     if shape.geometry.is_empty() || negligible {
         return Ok(());
     }
-    let mesh = shape.take_object_mesh();
+    // Extruded around the scope's origin (see `Shape::oriented_transform`).
+    let mesh = shape.take_oriented_mesh();
     let how = match kind {
         "world.up" | "world.y" | "y" => Extrusion::Direction(DVec3::Y),
         "world.x" | "x" => Extrusion::Direction(DVec3::X),
@@ -373,7 +374,7 @@ fn extrude(shape: &mut Shape, args: &[Arg]) -> Result<(), RtError> {
         .try_normalize()
         .unwrap_or_else(|| y.any_orthonormal_vector());
     let axes = DMat3::from_cols(x, y, x.cross(y));
-    let to_scope = shape.scope.frame.affine().inverse();
+    let to_scope = DAffine3::from_mat3(shape.scope.frame.axes).inverse();
     crate::shape::transform_in_place(&mut out, &to_scope);
     shape.set_local_mesh(out);
     shape.fit_scope(axes);

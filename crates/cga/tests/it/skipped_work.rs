@@ -316,3 +316,75 @@ fn warnings_of_repeated_subtrees_come_in_their_order_with_and_without_a_model() 
     // each row a leaf (the shape keeps its geometry), and the roof.
     assert_eq!(nothing[0].leaf_count, 2 * (10 + 15) * 6 + 1);
 }
+
+/// `alike_with_and_without_a_model` on lots of its own, comparing the
+/// lots' errors too; gives the lots without a model.
+fn alike_on(text: &str, lots: &[cga::Lot]) -> Vec<LotResult> {
+    let rules = Engine::new(MemoryWorld::new()).load_text("/p/rules/r.cga", text);
+    assert!(!rules.has_errors(), "{}", rules.render_diagnostics());
+    let run = |target: Target<'_>| {
+        let mut out = Vec::new();
+        rules
+            .generate_lots(lots, &Options::default().jobs(1), target, |r| out.push(r))
+            .unwrap();
+        out
+    };
+    let nothing = run(Target::Nothing);
+    let mut writer = ModelWriter::glb_in_memory(rules.export_options()).unwrap();
+    let written = run(Target::Writer(&mut writer));
+    let seen_all = |r: &LotResult| (seen(r), r.error.as_ref().map(|e| e.message.clone()));
+    let a: Vec<_> = nothing.iter().map(seen_all).collect();
+    let b: Vec<_> = written.iter().map(seen_all).collect();
+    assert_eq!(a, b, "{text}");
+    nothing
+}
+
+/// Lots whose sizes are not round, at the origin and away from it.
+fn odd_lots() -> Vec<cga::Lot> {
+    let sizes = [(22.9, 30.0), (101.3, 30.0), (20.0, 30.0)];
+    let mut lots: Vec<cga::Lot> = sizes.iter().map(|&(w, d)| cga::lots::rect(w, d)).collect();
+    for &(w, d) in &sizes {
+        let mut lot = cga::lots::rect(w, d);
+        for p in lot.mesh.positions.iter_mut() {
+            p.x += 1234.567;
+            p.z -= 765.4321;
+        }
+        lots.push(lot);
+    }
+    lots
+}
+
+#[test]
+fn tiles_that_meet_a_threshold_exactly_count_alike_wherever_they_stand() {
+    // Widths set to 3 m, extruded, then compared with 3 m; areas of
+    // 3 x 30 m compared with 90 m²: measured and extruded around the
+    // scope's origin, every tile gives the same answer wherever it stands
+    // (in object coordinates some gave 3 m less a last bit).
+    for text in [
+        "Lot --> split(x) { ~1 : W }*\nW --> s(3, '1, '1) extrude(world.y, 1) Q\nQ --> case scope.sx < 3 : B. else : split(x) { 1 : A. }*\n",
+        "Lot --> split(x) { ~1 : W }*\nW --> s(3, '1, '1) Q\nQ --> case geometry.area < 90 : B. else : split(x) { 0.5 : A. }*\n",
+    ] {
+        let lots = alike_on(text, &odd_lots());
+        // About a metre a tile (23, 101 and 20 of them), each made 3 m
+        // wide: none is less than 3 m wide, or than 90 m², so each is split
+        // into 3 (or 6) leaves, at the origin and away from it.
+        let leaves: Vec<usize> = lots.iter().map(|r| r.leaf_count).collect();
+        let k = if text.contains("0.5") { 6 } else { 3 };
+        assert_eq!(leaves, [23 * k, 101 * k, 20 * k, 23 * k, 101 * k, 20 * k], "{text}");
+    }
+}
+
+#[test]
+fn random_values_that_can_fail_or_warn_count_alike_with_and_without_a_model() {
+    // A random colour that is sometimes no colour, a random opacity that
+    // is sometimes a string, a projection that only some tiles set up: the
+    // tiles are derived for their own draws, and warn or fail as they do
+    // with a model.
+    for text in [
+        "Lot --> split(x) { ~1 : A }*\nA --> color(case rand < 0.5 : \"#ff0000\" else : \"bogus\") split(z) { 1 : X. }*\n",
+        "Lot --> split(x) { ~1 : A }*\nA --> set(material.opacity, case rand < 0.7 : 1 else : \"x\") split(z) { 1 : X. }*\n",
+        "Lot --> split(x) { 10 : P | 10 : W }\nP --> setupProjection(0, scope.xz, 1, 1) W\nW --> projectUV(0) split(z) { 1 : X. }*\n",
+    ] {
+        alike_on(text, &odd_lots());
+    }
+}

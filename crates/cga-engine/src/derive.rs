@@ -863,6 +863,7 @@ impl<'a> Interp<'a> {
         };
         let outer = std::mem::replace(&mut self.out, counts);
         let warned = self.warned.clone();
+        let mark = self.subtrees.as_deref().map_or(0, |t| t.mark());
         let generation = p.generation;
         let outer_deepest = std::mem::replace(&mut self.deepest, generation);
         self.plane_logs
@@ -875,10 +876,12 @@ impl<'a> Interp<'a> {
         let copied = std::mem::replace(&mut self.out, outer);
         if let Err(e) = &r {
             // Cancelled, or out of time: so is the shape's own derivation.
-            let out_of_time = self.started.elapsed().as_secs_f64() > self.limits.max_seconds;
-            if e.kind == RtErrorKind::Cancelled || out_of_time {
+            if e.kind == RtErrorKind::Cancelled || self.out_of_time() {
                 self.deepest = outer_deepest;
                 self.warned = warned;
+                if let Some(table) = self.subtrees.as_deref_mut() {
+                    table.forget_since(mark);
+                }
                 return Err(self.time_limit_error(p.span));
             }
         }
@@ -887,6 +890,9 @@ impl<'a> Interp<'a> {
         if r.is_err() || !quiet {
             self.deepest = outer_deepest;
             self.warned = warned;
+            if let Some(table) = self.subtrees.as_deref_mut() {
+                table.forget_since(mark);
+            }
             return Ok(Some(p));
         }
         self.deepest = self.deepest.max(outer_deepest);
@@ -1084,6 +1090,11 @@ impl<'a> Interp<'a> {
             return Err(self.time_limit_error(span));
         }
         Ok(())
+    }
+
+    /// Whether the initial shape has taken longer than its time limit.
+    pub(crate) fn out_of_time(&self) -> bool {
+        self.started.elapsed().as_secs_f64() > self.limits.max_seconds
     }
 
     fn is_cancelled(&self) -> bool {

@@ -213,6 +213,33 @@ fn derive<'a>(
     sink: Option<Box<dyn FnMut(Leaf) + 'a>>,
     context: Option<Box<ContextState>>,
 ) -> (LotOutput, Option<RtError>, Option<Box<ContextState>>) {
+    let lot = LotRun {
+        lot,
+        index: lot_index,
+        remember: true,
+    };
+    derive_lot(program, assets, rule, lot, options, sink, context)
+}
+
+/// The lot a derivation runs on, and whether it may count repeated
+/// subtrees from memory (`crate::subtree_memo`).
+struct LotRun<'l> {
+    lot: &'l Lot,
+    index: usize,
+    remember: bool,
+}
+
+/// [`derive`] of `run`.
+fn derive_lot<'a>(
+    program: &'a Program,
+    assets: &'a Assets,
+    rule: RuleId,
+    run: LotRun<'_>,
+    options: &GenerateOptions,
+    sink: Option<Box<dyn FnMut(Leaf) + 'a>>,
+    context: Option<Box<ContextState>>,
+) -> (LotOutput, Option<RtError>, Option<Box<ContextState>>) {
+    let (lot, lot_index) = (run.lot, run.index);
     let seed = options
         .lot_seed
         .or_else(|| own_seed(program, lot))
@@ -236,7 +263,11 @@ fn derive<'a>(
     interp.uv_skip = unused & !program.uv_sets_read();
     interp.count_leaves_only = options.count_leaves_only;
     // Without a model the counts of repeated subtrees are remembered.
-    if options.count_leaves_only && interp.context.is_none() && program.subtree_memo().any() {
+    if run.remember
+        && options.count_leaves_only
+        && interp.context.is_none()
+        && program.subtree_memo().any()
+    {
         interp.subtrees = Some(Default::default());
     }
     let mut error = None;
@@ -258,6 +289,23 @@ fn derive<'a>(
     if error.is_none() {
         if let Err(e) = interp.run(rule) {
             error = Some(e);
+        }
+    }
+    // A lot that failed with subtrees counted from memory is derived again
+    // without: where it stops (and what it had counted by then) follows
+    // the order of the derivation, which remembered subtrees change.
+    // Not after cancellation or the time limit.
+    if let Some(e) = &error {
+        let again = interp.subtrees.is_some()
+            && e.kind != crate::derive::RtErrorKind::Cancelled
+            && !interp.out_of_time();
+        if again {
+            let sink = interp.leaf_sink.take();
+            let run = LotRun {
+                remember: false,
+                ..run
+            };
+            return derive_lot(program, assets, rule, run, options, sink, None);
         }
     }
     let context = interp.context.take();

@@ -27,11 +27,13 @@
 //! condition, a split size, an operation's argument, a stochastic rule;
 //! not in the arguments of `color`, `texture`, material settings and the
 //! texture coordinate operations (which then compute nothing), nor in a
-//! rule's parameter used only there, as long as the random value there is
-//! a number made by arithmetic and rounding (so that whether the
-//! operation warns or fails is the same for every draw: a random choice
-//! between a colour and no colour counts). Candler's windows pick a
-//! random tile of their texture: their counts do not depend on it.
+//! rule's parameter used only there. Where a value does not matter it can
+//! still make an operation warn (a texture size of 0, a colour that is
+//! none), so a random value is left out of the key only in `translateUV`
+//! and `rotateUV`, and only as a number made by arithmetic and rounding
+//! (so that whether the operation warns is the same for every draw).
+//! Candler's windows pick a random tile of their texture (a `translateUV`
+//! by a random whole number of tiles): their counts do not depend on it.
 //!
 //! Extrusions and geometry measures are computed around the scope's origin
 //! (`Shape::oriented_transform`), not in object coordinates, so that two
@@ -659,10 +661,21 @@ impl<'a> Scan<'a> {
         if matches!(call.op, Op::Split | Op::Comp) {
             self.facts.creates = true;
         }
+        // Where a value does not matter, a random one still can make an
+        // operation warn (a texture size of 0, a colour that is none):
+        // only moving and turning texture coordinates takes any number.
+        let any_number = matches!(
+            call.op,
+            Op::Texturing(TextureOp::TranslateUV | TextureOp::RotateUV)
+        );
         for a in &call.args {
-            match relevant {
-                true => self.expr(a, true),
-                false => self.inert(a),
+            match (relevant, any_number) {
+                (true, _) => self.expr(a, true),
+                (false, true) => self.inert(a),
+                (false, false) => {
+                    self.facts.rng |= self.random(a).0;
+                    self.expr(a, false);
+                }
             }
         }
         for block in [&call.block, &call.remainder_block].into_iter().flatten() {
@@ -701,6 +714,8 @@ pub(crate) struct Remembered {
     /// Per rule: keys built and keys found. A rule whose shapes rarely
     /// repeat stops being looked up.
     tries: Vec<(u32, u32)>,
+    /// The keys stored, in order (see [`forget_since`](Self::forget_since)).
+    stored: Vec<u64>,
 }
 
 /// Remembered counts of one subtree.
@@ -781,6 +796,27 @@ impl Remembered {
             depth,
         });
         self.entries += 1;
+        self.stored.push(key.hash);
+    }
+
+    /// How many entries have been stored so far.
+    pub fn mark(&self) -> usize {
+        self.stored.len()
+    }
+
+    /// Drops the entries stored since `mark`: those of a copy derived to
+    /// be remembered and then dropped. One of them may have given no
+    /// warning only because the dropped copy had given it just before.
+    pub fn forget_since(&mut self, mark: usize) {
+        while self.stored.len() > mark {
+            let Some(hash) = self.stored.pop() else {
+                break;
+            };
+            if let Some(list) = self.table.get_mut(&hash) {
+                list.pop();
+            }
+            self.entries -= 1;
+        }
     }
 }
 

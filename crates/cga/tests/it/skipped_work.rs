@@ -320,12 +320,17 @@ fn warnings_of_repeated_subtrees_come_in_their_order_with_and_without_a_model() 
 /// `alike_with_and_without_a_model` on lots of its own, comparing the
 /// lots' errors too; gives the lots without a model.
 fn alike_on(text: &str, lots: &[cga::Lot]) -> Vec<LotResult> {
+    alike_with(text, lots, &Options::default().jobs(1))
+}
+
+/// [`alike_on`] with `options`.
+fn alike_with(text: &str, lots: &[cga::Lot], options: &Options) -> Vec<LotResult> {
     let rules = Engine::new(MemoryWorld::new()).load_text("/p/rules/r.cga", text);
     assert!(!rules.has_errors(), "{}", rules.render_diagnostics());
     let run = |target: Target<'_>| {
         let mut out = Vec::new();
         rules
-            .generate_lots(lots, &Options::default().jobs(1), target, |r| out.push(r))
+            .generate_lots(lots, options, target, |r| out.push(r))
             .unwrap();
         out
     };
@@ -384,7 +389,35 @@ fn random_values_that_can_fail_or_warn_count_alike_with_and_without_a_model() {
         "Lot --> split(x) { ~1 : A }*\nA --> color(case rand < 0.5 : \"#ff0000\" else : \"bogus\") split(z) { 1 : X. }*\n",
         "Lot --> split(x) { ~1 : A }*\nA --> set(material.opacity, case rand < 0.7 : 1 else : \"x\") split(z) { 1 : X. }*\n",
         "Lot --> split(x) { 10 : P | 10 : W }\nP --> setupProjection(0, scope.xz, 1, 1) W\nW --> projectUV(0) split(z) { 1 : X. }*\n",
+        // A texture size of 0 for some draws.
+        "Lot --> split(x) { 1 : W }*\nW --> setupProjection(0, scope.xy, floor(rand * 10), 1) B\nB --> X.\n",
+        // The repeated part warns: the copy of the whole that saw it first
+        // is dropped, and so is what it remembered of the parts.
+        "Lot --> split(x) { 1 : A }*\nA --> i(\"missing.obj\") B\nB --> X.\n",
     ] {
         alike_on(text, &odd_lots());
     }
+}
+
+#[test]
+fn a_lot_that_meets_the_shape_limit_stops_where_it_does_with_a_model() {
+    // Remembered subtrees count their leaves at once, where their root
+    // is: a lot that fails is derived again without them, so its partial
+    // counts are those of the model (2,999 shapes, no leaf yet).
+    let text = "Lot --> extrude(12) split(x) { 1 : R1(4) }*\n\
+        R1(d) --> case d <= 0 : NIL else : split(x) { ~2 : R2(d - 1) }\n\
+        R2(d) --> case d <= 0 : Y. else : split(y) { 2 : extrude(1) R2(d - 1) }*\n";
+    let limits = cga::Limits {
+        max_shapes: 3000,
+        ..cga::Limits::default()
+    };
+    let lots = [cga::lots::rect(22.9, 30.7)];
+    let r = alike_with(text, &lots, &Options::default().jobs(1).limits(limits));
+    assert_eq!((r[0].shapes, r[0].leaf_count), (2999, 0));
+    assert!(r[0]
+        .error
+        .as_ref()
+        .unwrap()
+        .message
+        .starts_with("shape limit (3000)"));
 }

@@ -839,9 +839,7 @@ impl<'a> Interp<'a> {
             self.out.shapes += shapes;
             self.out.leaf_count += leaves;
             self.deepest = self.deepest.max(p.generation + depth);
-            let mut frame = p.args;
-            frame.clear();
-            self.frame_pool.push(frame);
+            self.pool_frame(p.args);
             return Ok(None);
         }
         // Derived to its end now, on a copy, into outputs of its own. If
@@ -874,24 +872,20 @@ impl<'a> Interp<'a> {
         let log = self.plane_logs.pop().map(|l| l.slack).unwrap_or_default();
         let depth = self.deepest - generation;
         let copied = std::mem::replace(&mut self.out, outer);
-        if let Err(e) = &r {
-            // Cancelled, or out of time: so is the shape's own derivation.
-            if e.kind == RtErrorKind::Cancelled || self.out_of_time() {
-                self.deepest = outer_deepest;
-                self.warned = warned;
-                if let Some(table) = self.subtrees.as_deref_mut() {
-                    table.forget_since(mark);
-                }
-                return Err(self.time_limit_error(p.span));
-            }
-        }
         let quiet =
             copied.warnings.is_empty() && copied.prints.is_empty() && copied.reports.is_empty();
         if r.is_err() || !quiet {
+            // Dropped, with what it remembered of its parts.
             self.deepest = outer_deepest;
             self.warned = warned;
             if let Some(table) = self.subtrees.as_deref_mut() {
                 table.forget_since(mark);
+            }
+            // Cancelled, or out of time: so is the shape's own derivation.
+            if let Err(e) = &r {
+                if e.kind == RtErrorKind::Cancelled || self.out_of_time() {
+                    return Err(self.time_limit_error(p.span));
+                }
             }
             return Ok(Some(p));
         }
@@ -903,10 +897,14 @@ impl<'a> Interp<'a> {
         if let Some(table) = self.subtrees.as_deref_mut() {
             table.store(key, log, shapes, leaves, depth);
         }
-        let mut frame = p.args;
+        self.pool_frame(p.args);
+        Ok(None)
+    }
+
+    /// Keeps a rule's argument frame for the next rule call.
+    fn pool_frame(&mut self, mut frame: Vec<Value>) {
         frame.clear();
         self.frame_pool.push(frame);
-        Ok(None)
     }
 
     /// Applies a rule to its shape (see `run_rule`).
@@ -920,8 +918,7 @@ impl<'a> Interp<'a> {
             key,
         } = p;
         if self.context.is_some() && self.context_skips(rule) {
-            frame.clear();
-            self.frame_pool.push(frame);
+            self.pool_frame(frame);
             return Ok(());
         }
         let program = self.program;
@@ -976,8 +973,7 @@ impl<'a> Interp<'a> {
             self.tree_key = k;
             self.tree_children = n;
         }
-        frame.clear();
-        self.frame_pool.push(frame);
+        self.pool_frame(frame);
         r
     }
 

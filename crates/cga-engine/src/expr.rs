@@ -95,6 +95,87 @@ impl RExpr {
             span,
         }
     }
+
+    /// Calls `f` with each expression directly inside this one, in source
+    /// order (the analyses walk expressions with it).
+    pub fn for_each_child(&self, f: &mut dyn FnMut(&RExpr)) {
+        match &self.kind {
+            RExprKind::Const(_) | RExprKind::Local(_) | RExprKind::Attr(_) => {}
+            RExprKind::Func(_, args)
+            | RExprKind::Pure(_, args)
+            | RExprKind::Shape(_, args)
+            | RExprKind::CompSelector(_, args) => args.iter().for_each(f),
+            RExprKind::Unary { operand, .. } => f(operand),
+            RExprKind::Binary { lhs, rhs, .. } => {
+                f(lhs);
+                f(rhs);
+            }
+            RExprKind::Array(rows) => rows.iter().flatten().for_each(f),
+            RExprKind::Range { base, step, limit } => {
+                f(base);
+                if let Some(s) = step {
+                    f(s);
+                }
+                f(limit);
+            }
+            RExprKind::Index { base, indices } => {
+                f(base);
+                indices.iter().for_each(f);
+            }
+            RExprKind::Case {
+                branches,
+                otherwise,
+            }
+            | RExprKind::Stochastic {
+                branches,
+                otherwise,
+            } => {
+                for (c, v) in branches {
+                    f(c);
+                    f(v);
+                }
+                if let Some(o) = otherwise {
+                    f(o);
+                }
+            }
+            RExprKind::Relative(inner) | RExprKind::Floating(inner) => f(inner),
+            RExprKind::WithLocals { locals, body } => {
+                locals.iter().for_each(&mut *f);
+                f(body);
+            }
+            RExprKind::CompHead { expr, .. } => f(expr),
+            RExprKind::CompFn { args, block } => {
+                args.iter().for_each(&mut *f);
+                block_exprs(block, f);
+            }
+        }
+    }
+
+    /// Whether `f` holds for some expression directly inside this one.
+    pub fn any_child(&self, mut f: impl FnMut(&RExpr) -> bool) -> bool {
+        let mut any = false;
+        self.for_each_child(&mut |c| any = any || f(c));
+        any
+    }
+}
+
+/// The heads, depths and bodies of a comp function's block.
+fn block_exprs(block: &RBlock<RExpr>, f: &mut dyn FnMut(&RExpr)) {
+    for p in &block.parts {
+        match p {
+            RPart::Entry {
+                head, depth, body, ..
+            } => {
+                f(head);
+                if let Some(d) = depth {
+                    f(d);
+                }
+                f(body);
+            }
+            RPart::Group(g) => block_exprs(g, f),
+            RPart::Unlabeled { body, .. } => f(body),
+        }
+    }
 }
 
 /// What a rule body, a branch, a block entry or a push block does.

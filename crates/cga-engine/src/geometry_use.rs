@@ -170,46 +170,23 @@ struct Reads<'a> {
 
 impl Reads<'_> {
     fn expr(&self, e: &RExpr) -> bool {
-        let any = |es: &[RExpr]| es.iter().any(|x| self.expr(x));
         match &e.kind {
-            RExprKind::Const(_) | RExprKind::Local(_) | RExprKind::Attr(_) => false,
-            RExprKind::Func(f, args) => {
-                self.functions.get(*f as usize).copied().unwrap_or(true) || any(args)
+            RExprKind::Func(f, _) if self.functions.get(*f as usize).copied().unwrap_or(true) => {
+                true
             }
-            RExprKind::Pure(_, args) => any(args),
-            RExprKind::Shape(f, args) => {
+            RExprKind::Shape(f, _) => {
                 let scope = matches!(
                     f,
                     ShapeFn::Scope(_) | ShapeFn::ScopeElevation | ShapeFn::Pivot(_)
                 );
                 matches!(f, ShapeFn::Geometry(_) | ShapeFn::Context(_))
                     || (self.shape && scope)
-                    || any(args)
+                    || e.any_child(|c| self.expr(c))
             }
             RExprKind::CompFn { .. } | RExprKind::CompSelector(..) => true,
-            RExprKind::Unary { operand, .. } => self.expr(operand),
-            RExprKind::Binary { lhs, rhs, .. } => self.expr(lhs) || self.expr(rhs),
-            RExprKind::Array(rows) => rows.iter().any(|r| any(r)),
-            RExprKind::Range { base, step, limit } => {
-                self.expr(base) || step.as_deref().is_some_and(|s| self.expr(s)) || self.expr(limit)
-            }
-            RExprKind::Index { base, indices } => self.expr(base) || any(indices),
-            RExprKind::Case {
-                branches,
-                otherwise,
-            }
-            | RExprKind::Stochastic {
-                branches,
-                otherwise,
-            } => {
-                branches.iter().any(|(c, v)| self.expr(c) || self.expr(v))
-                    || otherwise.as_deref().is_some_and(|o| self.expr(o))
-            }
             // `'x` is relative to the scope.
             RExprKind::Relative(_) if self.shape => true,
-            RExprKind::Relative(inner) | RExprKind::Floating(inner) => self.expr(inner),
-            RExprKind::WithLocals { locals, body } => any(locals) || self.expr(body),
-            RExprKind::CompHead { expr, .. } => self.expr(expr),
+            _ => e.any_child(|c| self.expr(c)),
         }
     }
 

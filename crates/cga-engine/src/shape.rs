@@ -381,11 +381,7 @@ impl Shape {
     /// The map from the stored mesh's coordinates to object coordinates
     /// (what [`object_mesh`](Shape::object_mesh) applies).
     pub fn object_transform(&self) -> DAffine3 {
-        let frame = self.scope.frame.affine();
-        match self.geometry.raw().1 {
-            Some(m) => frame * *m,
-            None => frame,
-        }
+        self.after_pending(self.scope.frame.affine())
     }
 
     /// The map from the stored mesh's coordinates to object coordinates
@@ -396,10 +392,14 @@ impl Shape {
     /// results to the last bit (and coordinates far from the origin lose
     /// no precision on the way).
     pub fn oriented_transform(&self) -> DAffine3 {
-        let turn = DAffine3::from_mat3(self.scope.frame.axes);
+        self.after_pending(DAffine3::from_mat3(self.scope.frame.axes))
+    }
+
+    /// `map` applied after the geometry's pending map, if any.
+    fn after_pending(&self, map: DAffine3) -> DAffine3 {
         match self.geometry.raw().1 {
-            Some(m) => turn * *m,
-            None => turn,
+            Some(m) => map * *m,
+            None => map,
         }
     }
 
@@ -410,14 +410,10 @@ impl Shape {
     }
 
     /// [`oriented_mesh`](Shape::oriented_mesh), taking the mesh out of the
-    /// shape (no copy when no other shape shares it); the shape is left
-    /// without geometry, for an operation that replaces it.
+    /// shape (see [`take_object_mesh`](Shape::take_object_mesh)).
     pub fn take_oriented_mesh(&mut self) -> Mesh {
         let t = self.oriented_transform();
-        let g = std::mem::replace(&mut self.geometry, Geometry::empty());
-        let mut m = Arc::try_unwrap(g.mesh).unwrap_or_else(|shared| (*shared).clone());
-        transform_in_place(&mut m, &t);
-        m
+        self.take_mesh_mapped(&t)
     }
 
     /// [`object_mesh`](Shape::object_mesh), taking the mesh out of the shape
@@ -425,9 +421,14 @@ impl Shape {
     /// geometry, for an operation that replaces it.
     pub fn take_object_mesh(&mut self) -> Mesh {
         let t = self.object_transform();
+        self.take_mesh_mapped(&t)
+    }
+
+    /// The stored mesh taken out of the shape and mapped by `t`.
+    fn take_mesh_mapped(&mut self, t: &DAffine3) -> Mesh {
         let g = std::mem::replace(&mut self.geometry, Geometry::empty());
         let mut m = Arc::try_unwrap(g.mesh).unwrap_or_else(|shared| (*shared).clone());
-        transform_in_place(&mut m, &t);
+        transform_in_place(&mut m, t);
         m
     }
 }

@@ -107,6 +107,23 @@ pub enum GeometryFn {
     IsInstanced,
 }
 
+impl GeometryFn {
+    /// Whether the function reads texture coordinates (`geometry.hasUVs`,
+    /// `uMin`, `uMax`, `vMin`, `vMax`, `du`, `dv`).
+    pub fn reads_uvs(self) -> bool {
+        matches!(
+            self,
+            GeometryFn::HasUVs
+                | GeometryFn::UMin
+                | GeometryFn::UMax
+                | GeometryFn::VMin
+                | GeometryFn::VMax
+                | GeometryFn::Du
+                | GeometryFn::Dv
+        )
+    }
+}
+
 /// The shape function called `name` with `arity` arguments, if any.
 pub fn lookup(name: &str, arity: usize) -> Option<ShapeFn> {
     let axis = |s: &str| match s {

@@ -369,30 +369,15 @@ impl<'a> Scan<'a> {
 
     /// Whether anything in `e` depends on the random stream.
     fn walk_random(&self, e: &RExpr) -> bool {
-        let any = |es: &mut dyn Iterator<Item = &RExpr>| {
-            let mut found = false;
-            for x in es {
-                found = found || self.walk_random(x);
-            }
-            found
-        };
         match &e.kind {
-            RExprKind::Case {
-                branches,
-                otherwise,
-            } => any(&mut branches
-                .iter()
-                .flat_map(|(c, v)| [c, v])
-                .chain(otherwise.as_deref())),
             RExprKind::Stochastic { .. } | RExprKind::CompFn { .. } => true,
-            RExprKind::Index { base, indices } => any(&mut std::iter::once(&**base).chain(indices)),
-            RExprKind::Range { base, step, limit } => {
-                any(&mut [&**base, &**limit].into_iter().chain(step.as_deref()))
-            }
-            RExprKind::WithLocals { locals, body } => any(&mut locals.iter().chain([&**body])),
-            RExprKind::CompSelector(_, args) => any(&mut args.iter()),
-            RExprKind::Array(rows) => any(&mut rows.iter().flatten()),
-            RExprKind::CompHead { expr, .. } => self.walk_random(expr),
+            RExprKind::Case { .. }
+            | RExprKind::Index { .. }
+            | RExprKind::Range { .. }
+            | RExprKind::WithLocals { .. }
+            | RExprKind::CompSelector(..)
+            | RExprKind::Array(_)
+            | RExprKind::CompHead { .. } => e.any_child(|c| self.walk_random(c)),
             _ => self.random(e).0,
         }
     }
@@ -419,15 +404,12 @@ impl<'a> Scan<'a> {
     /// `relevant`: whether the expression's value can matter.
     fn expr(&mut self, e: &RExpr, relevant: bool) {
         match &e.kind {
-            RExprKind::Const(_) | RExprKind::Attr(_) => {}
-            RExprKind::Local(k) => {
-                if relevant {
-                    if let Some(r) = self.relevant.get_mut(*k as usize) {
-                        *r = true;
-                    }
+            RExprKind::Local(k) if relevant => {
+                if let Some(r) = self.relevant.get_mut(*k as usize) {
+                    *r = true;
                 }
             }
-            RExprKind::Func(f, args) => {
+            RExprKind::Func(f, _) => {
                 let mut f = self.functions.get(*f as usize).copied().unwrap_or(Facts {
                     bad: true,
                     ..Facts::default()
@@ -435,74 +417,18 @@ impl<'a> Scan<'a> {
                 f.rng &= relevant;
                 f.creates = false;
                 self.facts = self.facts.or(f);
-                self.exprs(args, relevant);
             }
-            RExprKind::Pure(_, args) => self.exprs(args, relevant),
-            RExprKind::Shape(f, args) => {
-                self.shape_fn(*f, relevant);
-                self.exprs(args, relevant);
-            }
-            RExprKind::Unary { operand, .. } => self.expr(operand, relevant),
-            RExprKind::Binary { lhs, rhs, .. } => {
-                self.expr(lhs, relevant);
-                self.expr(rhs, relevant);
-            }
-            RExprKind::Array(rows) => {
-                for r in rows {
-                    self.exprs(r, relevant);
-                }
-            }
-            RExprKind::Range { base, step, limit } => {
-                self.expr(base, relevant);
-                if let Some(s) = step {
-                    self.expr(s, relevant);
-                }
-                self.expr(limit, relevant);
-            }
-            RExprKind::Index { base, indices } => {
-                self.expr(base, relevant);
-                self.exprs(indices, relevant);
-            }
-            RExprKind::Case {
-                branches,
-                otherwise,
-            }
-            | RExprKind::Stochastic {
-                branches,
-                otherwise,
-            } => {
-                if relevant && matches!(e.kind, RExprKind::Stochastic { .. }) {
-                    self.facts.rng = true;
-                }
-                for (c, v) in branches {
-                    self.expr(c, relevant);
-                    self.expr(v, relevant);
-                }
-                if let Some(o) = otherwise {
-                    self.expr(o, relevant);
-                }
-            }
-            RExprKind::Relative(inner) | RExprKind::Floating(inner) => self.expr(inner, relevant),
-            RExprKind::WithLocals { locals, body } => {
-                self.exprs(locals, relevant);
-                self.expr(body, relevant);
-            }
-            RExprKind::CompHead { expr, .. } => self.expr(expr, relevant),
-            RExprKind::CompSelector(sel, args) => {
-                if *sel == Selector::IsTagged {
-                    self.facts.bad = true;
-                }
-                self.exprs(args, relevant);
-            }
+            RExprKind::Shape(f, _) => self.shape_fn(*f, relevant),
+            RExprKind::Stochastic { .. } => self.facts.rng |= relevant,
+            RExprKind::CompSelector(sel, _) => self.facts.bad |= *sel == Selector::IsTagged,
             // The comp function reads faces by any selector: not worth telling apart.
-            RExprKind::CompFn { .. } => self.facts.bad = true,
+            RExprKind::CompFn { .. } => {
+                self.facts.bad = true;
+                return;
+            }
+            _ => {}
         }
-    }
-
-    fn exprs(&mut self, es: &[RExpr], relevant: bool) {
-        for e in es {
-            self.expr(e, relevant);
-        }
+        e.for_each_child(&mut |c| self.expr(c, relevant));
     }
 
     fn shape_fn(&mut self, f: ShapeFn, relevant: bool) {
@@ -524,21 +450,15 @@ impl<'a> Scan<'a> {
             | ShapeFn::InitialShapeStartRule
             | ShapeFn::InitialShapeOrigin(_) => {}
             ShapeFn::Geometry(g) => {
-                self.facts.bad |= matches!(
-                    g,
-                    GeometryFn::HasUVs
-                        | GeometryFn::UMin
-                        | GeometryFn::UMax
-                        | GeometryFn::VMin
-                        | GeometryFn::VMax
-                        | GeometryFn::Du
-                        | GeometryFn::Dv
-                        | GeometryFn::Materials
-                        | GeometryFn::Tags
-                        | GeometryFn::HasTags
-                        | GeometryFn::Groups
-                        | GeometryFn::IsInstanced
-                )
+                self.facts.bad |= g.reads_uvs()
+                    || matches!(
+                        g,
+                        GeometryFn::Materials
+                            | GeometryFn::Tags
+                            | GeometryFn::HasTags
+                            | GeometryFn::Groups
+                            | GeometryFn::IsInstanced
+                    )
             }
             ShapeFn::ScopeElevation
             | ShapeFn::Pivot(_)

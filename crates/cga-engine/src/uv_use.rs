@@ -66,13 +66,7 @@ pub fn sets_read(program: &Program) -> UvSets {
         fns |= match g {
             // Without a set: whether any set is there.
             GeometryFn::HasUVs if args.is_empty() => ALL_UV_SETS,
-            GeometryFn::HasUVs
-            | GeometryFn::UMin
-            | GeometryFn::UMax
-            | GeometryFn::VMin
-            | GeometryFn::VMax
-            | GeometryFn::Du
-            | GeometryFn::Dv => set_of(args.first()),
+            g if g.reads_uvs() => set_of(args.first()),
             _ => 0,
         };
     };

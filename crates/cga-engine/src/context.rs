@@ -206,59 +206,10 @@ impl Walker<'_> {
     }
 
     fn expr(&mut self, e: &RExpr) {
-        match &e.kind {
-            RExprKind::Const(_) | RExprKind::Local(_) | RExprKind::Attr(_) => {}
-            RExprKind::Shape(f, args) => {
-                (self.shape_fn)(f, args);
-                args.iter().for_each(|a| self.expr(a));
-            }
-            RExprKind::Func(_, args)
-            | RExprKind::Pure(_, args)
-            | RExprKind::CompSelector(_, args) => args.iter().for_each(|a| self.expr(a)),
-            RExprKind::Unary { operand, .. } => self.expr(operand),
-            RExprKind::Binary { lhs, rhs, .. } => {
-                self.expr(lhs);
-                self.expr(rhs);
-            }
-            RExprKind::Array(rows) => rows.iter().flatten().for_each(|x| self.expr(x)),
-            RExprKind::Range { base, step, limit } => {
-                self.expr(base);
-                if let Some(s) = step {
-                    self.expr(s);
-                }
-                self.expr(limit);
-            }
-            RExprKind::Index { base, indices } => {
-                self.expr(base);
-                indices.iter().for_each(|i| self.expr(i));
-            }
-            RExprKind::Case {
-                branches,
-                otherwise,
-            }
-            | RExprKind::Stochastic {
-                branches,
-                otherwise,
-            } => {
-                for (c, v) in branches {
-                    self.expr(c);
-                    self.expr(v);
-                }
-                if let Some(o) = otherwise {
-                    self.expr(o);
-                }
-            }
-            RExprKind::Relative(inner) | RExprKind::Floating(inner) => self.expr(inner),
-            RExprKind::WithLocals { locals, body } => {
-                locals.iter().for_each(|l| self.expr(l));
-                self.expr(body);
-            }
-            RExprKind::CompFn { args, block } => {
-                args.iter().for_each(|a| self.expr(a));
-                self.block(block, &mut |w, e| w.expr(e));
-            }
-            RExprKind::CompHead { expr, .. } => self.expr(expr),
+        if let RExprKind::Shape(f, args) = &e.kind {
+            (self.shape_fn)(f, args);
         }
+        e.for_each_child(&mut |c| self.expr(c));
     }
 
     fn block<T>(&mut self, b: &RBlock<T>, f: &mut dyn FnMut(&mut Self, &T)) {

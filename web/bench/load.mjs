@@ -1,8 +1,8 @@
 // A bounded load test of `cga serve` on loopback (docs/performance.md):
 // CLIENTS clients (default 50) each ask for ROUNDS regenerations (default
-// 20: new attribute values, then the state and the model), three times
-// over; prints errors, time and the server's resident memory after each
-// pass (it should stay flat).
+// 20: new attribute values, the model being made for them, then the state
+// and the model), three times over; prints errors, time and the server's
+// resident memory after each pass (it should stay flat).
 //
 //   CGA_BIN=target/release/cga node bench/load.mjs [RULES.cga [LOT SPEC]]
 
@@ -23,16 +23,20 @@ let requests = 0;
 async function check(response) {
   requests++;
   if (!response.ok) errors++;
-  await response.arrayBuffer();
+  return response.arrayBuffer();
 }
 async function client(c) {
   for (let r = 0; r < rounds; r++) {
     try {
-      await check(await fetch(`${server.url}api/params`, {
+      const answer = await check(await fetch(`${server.url}api/params`, {
         method: 'POST',
         headers: { 'content-type': 'application/json' },
         body: JSON.stringify({ seed: c, attrs: { floors: 1 + ((c + r) % 20) } }),
       }));
+      // The model being made for this request (most are replaced by
+      // another client's before they are done: abandoned).
+      const { request } = JSON.parse(new TextDecoder().decode(answer));
+      await check(await fetch(`${server.url}api/live.bin?n=${request}`));
       await check(await fetch(`${server.url}api/state`));
       await check(await fetch(`${server.url}api/model.bin`));
     } catch (e) {

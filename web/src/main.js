@@ -2,7 +2,10 @@
 // attribute panel built from the rule file's annotations, and panels for
 // problems, prints, reports and statistics. The server pushes a `state`
 // event after every change (server-sent events); the model comes as plain
-// arrays (`/api/model.bin`, see crates/cga-serve/src/encode.rs).
+// arrays in a frame per lot (`/api/model.bin`, see
+// crates/cga-serve/src/encode.rs), and while a new model is made its lots
+// come as each is made (`/api/live.bin`): the page fetches and builds them
+// while the server derives the next.
 
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
@@ -15,6 +18,7 @@ const page = {
   stateVersion: 0,
   modelVersion: 0, // of the model drawn
   drawnAt: 0,
+  drawnFrom: null, // 'live' or 'whole', see showModel
   bounds: null, // {min: [x,y,z], max: [x,y,z]} of the model drawn
   problems: [],
   stale: false,
@@ -155,28 +159,74 @@ $('fit').addEventListener('click', fit);
 
 // ------------------------------------------------------------------ models
 
-// Reads the binary model: "CGAM", header length, data length, the
-// arrays, then the JSON header (see the server's encode.rs).
-function decodeModel(buffer) {
-  const view = new DataView(buffer);
-  const magic = String.fromCharCode(...new Uint8Array(buffer, 0, 4));
-  if (magic !== 'CGAM') throw new Error('not a model');
-  const headerLength = view.getUint32(4, true);
-  const dataLength = view.getUint32(8, true);
-  const header = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, 12 + dataLength, headerLength)));
-  return { header, data: 12 };
+// Reads a model's frames from a response as they come (see the server's
+// encode.rs): "CGAF", then frames of a header length, a data length, the
+// arrays and the JSON header. Calls `onFrame(header, data)` for each, `data`
+// an ArrayBuffer of the frame's arrays alone (their offsets count from its
+// start, and typed arrays over it are aligned); returns the end frame's
+// header. What `onFrame` throws stops the reading.
+const MAGIC = 'CGAF';
+const textDecoder = new TextDecoder();
+async function readFrames(response, onFrame) {
+  const reader = response.body.getReader();
+  const chunks = []; // received, not yet taken
+  let head = 0; // bytes of chunks[0] taken
+  let have = 0; // bytes received, not yet taken
+  const need = async (n) => {
+    while (have < n) {
+      const { done, value } = await reader.read();
+      if (done) throw new Error('the model was cut short');
+      chunks.push(value);
+      have += value.length;
+    }
+  };
+  // The next n bytes, in a buffer of their own.
+  const take = (n) => {
+    const out = new Uint8Array(n);
+    let at = 0;
+    while (at < n) {
+      const c = chunks[0];
+      const k = Math.min(n - at, c.length - head);
+      out.set(c.subarray(head, head + k), at);
+      at += k;
+      head += k;
+      if (head === c.length) {
+        chunks.shift();
+        head = 0;
+      }
+    }
+    have -= n;
+    return out;
+  };
+  try {
+    await need(4);
+    if (textDecoder.decode(take(4)) !== MAGIC) throw new Error('not a model');
+    for (;;) {
+      await need(8);
+      const lengths = new DataView(take(8).buffer);
+      const headerLength = lengths.getUint32(0, true);
+      const dataLength = lengths.getUint32(4, true);
+      await need(dataLength + headerLength);
+      const data = take(dataLength).buffer;
+      const header = JSON.parse(textDecoder.decode(take(headerLength)));
+      onFrame(header, data);
+      if (header.end) return header.end;
+    }
+  } finally {
+    reader.cancel().catch(() => {});
+  }
 }
 
 // A mesh's triangle indices: sent as they are, or (`fans`) as the number
 // of corners of each face, whose triangles are the fan (b, b + i, b + i + 1)
 // over the face's own run of vertices starting at b: a byte a face on the
 // wire instead of 6 or 12 bytes a triangle, made into indices here.
-function indices(buffer, data, m) {
+function indices(buffer, m) {
   if (m.fans === null || m.fans === undefined) {
     const Indices = m.index_bytes === 2 ? Uint16Array : Uint32Array;
-    return new Indices(buffer, data + m.indices, m.triangles * 3);
+    return new Indices(buffer, m.indices, m.triangles * 3);
   }
-  const corners = new Uint8Array(buffer, data + m.indices, m.fans);
+  const corners = new Uint8Array(buffer, m.indices, m.fans);
   const out = new (m.vertices <= 65536 ? Uint16Array : Uint32Array)(m.triangles * 3);
   let at = 0;
   let base = 0;
@@ -196,10 +246,10 @@ function indices(buffer, data, m) {
 // A mesh's normals, a vertex's three bytes each: sent so, or
 // (`face_normals`, meshes of flat fans) one per face, given here to the
 // face's vertices (3 bytes a quad on the wire instead of 12).
-function normals(buffer, data, m) {
-  if (!m.face_normals) return new Int8Array(buffer, data + m.normals, m.vertices * 3);
-  const corners = new Uint8Array(buffer, data + m.indices, m.fans);
-  const faces = new Int8Array(buffer, data + m.normals, m.fans * 3);
+function normals(buffer, m) {
+  if (!m.face_normals) return new Int8Array(buffer, m.normals, m.vertices * 3);
+  const corners = new Uint8Array(buffer, m.indices, m.fans);
+  const faces = new Int8Array(buffer, m.normals, m.fans * 3);
   const out = new Int8Array(m.vertices * 3);
   let at = 0;
   for (let f = 0; f < corners.length; f++) {
@@ -270,85 +320,130 @@ function groupBox(group) {
   return b ? new THREE.Box3(new THREE.Vector3().fromArray(b.min), new THREE.Vector3().fromArray(b.max)) : new THREE.Box3();
 }
 
-function buildMeshes(buffer, group, { lots = false } = {}) {
-  const { header, data } = decodeModel(buffer);
-  group.userData.bounds = header.bounds;
-  // Textures are shared between models (see `texture`): only geometry
-  // and materials are freed.
-  for (const child of group.children) {
+// Frees the meshes' geometry and materials. Textures are shared between
+// models (see `texture`): only the per-mesh copies go.
+function disposeMeshes(meshes) {
+  for (const child of meshes) {
     child.geometry.dispose();
     if (child.material.map?.userData.copy) child.material.map.dispose();
     child.material.dispose();
   }
-  group.clear();
-  for (const lot of header.lots) {
-    for (const m of lot.meshes) {
-      const geometry = new THREE.BufferGeometry();
-      // Positions come as 16-bit steps across the mesh's box (see the
-      // server's encode.rs): read as normalised, scaled by the box's
-      // largest side and moved to its corner.
-      geometry.setAttribute('position', new THREE.BufferAttribute(new Uint16Array(buffer, data + m.positions, m.vertices * 3), 3, true));
-      // Bytes scaled by 127, read as normalised.
-      geometry.setAttribute('normal', new THREE.BufferAttribute(normals(buffer, data, m), 3, true));
-      let map = null;
-      if (m.uvs !== null) {
-        // 16-bit steps across the box are read as normalised, and the
-        // map's offset and repeat put them back; else 32-bit floats.
-        const steps = m.uv_bytes === 2;
-        const Coords = steps ? Uint16Array : Float32Array;
-        geometry.setAttribute('uv', new THREE.BufferAttribute(new Coords(buffer, data + m.uvs, m.vertices * 2), 2, steps));
-        if (!lots && m.texture) map = steps ? steppedTexture(m.texture, m.uv_min, m.uv_extent) : texture(m.texture);
-      }
-      // Every quantised position lies in the unit cube: bounds known
-      // without a pass over the vertices (three.js would make one for
-      // culling and picking).
-      geometry.boundingBox = new THREE.Box3(new THREE.Vector3(0, 0, 0), new THREE.Vector3(1, 1, 1));
-      geometry.boundingSphere = new THREE.Sphere(new THREE.Vector3(0.5, 0.5, 0.5), Math.sqrt(3) / 2);
-      geometry.setIndex(new THREE.BufferAttribute(indices(buffer, data, m), 1));
-      const material = new THREE.MeshStandardMaterial({
-        color: lots ? 0xa8a89e : srgb(m.color),
-        map,
-        roughness: 0.85,
-        metalness: 0,
-        transparent: m.opacity < 1,
-        opacity: m.opacity,
-        side: m.double_sided || lots ? THREE.DoubleSide : THREE.FrontSide,
-        // Lots lie where the buildings stand: drawn behind them.
-        polygonOffset: lots,
-        polygonOffsetFactor: lots ? 2 : 0,
-        polygonOffsetUnits: lots ? 2 : 0,
-      });
-      const mesh = new THREE.Mesh(geometry, material);
-      mesh.position.fromArray(m.min);
-      mesh.scale.setScalar(m.extent);
-      mesh.castShadow = !lots;
-      mesh.receiveShadow = true;
-      mesh.userData = { lot: lot.index, lotName: lot.name, mesh: m.mesh, material: m.material };
-      group.add(mesh);
+}
+
+// The meshes of one lot's frame (`lot` its header, `buffer` its arrays).
+function lotMeshes(lot, buffer, { lots = false } = {}) {
+  const out = [];
+  for (const m of lot.meshes) {
+    const geometry = new THREE.BufferGeometry();
+    // Positions come as 16-bit steps across the mesh's box (see the
+    // server's encode.rs): read as normalised, scaled by the box's
+    // largest side and moved to its corner.
+    geometry.setAttribute('position', new THREE.BufferAttribute(new Uint16Array(buffer, m.positions, m.vertices * 3), 3, true));
+    // Bytes scaled by 127, read as normalised.
+    geometry.setAttribute('normal', new THREE.BufferAttribute(normals(buffer, m), 3, true));
+    let map = null;
+    if (m.uvs !== null) {
+      // 16-bit steps across the box are read as normalised, and the
+      // map's offset and repeat put them back; else 32-bit floats.
+      const steps = m.uv_bytes === 2;
+      const Coords = steps ? Uint16Array : Float32Array;
+      geometry.setAttribute('uv', new THREE.BufferAttribute(new Coords(buffer, m.uvs, m.vertices * 2), 2, steps));
+      if (!lots && m.texture) map = steps ? steppedTexture(m.texture, m.uv_min, m.uv_extent) : texture(m.texture);
     }
+    // Every quantised position lies in the unit cube: bounds known
+    // without a pass over the vertices (three.js would make one for
+    // culling and picking).
+    geometry.boundingBox = new THREE.Box3(new THREE.Vector3(0, 0, 0), new THREE.Vector3(1, 1, 1));
+    geometry.boundingSphere = new THREE.Sphere(new THREE.Vector3(0.5, 0.5, 0.5), Math.sqrt(3) / 2);
+    geometry.setIndex(new THREE.BufferAttribute(indices(buffer, m), 1));
+    const material = new THREE.MeshStandardMaterial({
+      color: lots ? 0xa8a89e : srgb(m.color),
+      map,
+      roughness: 0.85,
+      metalness: 0,
+      transparent: m.opacity < 1,
+      opacity: m.opacity,
+      side: m.double_sided || lots ? THREE.DoubleSide : THREE.FrontSide,
+      // Lots lie where the buildings stand: drawn behind them.
+      polygonOffset: lots,
+      polygonOffsetFactor: lots ? 2 : 0,
+      polygonOffsetUnits: lots ? 2 : 0,
+    });
+    const mesh = new THREE.Mesh(geometry, material);
+    mesh.position.fromArray(m.min);
+    mesh.scale.setScalar(m.extent);
+    mesh.castShadow = !lots;
+    mesh.receiveShadow = true;
+    mesh.userData = { lot: lot.index, lotName: lot.name, mesh: m.mesh, material: m.material };
+    out.push(mesh);
   }
+  return out;
 }
 
-let lotsLoaded = false;
+// Puts `meshes` in `group` in place of what it held.
+function replaceMeshes(group, meshes, bounds) {
+  disposeMeshes(group.children);
+  group.clear();
+  if (meshes.length) group.add(...meshes);
+  group.userData.bounds = bounds;
+}
+
+let lotsLoading = null;
 let fitted = false;
-let loadingModel = 0;
 
-async function loadLots() {
-  const response = await fetch('api/lots.bin');
-  buildMeshes(await response.arrayBuffer(), lotsGroup, { lots: true });
-  lotsLoaded = true;
+function loadLots() {
+  lotsLoading ??= (async () => {
+    const meshes = [];
+    const end = await readFrames(await fetch('api/lots.bin'), (header, data) => {
+      if (header.lot) meshes.push(...lotMeshes(header.lot, data, { lots: true }));
+    });
+    replaceMeshes(lotsGroup, meshes, end.bounds);
+  })();
+  return lotsLoading;
 }
 
-async function loadModel(version) {
-  loadingModel = version;
-  const t = performance.now();
-  const response = await fetch(`api/model.bin?v=${version}`);
-  const buffer = await response.arrayBuffer();
-  // A newer model was asked for meanwhile: that one is drawn.
-  if (loadingModel !== version) return;
-  if (!lotsLoaded) await loadLots();
+// The model being fetched: `{ controller, live }` (`live`: the number of
+// the request whose model comes as it is made, else null and `version`:
+// the model's number). A newer load aborts it.
+let loading = null;
+let lastState = null;
+
+function beginLoad(fields) {
+  loading?.controller.abort();
+  loading = { controller: new AbortController(), live: null, version: 0, ...fields };
+  return loading;
+}
+
+// Fetches a model's frames and builds each lot's meshes as it comes;
+// resolves with the end frame's header, the meshes and the time spent
+// building them, or null when the load was replaced or failed.
+async function fetchModel(url, load) {
+  const meshes = [];
+  let buildMs = 0;
+  try {
+    const response = await fetch(url, { signal: load.controller.signal });
+    if (!response.ok) return null;
+    const end = await readFrames(response, (header, data) => {
+      if (loading !== load) throw new Error('replaced');
+      if (!header.lot) return;
+      const t = performance.now();
+      meshes.push(...lotMeshes(header.lot, data));
+      buildMs += performance.now() - t;
+    });
+    if (loading === load && end.complete) return { end, meshes, buildMs };
+  } catch {
+    // Aborted, replaced or cut short: the model shown stays.
+  }
+  disposeMeshes(meshes);
+  return null;
+}
+
+// Shows a model fetched by `fetchModel` (started at `t`) as model `version`.
+async function showModel(got, version, t, from) {
   const fetched = performance.now();
-  buildMeshes(buffer, modelGroup);
+  await loadLots();
+  const swap = performance.now();
+  replaceMeshes(modelGroup, got.meshes, got.end.bounds);
   const built = performance.now();
   const box = groupBox(modelGroup);
   const both = box.clone().union(groupBox(lotsGroup));
@@ -365,15 +460,62 @@ async function loadModel(version) {
   // A newer model may have been drawn meanwhile: the version only grows.
   if (version < page.modelVersion) return;
   page.modelVersion = version;
+  // 'live': the lots came as they were made; 'whole': the last good model.
+  page.drawnFrom = from;
   page.drawnAt = performance.now();
   page.drawMs = page.drawnAt - t;
-  // Where the time went: fetching, building the meshes, issuing the
-  // draw, until the frame was shown (the benchmark reads these).
-  page.drawParts = { fetch: fetched - t, build: built - fetched, render: rendered - built, frame: page.drawnAt - rendered, sent: page.sentAt, state: page.stateAt, loadStart: t };
+  // Where the time went (the benchmark reads these): fetching (with the
+  // lots' meshes built as they came, `build` of it), putting the meshes
+  // in place, issuing the draw, until the frame was shown.
+  page.drawParts = { fetch: fetched - t, build: got.buildMs + (built - swap), render: rendered - built, frame: page.drawnAt - rendered, sent: page.sentAt, state: page.stateAt, loadStart: t };
   // The exact bounds the server computed (the positions drawn are within
   // a step of 16 bits of the mesh's box).
   page.bounds = modelGroup.userData.bounds ?? null;
   $('stat-draw').textContent = `${page.drawMs.toFixed(1)} ms`;
+}
+
+// The last good model, number `version`, all at once. (A load stays
+// `loading` until its model is shown: a state naming it meanwhile does
+// not load it again.)
+async function loadModel(version) {
+  const load = beginLoad({ version });
+  const t = performance.now();
+  const got = await fetchModel(`api/model.bin?v=${version}`, load);
+  if (loading !== load) return;
+  if (got) await showModel(got, version, t, 'whole');
+  else releaseShadows();
+  if (loading === load) {
+    loading = null;
+    catchUp();
+  }
+}
+
+// A newer model than the one shown that the states named while another
+// was shown (a page's own values, then another page's): loaded now.
+function catchUp() {
+  if (!loading && lastState && lastState.model_version > page.modelVersion) loadModel(lastState.model_version);
+}
+
+// The model being made for request `n`, its lots fetched and built as
+// each is made; when it is abandoned (a newer request, rules with errors,
+// a failure), the model the latest state names is shown.
+async function loadLive(n) {
+  if (loading && loading.live !== null && loading.live >= n) return;
+  const load = beginLoad({ live: n });
+  const t = performance.now();
+  const got = await fetchModel(`api/live.bin?n=${n}`, load);
+  if (loading !== load) return;
+  if (got) {
+    await showModel(got, got.end.model_version, t, 'live');
+    if (loading === load) {
+      loading = null;
+      catchUp();
+    }
+    return;
+  }
+  loading = null;
+  if (lastState && lastState.model_version !== page.modelVersion && lastState.model_version > 0) loadModel(lastState.model_version);
+  else releaseShadows();
 }
 
 // The model as drawn: its triangles and their total area in square metres
@@ -694,8 +836,11 @@ function onState(state) {
   const errors = state.problems.filter((p) => p.severity === 'error').length;
   if (errors) setStatus(`${errors} error${errors > 1 ? 's' : ''}`, 'error');
   else setStatus('up to date');
-  if (state.model_version !== page.modelVersion && state.model_version > 0) loadModel(state.model_version);
-  else releaseShadows();
+  lastState = state;
+  // A model on its way (being made, or this one) is awaited.
+  const awaited = loading && (loading.live !== null || loading.version === state.model_version);
+  if (state.model_version !== page.modelVersion && state.model_version > 0 && !awaited) loadModel(state.model_version);
+  else if (!loading) releaseShadows();
 }
 
 // ------------------------------------------------------------- provenance
@@ -733,9 +878,10 @@ canvas.addEventListener('pointerup', async (e) => {
 function connect() {
   const events = new EventSource('api/events');
   events.addEventListener('state', (e) => onState(JSON.parse(e.data)));
-  events.addEventListener('generating', () => {
+  events.addEventListener('generating', (e) => {
     holdShadows();
     setStatus('generating…', 'busy');
+    loadLive(Number(e.data));
   });
   events.onerror = () => setStatus('disconnected: is cga serve running?', 'error');
   events.onopen = () => setStatus('connected');

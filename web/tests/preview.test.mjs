@@ -123,6 +123,8 @@ test('moving a @Range slider changes the model', async () => {
   const h = await height();
   assert.ok(Math.abs(h - (before.bounds.max[1] + 6 * 3.2)) < 0.01, `height ${before.bounds.max[1]} -> ${h}`);
   assert.equal(await page.locator('label[data-attr=floors] output').innerText(), '12');
+  // Its lots came as they were made (api/live.bin), not fetched after.
+  assert.equal(await page.evaluate(() => window.cgaPreview.drawnFrom), 'live');
   await screenshot('preview.png');
 });
 
@@ -164,4 +166,5 @@ test('fixing the error brings the new model', async () => {
   assert.ok(await page.locator('#stale').isHidden());
   // The slider's 12 floors are kept: 8 + 12 x 3.2.
   assert.ok(Math.abs(after.bounds.max[1] - (8 + 12 * 3.2)) < 0.5, `height ${after.bounds.max[1]}`);
+  assert.equal(await page.evaluate(() => window.cgaPreview.drawnFrom), 'live');
 });

@@ -1,6 +1,7 @@
-//! How long making the page's model bytes takes (`encode::model`) for a
-//! set of lots, best and median of several runs, after generating them
-//! once into meshes to draw, and how long that generation took:
+//! How long making the page's model bytes takes (`encode::lot_frame` for
+//! each lot, as the preview encodes each lot when it is made) for a set of
+//! lots, best and median of several runs, after generating them once into
+//! meshes to draw, and how long that generation took:
 //!
 //!     cargo run --release -p cga-serve --example encode_bench -- RULES.cga LOTSPEC [RUNS]
 
@@ -31,30 +32,35 @@ fn main() {
         t.elapsed().as_secs_f64() * 1e3
     );
     let mut bytes = 0;
-    let mut last = Vec::new();
+    let mut last: Vec<Vec<u8>> = Vec::new();
     let mut times: Vec<f64> = (0..runs)
         .map(|_| {
             let t = Instant::now();
-            // Into the buffer of the run before, as the preview reuses
-            // its models' buffers.
-            let model = cga_serve::encode::model_into(
-                &results,
-                [0.0; 3],
-                &mut |p| Some(p.to_string()),
-                std::mem::take(&mut last),
-            );
-            bytes = model.len();
+            // Into the buffers of the run before, as the preview reuses
+            // its frames' buffers.
+            let mut spare = std::mem::take(&mut last);
+            let frames: Vec<Vec<u8>> = results
+                .iter()
+                .map(|lot| {
+                    let used = spare.pop().unwrap_or_default();
+                    cga_serve::encode::lot_frame(lot, &mut |p| Some(p.to_string()), used).0
+                })
+                .collect();
             let took = t.elapsed().as_secs_f64() * 1e3;
-            last = model;
+            bytes = frames.iter().map(Vec::len).sum();
+            last = frames;
             took
         })
         .collect();
     times.sort_by(f64::total_cmp);
     // FNV-1a of the bytes: a change of code that should not change them
     // shows here.
-    let digest = last.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
-        (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3)
-    });
+    let digest = last
+        .iter()
+        .flatten()
+        .fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
+            (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3)
+        });
     println!(
         "{} lots, {:.1} MB (digest {digest:016x}): best {:.1} ms, median {:.1} ms",
         lots.len(),

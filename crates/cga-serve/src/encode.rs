@@ -1,9 +1,10 @@
 //! The model as the page reads it, and values as JSON.
 //!
-//! Binary model (`/api/model.bin`, `/api/lots.bin`), little-endian:
+//! Binary model (`/api/model.bin`, `/api/lots.bin`, and the model being
+//! made, `/api/live.bin`), little-endian: [`MAGIC`], then frames, each
 //!
 //! ```text
-//! "CGAM"  u32 header length H  u32 data length D
+//! u32 header length H  u32 data length D
 //! data (D bytes): per mesh, positions (u16 x 3 per vertex, quantised: see below),
 //!       texture coordinates (only for textured meshes: u16 x 2 quantised,
 //!       or f32 x 2: "uv_bytes"), normals (i8 x 3, x 127, per vertex or,
@@ -11,26 +12,31 @@
 //!       the corner counts of its faces (u8 per face: "fans", see below)
 //!       or indices (u16 or u32 x 3 per triangle: "index_bytes");
 //!       each array padded to 4 bytes
-//! header (JSON, H bytes)
+//! header (JSON, H bytes, padded with spaces to 4 bytes)
 //! ```
 //!
-//! The header: `{"origin": [x, y, z], "bounds": {"min", "max"} | null,
-//! "lots": [{"index", "name", "meshes": [{"mesh", "vertices",
-//! "triangles", "positions", "min", "extent", "normals", "face_normals", "uvs",
-//! "uv_bytes", "uv_min", "uv_extent", "indices", "index_bytes", "fans", "color",
-//! "opacity", "material", "double_sided", "texture"}]}]}`,
-//! coordinates relative to `origin` (the lots' centre when they lie far
-//! from the frame's origin, else zero), offsets in bytes from the start
-//! of the data. A vertex is at `min + q / 65535 * extent` for its three
-//! 16-bit numbers `q`: one scale for all axes (the mesh's largest side),
+//! The frames: first `{"start": {"origin": [x, y, z], "lots"}}` (no data),
+//! then one per lot as it is made, `{"lot": {"index", "name", "bounds",
+//! "meshes": [{"mesh", "vertices", "triangles", "positions", "min",
+//! "extent", "normals", "face_normals", "uvs", "uv_bytes", "uv_min",
+//! "uv_extent", "indices", "index_bytes", "fans", "color", "opacity",
+//! "material", "double_sided", "texture"}]}}` (offsets in bytes from the
+//! start of the frame's data), and last `{"end": {"complete", "bounds",
+//! "model_version"}}`: a model being made ends with `complete` false when a
+//! newer edit made it obsolete or it failed. Lots come in frames so that
+//! the page can fetch and build a lot while the next are derived.
+//!
+//! Coordinates are relative to `origin` (the lots' centre when they lie
+//! far from the frame's origin, else zero). A vertex is at `min + q /
+//! 65535 * extent` for its three 16-bit numbers `q`: one scale for all axes (the mesh's largest side),
 //! so that the page can draw the numbers as they are, scaled, without
 //! bending the normals; a step is the largest side / 65535 (1.5 mm for a
-//! building of 100 m). `bounds` are the model's bounds (of its positions
-//! as collected: `f32` relative to the origin). The header
-//! comes last because the boxes are known only once the positions have
-//! been read: each mesh is measured and written in one visit, while its
-//! arrays are in the cache. The meshes are the lots' [`cga::DrawModel`]s,
-//! collected on the deriving threads relative to the origin (positions
+//! building of 100 m). `bounds` are the lot's or the model's bounds (of
+//! its positions as collected: `f32` relative to the origin). A frame's
+//! header comes after its data because the boxes are known only once the
+//! positions have been read: each mesh is measured and written in one
+//! visit, while its arrays are in the cache. The meshes are the lots'
+//! [`cga::DrawModel`]s, collected on the deriving threads relative to the origin (positions
 //! and texture coordinates in `f32`, normals already bytes, convex faces
 //! as corner counts: 23 bytes a vertex to read instead of the plain
 //! meshes' 64). `mesh` is the mesh's number in the lot's drawing, which
@@ -66,6 +72,9 @@
 
 use cga::{LotResult, Value};
 use serde_json::{json, Value as Json};
+
+/// A model's first four bytes.
+pub const MAGIC: &[u8; 4] = b"CGAF";
 
 /// Largest quantised coordinate.
 const STEPS: f64 = 65535.0;
@@ -214,7 +223,6 @@ impl Uvs {
 /// Where one mesh's arrays go in the data, and how its positions are
 /// quantised.
 struct Placed<'a> {
-    lot: usize,
     /// The mesh's number in its lot's drawing.
     number: usize,
     mesh: &'a cga::DrawMesh,
@@ -256,6 +264,34 @@ impl Placed<'_> {
         } else {
             1.0
         }
+    }
+
+    /// The mesh's part of its lot's header.
+    fn header(&self) -> Json {
+        let material = self.material;
+        let [positions, uvs, normals, indices, _] = self.at;
+        json!({
+            "mesh": self.number,
+            "vertices": self.mesh.positions.len(),
+            "triangles": self.mesh.triangles(),
+            "positions": positions,
+            "min": self.min,
+            "extent": self.extent(),
+            "normals": normals,
+            "face_normals": matches!(self.mesh.normals, cga::DrawNormals::PerFace(_)),
+            "uvs": if self.uvs == Uvs::None { Json::Null } else { json!(uvs) },
+            "uv_bytes": self.uvs.bytes() / 2,
+            "uv_min": match self.uvs { Uvs::Steps { min, .. } => json!(min), _ => Json::Null },
+            "uv_extent": match self.uvs { Uvs::Steps { extent, .. } => json!(extent), _ => Json::Null },
+            "indices": indices,
+            "index_bytes": self.index_bytes(),
+            "fans": self.fans.map(<[u8]>::len),
+            "texture": self.texture,
+            "color": material.map(|m| m.color).unwrap_or([0.8, 0.8, 0.8]),
+            "opacity": material.map(|m| m.opacity).unwrap_or(1.0),
+            "material": material.map(|m| m.name.to_string()).unwrap_or_default(),
+            "double_sided": material.map(|m| m.double_sided).unwrap_or(false),
+        })
     }
 
     /// Measures the box, then writes the arrays into `out`, the bytes
@@ -326,74 +362,115 @@ pub fn drawn(
     Ok(out)
 }
 
-/// The lots' meshes to draw ([`LotResult::drawing`], made by [`drawn`]
-/// relative to `origin`) in the binary form above; `texture` gives the
-/// URL of a colour map path as the rules wrote it (`None`: not found,
-/// drawn without).
-pub fn model(
-    results: &[LotResult],
-    origin: [f64; 3],
-    texture: &mut dyn FnMut(&str) -> Option<String>,
-) -> Vec<u8> {
-    model_into(results, origin, texture, Vec::new())
+/// A box: its corner and far corner.
+pub type Bounds = ([f64; 3], [f64; 3]);
+
+/// The smallest box around both (either may be none).
+pub fn union(a: Option<Bounds>, b: Option<Bounds>) -> Option<Bounds> {
+    match (a, b) {
+        (Some((l, h)), Some((m, k))) => Some((
+            std::array::from_fn(|i| l[i].min(m[i])),
+            std::array::from_fn(|i| h[i].max(k[i])),
+        )),
+        (a, None) => a,
+        (None, b) => b,
+    }
 }
 
-/// [`model`], written into `out` (its contents replaced): a buffer kept
-/// from an earlier model is written without the page faults of fresh
-/// memory (tens of megabytes for a street).
-pub fn model_into(
-    results: &[LotResult],
-    origin: [f64; 3],
+fn bounds_json(b: Option<Bounds>) -> Json {
+    b.map_or(Json::Null, |(min, max)| json!({"min": min, "max": max}))
+}
+
+/// Appends a frame to `out`: its lengths, then `data` bytes that `fill`
+/// writes (all of them), then `header` padded to 4 bytes.
+fn frame(out: &mut Vec<u8>, data: usize, fill: impl FnOnce(&mut [u8]) -> Json) {
+    let at = out.len();
+    out.resize(at + 8 + data, 0);
+    out[at + 4..at + 8].copy_from_slice(&(data as u32).to_le_bytes());
+    let header = fill(&mut out[at + 8..]);
+    let mut header = serde_json::to_vec(&header).expect("JSON of plain data");
+    // Padded with spaces (JSON reads them as nothing), so that the next
+    // frame's arrays stay aligned.
+    header.resize(header.len().next_multiple_of(4), b' ');
+    out[at..at + 4].copy_from_slice(&(header.len() as u32).to_le_bytes());
+    out.extend_from_slice(&header);
+}
+
+/// The model's first bytes: [`MAGIC`] and the frame that says the origin
+/// and the number of lots to come.
+pub fn start_frame(origin: [f64; 3], lots: usize) -> Vec<u8> {
+    let mut out = MAGIC.to_vec();
+    frame(
+        &mut out,
+        0,
+        |_| json!({"start": {"origin": origin, "lots": lots}}),
+    );
+    out
+}
+
+/// The model's last frame: complete (with the model's bounds and, for
+/// the preview's models, the number the page's state gives it), or
+/// abandoned (a newer edit made it obsolete, or it failed: the page keeps
+/// what it shows).
+pub fn end_frame(complete: bool, bounds: Option<Bounds>, model_version: Option<u64>) -> Vec<u8> {
+    let mut out = Vec::new();
+    frame(
+        &mut out,
+        0,
+        |_| json!({"end": {"complete": complete, "bounds": bounds_json(bounds), "model_version": model_version}}),
+    );
+    out
+}
+
+/// One lot's meshes to draw ([`LotResult::drawing`], made by [`drawn`]
+/// relative to the origin) as a frame, written into `out` (its contents
+/// replaced: a buffer of an earlier frame is written without the page
+/// faults of fresh memory), with the box of its positions. `texture`
+/// gives the URL of a colour map path as the rules wrote it (`None`: not
+/// found, drawn without).
+pub fn lot_frame(
+    lot: &LotResult,
     texture: &mut dyn FnMut(&str) -> Option<String>,
     mut out: Vec<u8>,
-) -> Vec<u8> {
-    // What each mesh sends, its texture coordinates' boxes (on all
-    // cores), where everything goes; then the positions' boxes, the
-    // arrays and the header: boxes and arrays on all cores (tens of
-    // megabytes for a street).
+) -> (Vec<u8>, Option<Bounds>) {
+    // What each mesh sends and where it goes; then each mesh's box and
+    // arrays, written in one visit while its arrays are in the cache, and
+    // the header.
     let mut placed: Vec<Placed> = Vec::new();
-    for (l, lot) in results.iter().enumerate() {
-        for (number, mesh) in lot.drawing.meshes.iter().enumerate() {
-            if mesh.triangles() == 0 {
-                continue;
-            }
-            let material = lot.drawing.materials.get(mesh.material);
-            let texture = material
-                .map(|m| m.colormap())
-                .filter(|p| !p.is_empty())
-                .and_then(&mut *texture);
-            let vertices = mesh.positions.len();
-            let uvs = if texture.is_some() && mesh.uvs.len() == vertices {
-                Uvs::Floats
-            } else {
-                Uvs::None
-            };
-            placed.push(Placed {
-                lot: l,
-                number,
-                mesh,
-                material,
-                texture,
-                min: [0.0; 3],
-                max: [0.0; 3],
-                uvs,
-                normals: match &mesh.normals {
-                    cga::DrawNormals::PerFace(n) | cga::DrawNormals::PerVertex(n) => n.len(),
-                },
-                short: vertices <= 1 << 16,
-                fans: match &mesh.faces {
-                    cga::DrawFaces::Fans(sizes) => Some(sizes),
-                    cga::DrawFaces::Triangles(_) => None,
-                },
-                at: [0; 5],
-            });
+    for (number, mesh) in lot.drawing.meshes.iter().enumerate() {
+        if mesh.triangles() == 0 {
+            continue;
         }
+        let material = lot.drawing.materials.get(mesh.material);
+        let texture = material
+            .map(|m| m.colormap())
+            .filter(|p| !p.is_empty())
+            .and_then(&mut *texture);
+        let vertices = mesh.positions.len();
+        let uvs = if texture.is_some() && mesh.uvs.len() == vertices {
+            Uvs::of(&mesh.uvs)
+        } else {
+            Uvs::None
+        };
+        placed.push(Placed {
+            number,
+            mesh,
+            material,
+            texture,
+            min: [0.0; 3],
+            max: [0.0; 3],
+            uvs,
+            normals: match &mesh.normals {
+                cga::DrawNormals::PerFace(n) | cga::DrawNormals::PerVertex(n) => n.len(),
+            },
+            short: vertices <= 1 << 16,
+            fans: match &mesh.faces {
+                cga::DrawFaces::Fans(sizes) => Some(sizes),
+                cga::DrawFaces::Triangles(_) => None,
+            },
+            at: [0; 5],
+        });
     }
-    on_cores(&mut placed, |p| {
-        if p.uvs != Uvs::None {
-            p.uvs = Uvs::of(&p.mesh.uvs);
-        }
-    });
     let mut size = 0usize;
     for p in &mut placed {
         let vertices = p.mesh.positions.len();
@@ -411,91 +488,44 @@ pub fn model_into(
     // Every byte of the data is written below (the padding by
     // `Placed::write`): only room a reused buffer lacks is zeroed. Room
     // for the header too, so that appending it does not copy the data.
-    let room = 12 + size + 512 * placed.len() + 4096;
-    if out.capacity() < room {
-        out = Vec::with_capacity(room);
-    }
-    out.resize(12 + size, 0);
-    out[..4].copy_from_slice(b"CGAM");
-    out[8..12].copy_from_slice(&(size as u32).to_le_bytes());
-    // Each mesh's bytes, cut off the data in order, go with the mesh.
-    let mut data = &mut out[12..];
-    let mut jobs: Vec<(&mut Placed, &mut [u8])> = Vec::with_capacity(placed.len());
-    for p in &mut placed {
-        let (mine, rest) = std::mem::take(&mut data).split_at_mut(p.at[4] - p.at[0]);
-        jobs.push((p, mine));
-        data = rest;
-    }
-    on_cores(&mut jobs, |(p, bytes)| p.write(bytes));
-
-    let mut lots: Vec<Json> = results
-        .iter()
-        .map(|lot| json!({"index": lot.index, "name": lot.name, "meshes": []}))
-        .collect();
-    let mut bounds: Option<([f64; 3], [f64; 3])> = None;
-    for p in &placed {
-        let material = p.material;
-        let [positions, uvs, normals, indices, _] = p.at;
-        lots[p.lot]["meshes"]
-            .as_array_mut()
-            .expect("an array above")
-            .push(json!({
-                "mesh": p.number,
-                "vertices": p.mesh.positions.len(),
-                "triangles": p.mesh.triangles(),
-                "positions": positions,
-                "min": p.min,
-                "extent": p.extent(),
-                "normals": normals,
-                "face_normals": matches!(p.mesh.normals, cga::DrawNormals::PerFace(_)),
-                "uvs": if p.uvs == Uvs::None { Json::Null } else { json!(uvs) },
-                "uv_bytes": p.uvs.bytes() / 2,
-                "uv_min": match p.uvs { Uvs::Steps { min, .. } => json!(min), _ => Json::Null },
-                "uv_extent": match p.uvs { Uvs::Steps { extent, .. } => json!(extent), _ => Json::Null },
-                "indices": indices,
-                "index_bytes": p.index_bytes(),
-                "fans": p.fans.map(<[u8]>::len),
-                "texture": p.texture,
-                "color": material.map(|m| m.color).unwrap_or([0.8, 0.8, 0.8]),
-                "opacity": material.map(|m| m.opacity).unwrap_or(1.0),
-                "material": material.map(|m| m.name.to_string()).unwrap_or_default(),
-                "double_sided": material.map(|m| m.double_sided).unwrap_or(false),
-            }));
-        bounds = Some(match bounds {
-            None => (p.min, p.max),
-            Some((l, h)) => (
-                std::array::from_fn(|a| l[a].min(p.min[a])),
-                std::array::from_fn(|a| h[a].max(p.max[a])),
-            ),
-        });
-    }
-    let header = json!({
-        "lots": lots,
-        "origin": origin,
-        "bounds": bounds.map(|(min, max)| json!({"min": min, "max": max})),
+    out.clear();
+    out.reserve(8 + size + 512 * placed.len() + 1024);
+    let mut bounds = None;
+    frame(&mut out, size, |mut data| {
+        for p in &mut placed {
+            let (mine, rest) = std::mem::take(&mut data).split_at_mut(p.at[4] - p.at[0]);
+            p.write(mine);
+            data = rest;
+        }
+        let meshes: Vec<Json> = placed
+            .iter()
+            .map(|p| {
+                bounds = union(bounds, Some((p.min, p.max)));
+                p.header()
+            })
+            .collect();
+        json!({"lot": {"index": lot.index, "name": lot.name, "bounds": bounds_json(bounds), "meshes": meshes}})
     });
-    let header = serde_json::to_vec(&header).expect("JSON of plain data");
-    out[4..8].copy_from_slice(&(header.len() as u32).to_le_bytes());
-    out.extend_from_slice(&header);
-    out
+    (out, bounds)
 }
 
-/// Runs `work` on every item, the items shared among the cores in runs
-/// of about equal length.
-fn on_cores<T: Send>(items: &mut [T], work: impl Fn(&mut T) + Sync) {
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let run = items.len().div_ceil(threads).max(1);
-    std::thread::scope(|scope| {
-        let mut runs = items.chunks_mut(run);
-        let first = runs.next();
-        for run in runs {
-            let work = &work;
-            scope.spawn(move || run.iter_mut().for_each(work));
-        }
-        if let Some(run) = first {
-            run.iter_mut().for_each(&work);
-        }
-    });
+/// The lots' meshes to draw ([`LotResult::drawing`], made by [`drawn`]
+/// relative to `origin`) as a whole model: the start frame, a frame per
+/// lot and a complete end frame.
+pub fn model(
+    results: &[LotResult],
+    origin: [f64; 3],
+    texture: &mut dyn FnMut(&str) -> Option<String>,
+) -> Vec<u8> {
+    let mut out = start_frame(origin, results.len());
+    let mut bounds = None;
+    for lot in results {
+        let (bytes, b) = lot_frame(lot, texture, Vec::new());
+        out.extend_from_slice(&bytes);
+        bounds = union(bounds, b);
+    }
+    out.extend_from_slice(&end_frame(true, bounds, None));
+    out
 }
 
 /// A CGA value as JSON: numbers (non-finite ones as their text), booleans,
@@ -557,16 +587,38 @@ mod tests {
         (drawn, rules.generate_all(lots, options).unwrap())
     }
 
-    /// The header and the data of a binary model.
+    /// The frames of a binary model: their headers and data.
+    fn frames(bytes: &[u8]) -> Vec<(Json, &[u8])> {
+        assert_eq!(&bytes[..4], MAGIC);
+        let mut at = 4;
+        let mut out = Vec::new();
+        while at < bytes.len() {
+            let h = u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+            let d = u32::from_le_bytes(bytes[at + 4..at + 8].try_into().unwrap()) as usize;
+            assert_eq!((h % 4, d % 4), (0, 0));
+            let data = &bytes[at + 8..at + 8 + d];
+            let header = serde_json::from_slice(&bytes[at + 8 + d..at + 8 + d + h]).unwrap();
+            out.push((header, data));
+            at += 8 + d + h;
+        }
+        assert_eq!(at, bytes.len());
+        out
+    }
+
+    /// The header and the data of a model of one lot: the lot's frame,
+    /// with the start's origin and the end's bounds.
     fn split(bytes: &[u8]) -> (Json, &[u8]) {
-        assert_eq!(&bytes[..4], b"CGAM");
-        let h = u32::from_le_bytes(bytes[4..8].try_into().unwrap()) as usize;
-        let d = u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize;
-        assert_eq!(bytes.len(), 12 + d + h);
-        (
-            serde_json::from_slice(&bytes[12 + d..]).unwrap(),
-            &bytes[12..12 + d],
-        )
+        let f = frames(bytes);
+        assert_eq!(f.len(), 3);
+        assert_eq!(f[0].0["start"]["lots"], 1);
+        assert_eq!(f[2].0["end"]["complete"], true);
+        assert_eq!(f[2].0["end"]["bounds"], f[1].0["lot"]["bounds"]);
+        let header = json!({
+            "origin": f[0].0["start"]["origin"],
+            "bounds": f[2].0["end"]["bounds"],
+            "lots": [f[1].0["lot"]],
+        });
+        (header, f[1].1)
     }
 
     /// A mesh's positions as the page computes them.
@@ -849,11 +901,21 @@ mod tests {
         let lots = [cga::lots::rect(10.0, 20.0), cga::lots::rect(3.0, 5.0)];
         let (results, _) = both(&rules, &lots, &cga::Options::default(), [1.0, 0.0, 2.0]);
         let fresh = model(&results, [1.0, 0.0, 2.0], &mut |_| None);
+        let frames = frames(&fresh);
+        assert_eq!(frames.len(), 4);
+        // The model's box holds both lots' boxes.
+        let b = |f: &Json, k: &str, a: usize| f[k].as_array().unwrap()[a].as_f64().unwrap();
+        let model_box = &frames[3].0["end"]["bounds"];
+        for (lot, _) in &frames[1..3] {
+            for a in 0..3 {
+                assert!(b(model_box, "min", a) <= b(&lot["lot"]["bounds"], "min", a));
+                assert!(b(model_box, "max", a) >= b(&lot["lot"]["bounds"], "max", a));
+            }
+        }
         // The padding after each array is zeros.
-        let (header, data) = split(&fresh);
         let mut padded = 0;
-        for lot in header["lots"].as_array().unwrap() {
-            for m in lot["meshes"].as_array().unwrap() {
+        for (header, data) in &frames[1..3] {
+            for m in header["lot"]["meshes"].as_array().unwrap() {
                 let at = |k: &str| m[k].as_u64().unwrap() as usize;
                 let vertices = at("vertices");
                 let normals = if m["face_normals"] == json!(true) {
@@ -877,10 +939,20 @@ mod tests {
             }
         }
         assert!(padded > 0);
-        for used in [vec![0xAA; 10], vec![0x55; fresh.len() * 2]] {
-            let again = model_into(&results, [1.0, 0.0, 2.0], &mut |_| None, used);
-            assert_eq!(again, fresh);
+        // The model is its frames one after the other, and a frame
+        // written into a used buffer is the frame written anew.
+        let mut joined = start_frame([1.0, 0.0, 2.0], 2);
+        let mut bounds = None;
+        for result in &results {
+            let (frame, b) = lot_frame(result, &mut |_| None, Vec::new());
+            for used in [vec![0xAA; 10], vec![0x55; frame.len() * 2]] {
+                assert_eq!(lot_frame(result, &mut |_| None, used).0, frame);
+            }
+            joined.extend_from_slice(&frame);
+            bounds = union(bounds, b);
         }
+        joined.extend_from_slice(&end_frame(true, bounds, None));
+        assert_eq!(joined, fresh);
     }
 
     #[test]

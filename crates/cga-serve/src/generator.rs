@@ -31,12 +31,21 @@ pub struct Snapshot {
     pub version: u64,
     /// The state as JSON (`/api/state`, the `state` event).
     pub state: Arc<String>,
-    /// The last good model (binary, see [`encode`]) and its number.
-    /// Shared with every request that sends it (no copy).
-    pub model: Bytes,
+    /// The last good model (binary, see [`encode`]): its frames, shared
+    /// with every request that sends them (no copy), and its number.
+    pub model: Vec<Bytes>,
     pub model_version: u64,
     /// What made the model: for provenance and the GLB download.
     pub made_by: Option<Made>,
+}
+
+/// A model made: what made it, its frames but the end, its box and the
+/// time its lots took to encode.
+struct Model {
+    made: Made,
+    frames: Vec<Bytes>,
+    bounds: Option<encode::Bounds>,
+    encode_ms: f64,
 }
 
 #[derive(Clone)]
@@ -46,6 +55,18 @@ pub struct Made {
     pub generate_ms: f64,
     pub results: Arc<Vec<LotResult>>,
     pub options: Options,
+}
+
+/// The model being made, frame by frame, for the pages that fetch it as
+/// it comes (`/api/live.bin`): the start frame, a frame per lot as it is
+/// made, and at last the end frame.
+#[derive(Default)]
+pub struct Live {
+    /// The number of the request it serves.
+    pub number: u64,
+    pub frames: Vec<Bytes>,
+    /// The end frame is the last of `frames`.
+    pub ended: bool,
 }
 
 pub(crate) struct Request {
@@ -89,15 +110,17 @@ pub struct Preview {
     requests: tokio::sync::watch::Sender<u64>,
     watcher: Mutex<Option<notify::RecommendedWatcher>>,
     lot_notes: Vec<String>,
-    /// Buffers of models no longer sent, for the next models' bytes.
-    spare_models: Arc<Mutex<Vec<Vec<u8>>>>,
+    /// The model being made.
+    live: tokio::sync::watch::Sender<Live>,
+    /// Buffers of lots' frames no longer sent, for the next frames' bytes.
+    spare_frames: Arc<Mutex<Vec<Vec<u8>>>>,
 }
 
-/// Buffers of models kept for reuse at most: the model shown and the one
-/// being made are the others.
-const SPARE_MODELS: usize = 2;
+/// Buffers of lots' frames kept for reuse at most (those of the model
+/// shown and of the one being made are the others).
+const SPARE_FRAMES: usize = 64;
 
-/// A model's bytes, which go back to the spare buffers when the last
+/// A frame's bytes, which go back to the spare buffers when the last
 /// request sending them is done with them.
 struct Pooled {
     bytes: Vec<u8>,
@@ -114,7 +137,7 @@ impl Drop for Pooled {
     fn drop(&mut self) {
         if let Some(spares) = self.spares.upgrade() {
             let mut spares = spares.lock().unwrap_or_else(|e| e.into_inner());
-            if spares.len() < SPARE_MODELS {
+            if spares.len() < SPARE_FRAMES {
                 spares.push(std::mem::take(&mut self.bytes));
             }
         }
@@ -159,7 +182,7 @@ impl Preview {
         let empty = Snapshot {
             version: 0,
             state: Arc::new("{}".to_string()),
-            model: Bytes::from(encode::model(&[], origin, &mut |_| None)),
+            model: vec![Bytes::from(encode::model(&[], origin, &mut |_| None))],
             model_version: 0,
             made_by: None,
         };
@@ -185,7 +208,8 @@ impl Preview {
             events,
             requests,
             watcher: Mutex::new(None),
-            spare_models: Arc::default(),
+            live: tokio::sync::watch::channel(Live::default()).0,
+            spare_frames: Arc::default(),
             lot_notes: lot_set.warnings,
         });
         let worker = preview.clone();
@@ -243,8 +267,8 @@ impl Preview {
     }
 
     /// Asks for a new generation (after `change`), cancelling the running
-    /// one, which the change makes obsolete.
-    pub(crate) fn request(&self, change: impl FnOnce(&mut Request)) {
+    /// one, which the change makes obsolete; returns the request's number.
+    pub(crate) fn request(&self, change: impl FnOnce(&mut Request)) -> u64 {
         let number = {
             let mut r = self.request.lock().unwrap();
             change(&mut r);
@@ -262,11 +286,13 @@ impl Preview {
                 cancel.cancel();
             }
         }
+        number
     }
 
-    /// New values from the page.
-    pub fn set_params(&self, params: Params) {
-        self.request(|r| r.params = params);
+    /// New values from the page; returns the number of the request (its
+    /// model being made is `/api/live.bin?n=` it).
+    pub fn set_params(&self, params: Params) -> u64 {
+        self.request(|r| r.params = params)
     }
 
     pub fn params(&self) -> Params {
@@ -289,6 +315,42 @@ impl Preview {
     /// The number of each request as it is made (see `requests`).
     pub fn subscribe_requests(&self) -> tokio::sync::watch::Receiver<u64> {
         self.requests.subscribe()
+    }
+
+    /// The number of the latest request.
+    pub fn latest_request(&self) -> u64 {
+        *self.requests.borrow()
+    }
+
+    /// The model being made, as its frames come.
+    pub fn subscribe_live(&self) -> tokio::sync::watch::Receiver<Live> {
+        self.live.subscribe()
+    }
+
+    /// Ends the model being made for request `number` (started or not)
+    /// with `end`, unless it has ended.
+    fn end_live(&self, number: u64, end: Bytes) {
+        self.live.send_modify(|l| {
+            if l.number != number {
+                *l = Live {
+                    number,
+                    frames: vec![Bytes::from(encode::start_frame(
+                        self.origin,
+                        self.lots.len(),
+                    ))],
+                    ended: false,
+                };
+            }
+            if !l.ended {
+                l.frames.push(end);
+                l.ended = true;
+            }
+        });
+    }
+
+    /// Gives up the model being made for request `number`.
+    fn abandon_live(&self, number: u64) {
+        self.end_live(number, Bytes::from(encode::end_frame(false, None, None)));
     }
 
     /// Blocks until a state of at least `version` is published (tests,
@@ -357,6 +419,7 @@ impl Preview {
         let previous = self.snapshot();
         if rules.has_errors() {
             self.publish(rules, params, problems, None, load_ms, 0.0, &previous);
+            self.abandon_live(number);
             return;
         }
         let cancel = Cancel::new();
@@ -365,6 +428,7 @@ impl Preview {
         // cancel this generation, so this one is not started.
         if self.request.lock().unwrap().number != number {
             self.running.lock().unwrap().take();
+            self.abandon_live(number);
             return;
         }
         let mut options = Options::default()
@@ -380,12 +444,52 @@ impl Preview {
                 }
             }
         }
+        // Each lot is encoded as it comes, on this thread while the
+        // workers derive the next, and sent to the pages fetching the
+        // model being made.
+        self.live.send_replace(Live {
+            number,
+            frames: vec![Bytes::from(encode::start_frame(
+                self.origin,
+                self.lots.len(),
+            ))],
+            ended: false,
+        });
+        let mut results = Vec::with_capacity(self.lots.len());
+        let mut bounds = None;
+        let mut encode_ms = 0.0;
+        let mut found = std::collections::HashMap::new();
+        let mut texture = |path: &str| {
+            found
+                .entry(path.to_string())
+                .or_insert_with(|| self.texture_url(path))
+                .clone()
+        };
         let t = Instant::now();
-        let outcome = encode::drawn(rules, &self.lots, &options, self.origin);
+        let outcome = rules.generate_lots(
+            &self.lots,
+            &options,
+            cga::Target::Drawing(self.origin),
+            |lot| {
+                let encoding = Instant::now();
+                // Written into a buffer of an earlier frame, and given
+                // back when no request sends it any more.
+                let spare = self.spare_frames.lock().unwrap().pop().unwrap_or_default();
+                let (bytes, b) = encode::lot_frame(&lot, &mut texture, spare);
+                bounds = encode::union(bounds, b);
+                let frame = Bytes::from_owner(Pooled {
+                    bytes,
+                    spares: Arc::downgrade(&self.spare_frames),
+                });
+                self.live.send_modify(|l| l.frames.push(frame));
+                encode_ms += encoding.elapsed().as_secs_f64() * 1e3;
+                results.push(lot);
+            },
+        );
         let gen_ms = t.elapsed().as_secs_f64() * 1e3;
         self.running.lock().unwrap().take();
         match outcome {
-            Ok(results) => {
+            Ok(_) => {
                 for lot in &results {
                     for w in &lot.warnings {
                         problems.push(self.diagnostic(w, Some(&lot.name)));
@@ -403,68 +507,70 @@ impl Preview {
                     results: Arc::new(results),
                     options,
                 };
+                let frames = self.live.borrow().frames.clone();
+                let model = Model {
+                    made,
+                    frames,
+                    bounds,
+                    encode_ms,
+                };
                 self.publish(
                     rules,
                     params,
                     problems,
-                    Some(made),
+                    Some(model),
                     load_ms,
                     gen_ms,
                     &previous,
                 );
+                // The same end frame: with the number the state gives the
+                // model, published first (a page drawing the model may ask
+                // for its provenance at once).
+                if let Some(end) = self.snapshot().model.last() {
+                    self.end_live(number, end.clone());
+                }
             }
             // A newer request is waiting: it will publish.
-            Err(Error::Cancelled) => {}
+            Err(Error::Cancelled) => self.abandon_live(number),
             Err(e) => {
                 problems.push(json!({"severity": "error", "message": e.to_string()}));
                 self.publish(rules, params, problems, None, load_ms, gen_ms, &previous);
+                self.abandon_live(number);
             }
         }
     }
 
+    /// Publishes the state, with `model` as the new model shown (else
+    /// the last good one stays).
     #[allow(clippy::too_many_arguments)]
     fn publish(
         &self,
         rules: &Rules,
         params: &Params,
         problems: Vec<Json>,
-        made: Option<Made>,
+        model: Option<Model>,
         load_ms: f64,
         gen_ms: f64,
         previous: &Snapshot,
     ) {
         let version = previous.version + 1;
-        let fresh = made.is_some();
-        let encoding = Instant::now();
-        let (model, model_version, made_by) = match made {
-            Some(m) => {
-                let mut found = std::collections::HashMap::new();
-                let mut texture = |path: &str| {
-                    found
-                        .entry(path.to_string())
-                        .or_insert_with(|| self.texture_url(path))
-                        .clone()
-                };
-                // Written into a buffer of an earlier model, and given back
-                // when no request sends it any more.
-                let spare = self.spare_models.lock().unwrap().pop().unwrap_or_default();
-                let bytes = encode::model_into(&m.results, self.origin, &mut texture, spare);
-                let pooled = Pooled {
-                    bytes,
-                    spares: Arc::downgrade(&self.spare_models),
-                };
-                (Bytes::from_owner(pooled), version, Some(m))
+        let fresh = model.is_some();
+        let (model, model_version, made_by, encode_ms) = match model {
+            Some(Model {
+                made,
+                mut frames,
+                bounds,
+                encode_ms,
+            }) => {
+                frames.push(Bytes::from(encode::end_frame(true, bounds, Some(version))));
+                (frames, version, Some(made), encode_ms)
             }
             None => (
                 previous.model.clone(),
                 previous.model_version,
                 previous.made_by.clone(),
+                0.0,
             ),
-        };
-        let encode_ms = if fresh {
-            encoding.elapsed().as_secs_f64() * 1e3
-        } else {
-            0.0
         };
         let results: &[LotResult] = made_by.as_ref().map(|m| &m.results[..]).unwrap_or(&[]);
         let mut prints = Vec::new();
@@ -488,7 +594,7 @@ impl Preview {
             "generate_ms": made_by.as_ref().map(|m| m.generate_ms).unwrap_or(gen_ms),
             // Making the bytes the page fetches.
             "encode_ms": encode_ms,
-            "model_bytes": model.len(),
+            "model_bytes": model.iter().map(Bytes::len).sum::<usize>(),
         });
         let state = json!({
             "version": version,
@@ -743,9 +849,9 @@ mod tests {
         drop(sent);
         assert_eq!(spares.lock().unwrap().len(), 1);
         assert_eq!(spares.lock().unwrap()[0].len(), 100);
-        let more: Vec<Bytes> = (0..SPARE_MODELS + 2).map(|_| pooled(10)).collect();
+        let more: Vec<Bytes> = (0..SPARE_FRAMES + 2).map(|_| pooled(10)).collect();
         drop(more);
-        assert_eq!(spares.lock().unwrap().len(), SPARE_MODELS);
+        assert_eq!(spares.lock().unwrap().len(), SPARE_FRAMES);
     }
 
     /// A writer's close ends a save; its other steps and renames may be

@@ -5,6 +5,7 @@ use std::convert::Infallible;
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use axum::body::{Body, Bytes};
 use axum::extract::{DefaultBodyLimit, Query, State};
 use axum::http::{header, Method, StatusCode, Uri};
 use axum::response::sse::{Event, KeepAlive, Sse};
@@ -16,6 +17,7 @@ use serde::Deserialize;
 use serde_json::json;
 use tokio_stream::StreamExt;
 
+use crate::encode;
 use crate::generator::{Params, Preview};
 use crate::paths;
 
@@ -41,6 +43,7 @@ pub fn router(preview: Arc<Preview>, web_dir: PathBuf) -> Router {
         .route("/api/state", get(state))
         .route("/api/events", get(events))
         .route("/api/model.bin", get(model))
+        .route("/api/live.bin", get(live))
         .route("/api/lots.bin", get(lots))
         .route("/api/model.glb", get(glb))
         .route("/api/provenance", get(provenance))
@@ -88,9 +91,89 @@ async fn events(
     Sse::new(stream).keep_alive(KeepAlive::default())
 }
 
+/// A body of frames sent one after the other, as they are.
+fn frames_body(frames: Vec<Bytes>) -> Body {
+    Body::from_stream(tokio_stream::iter(
+        frames.into_iter().map(Ok::<_, Infallible>),
+    ))
+}
+
 async fn model(State(app): State<App>) -> Response {
-    let s = app.preview.snapshot();
-    no_store("application/octet-stream", s.model.clone())
+    let frames = app.preview.snapshot().model.clone();
+    let length = frames.iter().map(Bytes::len).sum::<usize>();
+    let mut response = no_store("application/octet-stream", frames_body(frames));
+    response
+        .headers_mut()
+        .insert(header::CONTENT_LENGTH, header::HeaderValue::from(length));
+    response
+}
+
+/// Longest wait for the next frame of a model being made: a page whose
+/// model does not come in this time is sent an abandoned end (it then
+/// fetches the model the next state names).
+const LIVE_WAIT: std::time::Duration = std::time::Duration::from_secs(60);
+
+#[derive(Deserialize)]
+struct LiveQuery {
+    /// The number of the request (the `generating` event's).
+    n: u64,
+}
+
+/// The model being made for request `n`, its frames sent as they come
+/// (see [`crate::generator::Live`]). A request that another replaced
+/// before its model was done ends with an abandoned end frame.
+async fn live(State(app): State<App>, Query(q): Query<LiveQuery>) -> Response {
+    if q.n > app.preview.latest_request() {
+        return not_found();
+    }
+    let mut live = app.preview.subscribe_live();
+    let preview = app.preview.clone();
+    let (tx, rx) = tokio::sync::mpsc::channel::<Result<Bytes, Infallible>>(4);
+    tokio::spawn(async move {
+        // Frames sent so far.
+        let mut sent = 0;
+        let abandoned = |sent: usize| {
+            let mut end = Vec::new();
+            if sent == 0 {
+                end = encode::start_frame(preview.origin, preview.lots.len());
+            }
+            end.extend_from_slice(&encode::end_frame(false, None, None));
+            Bytes::from(end)
+        };
+        loop {
+            let (frames, ended) = {
+                let l = live.borrow_and_update();
+                match l.number.cmp(&q.n) {
+                    std::cmp::Ordering::Less => (Vec::new(), false),
+                    std::cmp::Ordering::Equal => (l.frames[sent..].to_vec(), l.ended),
+                    // Replaced before it was done (or before this page
+                    // caught up with it).
+                    std::cmp::Ordering::Greater => (vec![abandoned(sent)], true),
+                }
+            };
+            for frame in frames {
+                if tx.send(Ok(frame)).await.is_err() {
+                    return; // The page went away.
+                }
+                sent += 1;
+            }
+            if ended {
+                return;
+            }
+            match tokio::time::timeout(LIVE_WAIT, live.changed()).await {
+                Ok(Ok(())) => {}
+                // Waited too long, or the server stops.
+                _ => {
+                    let _ = tx.send(Ok(abandoned(sent))).await;
+                    return;
+                }
+            }
+        }
+    });
+    no_store(
+        "application/octet-stream",
+        Body::from_stream(tokio_stream::wrappers::ReceiverStream::new(rx)),
+    )
 }
 
 async fn lots(State(app): State<App>) -> Response {
@@ -196,11 +279,15 @@ async fn set_params(State(app): State<App>, Json(body): Json<serde_json::Value>)
     if body.attrs.len() > MAX_ATTRS {
         return (StatusCode::PAYLOAD_TOO_LARGE, "too many attributes\n").into_response();
     }
-    app.preview.set_params(Params {
+    let request = app.preview.set_params(Params {
         seed: body.seed,
         attrs: body.attrs,
     });
-    (StatusCode::ACCEPTED, Json(json!({"accepted": true}))).into_response()
+    (
+        StatusCode::ACCEPTED,
+        Json(json!({"accepted": true, "request": request})),
+    )
+        .into_response()
 }
 
 /// The page's files (`/`, `/main.js`) and the workspace's (`/files/...`),

@@ -10,7 +10,8 @@
 //! | `GET /` and `GET /NAME` | the page (`web/dist`: `index.html`, `main.js`, ...) |
 //! | `GET /api/state` | JSON: attributes with annotations, values, diagnostics, prints, reports, statistics |
 //! | `GET /api/events` | server-sent events: a `state` event (the same JSON) after every change, a `generating` event (the request's number) as each regeneration is asked for |
-//! | `GET /api/model.bin` | the last good model: meshes per lot and material (see [`encode`]) |
+//! | `GET /api/model.bin` | the last good model: a frame of meshes per lot and material (see [`encode`]) |
+//! | `GET /api/live.bin?n=N` | the model being made for request `N`, each lot's frame sent as the lot is made; it ends complete, or abandoned when a newer request replaced it |
 //! | `GET /api/lots.bin` | the lots, in the same form, to draw under the buildings |
 //! | `GET /api/model.glb` | the model as a GLB file (download) |
 //! | `GET /api/provenance?lot=L&mesh=M&tri=T` | the rule and source line that made a triangle |

@@ -51,6 +51,37 @@ fn post(addr: SocketAddr, path: &str, body: &str) -> (u16, Vec<u8>) {
     )
 }
 
+/// A body sent in chunks (`Transfer-Encoding: chunked`), joined.
+fn dechunk(mut body: &[u8]) -> Vec<u8> {
+    let mut out = Vec::new();
+    loop {
+        let line = body.windows(2).position(|w| w == b"\r\n").unwrap();
+        let size = usize::from_str_radix(std::str::from_utf8(&body[..line]).unwrap(), 16).unwrap();
+        if size == 0 {
+            return out;
+        }
+        out.extend_from_slice(&body[line + 2..line + 2 + size]);
+        body = &body[line + 2 + size + 2..];
+    }
+}
+
+/// The frames of a binary model (see `cga_serve::encode`): headers and
+/// data.
+fn frames(bytes: &[u8]) -> Vec<(Json, Vec<u8>)> {
+    assert_eq!(&bytes[..4], b"CGAF");
+    let mut at = 4;
+    let mut out = Vec::new();
+    while at < bytes.len() {
+        let h = u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+        let d = u32::from_le_bytes(bytes[at + 4..at + 8].try_into().unwrap()) as usize;
+        let header = serde_json::from_slice(&bytes[at + 8 + d..at + 8 + d + h]).unwrap();
+        out.push((header, bytes[at + 8..at + 8 + d].to_vec()));
+        at += 8 + d + h;
+    }
+    assert_eq!(at, bytes.len());
+    out
+}
+
 fn state(addr: SocketAddr) -> Json {
     let (status, body) = get(addr, "/api/state");
     assert_eq!(status, 200);
@@ -137,18 +168,18 @@ fn state_model_provenance_and_parameters() {
     // The model: a box 10 m high on the default 20 x 30 lot.
     let (status, model) = get(addr, "/api/model.bin");
     assert_eq!(status, 200);
-    assert_eq!(&model[..4], b"CGAM");
-    // Header length, data length, the data, then the header.
-    let length = u32::from_le_bytes(model[4..8].try_into().unwrap()) as usize;
-    let data = u32::from_le_bytes(model[8..12].try_into().unwrap()) as usize;
-    assert_eq!(model.len(), 12 + data + length);
-    let header: Json = serde_json::from_slice(&model[12 + data..]).unwrap();
-    let mesh = &header["lots"][0]["meshes"][0];
+    let frames = frames(&model);
+    // The start, the lot, the end.
+    assert_eq!(frames.len(), 3);
+    assert_eq!(frames[0].0["start"]["lots"], 1);
+    let mesh = &frames[1].0["lot"]["meshes"][0];
     // The texture named relative to the rule file, served from the workspace.
     assert_eq!(mesh["texture"], "files/assets/brick.png");
     assert_eq!(mesh["triangles"], 12);
+    assert_eq!(frames[2].0["end"]["complete"], true);
+    assert_eq!(frames[2].0["end"]["model_version"], s["model_version"]);
     let (status, lots) = get(addr, "/api/lots.bin");
-    assert_eq!((status, &lots[..4]), (200, &b"CGAM"[..]));
+    assert_eq!((status, &lots[..4]), (200, &b"CGAF"[..]));
     let (status, glb) = get(addr, "/api/model.glb");
     assert_eq!((status, &glb[..4]), (200, &b"glTF"[..]));
     let (status, body) = get(addr, "/api/provenance?lot=0&mesh=0&tri=0");
@@ -188,6 +219,69 @@ fn state_model_provenance_and_parameters() {
     let s = state(addr);
     assert_eq!(s["reports"][0]["value"], 10.0);
     assert_eq!(s["problems"], serde_json::json!([]));
+}
+
+/// The model being made comes in frames for the request that asked for
+/// it; a request replaced before its model ends abandoned; one not yet
+/// made is not found.
+#[test]
+fn the_model_being_made_comes_for_its_request() {
+    let (dir, server) = workspace(RULE);
+    let addr = server.addr;
+    let version = state(addr)["version"].as_u64().unwrap();
+    let (status, body) = post(addr, "/api/params", r#"{"attrs": {"height": 15}}"#);
+    assert_eq!(status, 202);
+    // The answer names the request.
+    let n = serde_json::from_slice::<Json>(&body).unwrap()["request"]
+        .as_u64()
+        .unwrap();
+    assert_eq!(n, server.preview.latest_request());
+    assert_eq!(get(addr, &format!("/api/live.bin?n={}", n + 1)).0, 404);
+    // Asked for while it is made or after: all of its frames.
+    let (status, body) = get(addr, &format!("/api/live.bin?n={n}"));
+    assert_eq!(status, 200);
+    let live = frames(&dechunk(&body));
+    assert_eq!(
+        live.len(),
+        3,
+        "{:?}",
+        live.iter().map(|f| &f.0).collect::<Vec<_>>()
+    );
+    assert_eq!(live[1].0["lot"]["meshes"][0]["triangles"], 12);
+    // The box of the model 15 m high.
+    assert_eq!(live[2].0["end"]["bounds"]["max"][1], 15.0);
+    assert_eq!(live[2].0["end"]["complete"], true);
+    assert!(server
+        .preview
+        .wait_for_version(version + 1, Duration::from_secs(30)));
+    let s = state(addr);
+    assert_eq!(live[2].0["end"]["model_version"], s["model_version"]);
+    // The model sent whole is the same frames.
+    let (_, model) = get(addr, "/api/model.bin");
+    assert_eq!(frames(&model), live);
+
+    // An older request's model, replaced: abandoned.
+    let (status, body) = get(addr, &format!("/api/live.bin?n={}", n - 1));
+    assert_eq!(status, 200);
+    let old = frames(&dechunk(&body));
+    assert_eq!(old.len(), 2);
+    assert_eq!(old[1].0["end"]["complete"], false);
+
+    // Rules with an error make no model: abandoned too, and the model
+    // shown stays.
+    let rules = dir.path().join("project/rules/a.cga");
+    let text = std::fs::read_to_string(&rules).unwrap();
+    std::fs::write(&rules, format!("{text}\nBroken --> split(\n")).unwrap();
+    assert!(server
+        .preview
+        .wait_for_version(s["version"].as_u64().unwrap() + 1, Duration::from_secs(30)));
+    let n = server.preview.latest_request();
+    let (_, body) = get(addr, &format!("/api/live.bin?n={n}"));
+    let broken = frames(&dechunk(&body));
+    assert_eq!(broken.last().unwrap().0["end"]["complete"], false);
+    let s = state(addr);
+    assert_eq!(s["has_errors"], true);
+    assert_eq!(s["model_version"], live[2].0["end"]["model_version"]);
 }
 
 #[test]

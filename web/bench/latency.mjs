@@ -8,12 +8,14 @@
 // the lots given (default: its footprint); each edit changes the default
 // of BuildingHeight (file: 62 to 76 m) or moves the BuildingHeight slider
 // (43 to 100 m: later slider edits make larger models). DEBUG=1 prints
-// each edit's timeline.
+// each edit's timeline. The browser is driven without Playwright (see
+// plain.mjs); PLAYWRIGHT=1 drives it with Playwright.
 
 import { cpSync, mkdtempSync, readFileSync, writeFileSync, rmSync, existsSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
 import { repo, startServer, launchBrowser } from '../tests/harness.mjs';
+import { launchPlain } from './plain.mjs';
 
 const oracle = resolve(repo, '..', 'shared', 'prt-oracle');
 if (!existsSync(join(oracle, 'rules', 'candler'))) {
@@ -30,7 +32,8 @@ cpSync(join(oracle, 'rules', 'candler'), join(dir, 'candler'), { recursive: true
 const rules = join(dir, 'candler', 'rules', 'candler.cga');
 const original = readFileSync(rules, 'utf8');
 const server = await startServer([rules, ...specs.flatMap((s) => ['--lot', s])]);
-const browser = await launchBrowser();
+// PLAYWRIGHT=1: under Playwright, as the tests drive the page.
+const browser = process.env.PLAYWRIGHT ? await launchBrowser() : await launchPlain();
 const median = (xs) => { const s = [...xs].sort((a, b) => a - b); return s[Math.floor(s.length / 2)]; };
 const p90 = (xs) => { const s = [...xs].sort((a, b) => a - b); return s[Math.min(s.length - 1, Math.floor(s.length * 0.9))]; };
 

@@ -22,7 +22,7 @@ export function cgaBinary() {
 export function startServer(args) {
   return new Promise((resolveStart, reject) => {
     const child = spawn(cgaBinary(), ['serve', ...args, '--port', '0'], {
-      env: { ...process.env, CGA_WEB_DIR: join(repo, 'web', 'dist') },
+      env: { ...process.env, CGA_WEB_DIR: process.env.CGA_WEB_DIR || join(repo, 'web', 'dist') },
       stdio: ['ignore', 'pipe', 'pipe'],
     });
     let out = '';

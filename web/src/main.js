@@ -391,14 +391,20 @@ function replaceMeshes(group, meshes, bounds) {
 let lotsLoading = null;
 let fitted = false;
 
+// The lots' outlines, fetched once (again after a failure).
 function loadLots() {
   lotsLoading ??= (async () => {
+    const response = await fetch('api/lots.bin');
+    if (!response.ok) throw new Error(`lots.bin: ${response.status}`);
     const meshes = [];
-    const end = await readFrames(await fetch('api/lots.bin'), (header, data) => {
+    const end = await readFrames(response, (header, data) => {
       if (header.lot) meshes.push(...lotMeshes(header.lot, data, { lots: true }));
     });
     replaceMeshes(lotsGroup, meshes, end.bounds);
-  })();
+  })().catch((e) => {
+    lotsLoading = null;
+    throw e;
+  });
   return lotsLoading;
 }
 
@@ -439,9 +445,20 @@ async function fetchModel(url, load) {
 }
 
 // Shows a model fetched by `fetchModel` (started at `t`) as model `version`.
+// Resolves with whether it was shown (not when an older model than the
+// one shown, or when the lots could not be loaded).
 async function showModel(got, version, t, from) {
   const fetched = performance.now();
-  await loadLots();
+  try {
+    await loadLots();
+  } catch {
+    disposeMeshes(got.meshes);
+    return false;
+  }
+  if (version < page.modelVersion) {
+    disposeMeshes(got.meshes);
+    return false;
+  }
   const swap = performance.now();
   replaceMeshes(modelGroup, got.meshes, got.end.bounds);
   const built = performance.now();
@@ -458,7 +475,7 @@ async function showModel(got, version, t, from) {
   // were issued.
   await new Promise((r) => requestAnimationFrame(() => r()));
   // A newer model may have been drawn meanwhile: the version only grows.
-  if (version < page.modelVersion) return;
+  if (version < page.modelVersion) return true;
   page.modelVersion = version;
   // 'live': the lots came as they were made; 'whole': the last good model.
   page.drawnFrom = from;
@@ -472,6 +489,7 @@ async function showModel(got, version, t, from) {
   // a step of 16 bits of the mesh's box).
   page.bounds = modelGroup.userData.bounds ?? null;
   $('stat-draw').textContent = `${page.drawMs.toFixed(1)} ms`;
+  return true;
 }
 
 // The last good model, number `version`, all at once. (A load stays
@@ -482,11 +500,14 @@ async function loadModel(version) {
   const t = performance.now();
   const got = await fetchModel(`api/model.bin?v=${version}`, load);
   if (loading !== load) return;
-  if (got) await showModel(got, version, t, 'whole');
-  else releaseShadows();
+  // The model sent is the newest, which may be newer than asked for.
+  const shown = got ? await showModel(got, got.end.model_version ?? version, t, 'whole') : false;
+  if (!shown) releaseShadows();
   if (loading === load) {
     loading = null;
-    catchUp();
+    // Only after a success: a model that cannot be fetched now is asked
+    // for again by the next state.
+    if (shown) catchUp();
   }
 }
 
@@ -506,15 +527,15 @@ async function loadLive(n) {
   const got = await fetchModel(`api/live.bin?n=${n}`, load);
   if (loading !== load) return;
   if (got) {
-    await showModel(got, got.end.model_version, t, 'live');
+    const shown = await showModel(got, got.end.model_version, t, 'live');
     if (loading === load) {
       loading = null;
-      catchUp();
+      if (shown) catchUp();
     }
     return;
   }
   loading = null;
-  if (lastState && lastState.model_version !== page.modelVersion && lastState.model_version > 0) loadModel(lastState.model_version);
+  if (lastState && lastState.model_version > page.modelVersion) loadModel(lastState.model_version);
   else releaseShadows();
 }
 
@@ -839,7 +860,7 @@ function onState(state) {
   lastState = state;
   // A model on its way (being made, or this one) is awaited.
   const awaited = loading && (loading.live !== null || loading.version === state.model_version);
-  if (state.model_version !== page.modelVersion && state.model_version > 0 && !awaited) loadModel(state.model_version);
+  if (state.model_version > page.modelVersion && !awaited) loadModel(state.model_version);
   else if (!loading) releaseShadows();
 }
 
@@ -881,10 +902,18 @@ function connect() {
   events.addEventListener('generating', (e) => {
     holdShadows();
     setStatus('generating…', 'busy');
-    loadLive(Number(e.data));
+    // Pages in the background leave the connection to the one in view
+    // (a browser opens six to a server); they load the model the state
+    // names.
+    if (document.visibilityState === 'visible') loadLive(Number(e.data));
   });
   events.onerror = () => setStatus('disconnected: is cga serve running?', 'error');
-  events.onopen = () => setStatus('connected');
+  events.onopen = () => {
+    setStatus('connected');
+    // A server started again counts its models from 1: the model its
+    // first state names is loaded whatever this page showed.
+    page.modelVersion = 0;
+  };
 }
 
 render();

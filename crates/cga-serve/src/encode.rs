@@ -485,9 +485,9 @@ pub fn lot_frame(
         size = index_at + index_bytes.next_multiple_of(4);
         p.at = [positions, uv_at, normal_at, index_at, size];
     }
-    // Every byte of the data is written below (the padding by
-    // `Placed::write`): only room a reused buffer lacks is zeroed. Room
-    // for the header too, so that appending it does not copy the data.
+    // A reused buffer has its pages already: the data is zeroed and then
+    // written over (the padding by `Placed::write`). Room for the header
+    // too, so that appending it does not copy the data.
     out.clear();
     out.reserve(8 + size + 512 * placed.len() + 1024);
     let mut bounds = None;

@@ -35,6 +35,8 @@ pub struct Snapshot {
     /// with every request that sends them (no copy), and its number.
     pub model: Vec<Bytes>,
     pub model_version: u64,
+    /// The number of the request whose generation made the model.
+    pub model_request: Option<u64>,
     /// What made the model: for provenance and the GLB download.
     pub made_by: Option<Made>,
 }
@@ -42,6 +44,8 @@ pub struct Snapshot {
 /// A model made: what made it, its frames but the end, its box and the
 /// time its lots took to encode.
 struct Model {
+    /// The request it was made for.
+    request: u64,
     made: Made,
     frames: Vec<Bytes>,
     bounds: Option<encode::Bounds>,
@@ -184,6 +188,7 @@ impl Preview {
             state: Arc::new("{}".to_string()),
             model: vec![Bytes::from(encode::model(&[], origin, &mut |_| None))],
             model_version: 0,
+            model_request: None,
             made_by: None,
         };
         let preview = Arc::new(Preview {
@@ -331,7 +336,7 @@ impl Preview {
     /// with `end`, unless it has ended.
     fn end_live(&self, number: u64, end: Bytes) {
         self.live.send_modify(|l| {
-            if l.number != number {
+            if l.number != number || l.frames.is_empty() {
                 *l = Live {
                     number,
                     frames: vec![Bytes::from(encode::start_frame(
@@ -509,6 +514,7 @@ impl Preview {
                 };
                 let frames = self.live.borrow().frames.clone();
                 let model = Model {
+                    request: number,
                     made,
                     frames,
                     bounds,
@@ -555,19 +561,21 @@ impl Preview {
     ) {
         let version = previous.version + 1;
         let fresh = model.is_some();
-        let (model, model_version, made_by, encode_ms) = match model {
+        let (model, model_version, model_request, made_by, encode_ms) = match model {
             Some(Model {
+                request,
                 made,
                 mut frames,
                 bounds,
                 encode_ms,
             }) => {
                 frames.push(Bytes::from(encode::end_frame(true, bounds, Some(version))));
-                (frames, version, Some(made), encode_ms)
+                (frames, version, Some(request), Some(made), encode_ms)
             }
             None => (
                 previous.model.clone(),
                 previous.model_version,
+                previous.model_request,
                 previous.made_by.clone(),
                 0.0,
             ),
@@ -622,6 +630,7 @@ impl Preview {
             state: Arc::new(state.to_string()),
             model,
             model_version,
+            model_request,
             made_by,
         };
         *self.published.write().unwrap() = Arc::new(snapshot);

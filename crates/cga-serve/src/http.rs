@@ -146,9 +146,16 @@ async fn live(State(app): State<App>, Query(q): Query<LiveQuery>) -> Response {
                 match l.number.cmp(&q.n) {
                     std::cmp::Ordering::Less => (Vec::new(), false),
                     std::cmp::Ordering::Equal => (l.frames[sent..].to_vec(), l.ended),
-                    // Replaced before it was done (or before this page
-                    // caught up with it).
-                    std::cmp::Ordering::Greater => (vec![abandoned(sent)], true),
+                    // Replaced: by the time this page caught up, its model
+                    // may have been done (it is then the one published,
+                    // the same frames) or not.
+                    std::cmp::Ordering::Greater => {
+                        let s = preview.snapshot();
+                        match s.model_request == Some(q.n) {
+                            true => (s.model.get(sent..).unwrap_or_default().to_vec(), true),
+                            false => (vec![abandoned(sent)], true),
+                        }
+                    }
                 }
             };
             for frame in frames {

@@ -284,6 +284,20 @@ fn the_model_being_made_comes_for_its_request() {
     assert_eq!(s["model_version"], live[2].0["end"]["model_version"]);
 }
 
+/// Rules with an error from the start: the first request's model is
+/// abandoned, in frames a page reads (the magic, the start, the end).
+#[test]
+fn the_first_model_of_rules_with_an_error_is_abandoned_in_frames() {
+    let (_dir, server) = workspace("Lot --> split(\n");
+    assert_eq!(state(server.addr)["has_errors"], true);
+    let (status, body) = get(server.addr, "/api/live.bin?n=0");
+    assert_eq!(status, 200);
+    let live = frames(&dechunk(&body));
+    assert_eq!(live.len(), 2);
+    assert_eq!(live[0].0["start"]["lots"], 1);
+    assert_eq!(live[1].0["end"]["complete"], false);
+}
+
 #[test]
 fn only_the_page_and_workspace_files_are_served() {
     let (_dir, server) = workspace(RULE);

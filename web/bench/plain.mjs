@@ -16,6 +16,7 @@ import { spawn } from 'node:child_process';
 import { mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
+import { chromiumArgs } from '../tests/harness.mjs';
 
 export async function launchPlain() {
   const profile = mkdtempSync(join(tmpdir(), 'cga-bench-profile-'));
@@ -24,15 +25,7 @@ export async function launchPlain() {
     '--remote-debugging-pipe',
     `--user-data-dir=${profile}`,
     '--window-size=1280,800',
-    '--no-sandbox',
-    '--disable-gpu',
-    '--disable-quic',
-    '--no-first-run',
-    '--disable-background-networking',
-    '--disable-component-update',
-    '--disable-sync',
-    '--enable-unsafe-swiftshader',
-    '--use-angle=swiftshader',
+    ...chromiumArgs,
     'about:blank',
   ], { stdio: ['ignore', 'ignore', 'ignore', 'pipe', 'pipe'] });
   const toBrowser = child.stdio[3];

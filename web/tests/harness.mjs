@@ -44,6 +44,21 @@ export function startServer(args) {
   });
 }
 
+/// How Chromium is started here: without the sandbox and the background
+/// connections this machine's closed network refuses, WebGL in software.
+export const chromiumArgs = [
+  '--no-sandbox',
+  '--disable-gpu',
+  '--disable-quic',
+  '--no-first-run',
+  '--disable-background-networking',
+  '--disable-component-update',
+  '--disable-sync',
+  // WebGL without a GPU: Chromium's software renderer.
+  '--enable-unsafe-swiftshader',
+  '--use-angle=swiftshader',
+];
+
 /// Debian's Chromium, headless, with a fresh profile and without the
 /// background connections this machine's closed network refuses.
 export async function launchBrowser() {
@@ -52,18 +67,7 @@ export async function launchBrowser() {
     executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
     headless: true,
     viewport: { width: 1280, height: 800 },
-    args: [
-      '--no-sandbox',
-      '--disable-gpu',
-      '--disable-quic',
-      '--no-first-run',
-      '--disable-background-networking',
-      '--disable-component-update',
-      '--disable-sync',
-      // WebGL without a GPU: Chromium's software renderer.
-      '--enable-unsafe-swiftshader',
-      '--use-angle=swiftshader',
-    ],
+    args: chromiumArgs,
   });
   return {
     context,

@@ -332,19 +332,26 @@ impl Preview {
         self.live.subscribe()
     }
 
+    /// A model's start frame (the origin and the number of lots).
+    pub fn start_frame(&self) -> Vec<u8> {
+        encode::start_frame(self.origin, self.lots.len())
+    }
+
+    /// The model being made for request `number`, begun.
+    fn begun_live(&self, number: u64) -> Live {
+        Live {
+            number,
+            frames: vec![Bytes::from(self.start_frame())],
+            ended: false,
+        }
+    }
+
     /// Ends the model being made for request `number` (started or not)
     /// with `end`, unless it has ended.
     fn end_live(&self, number: u64, end: Bytes) {
         self.live.send_modify(|l| {
             if l.number != number || l.frames.is_empty() {
-                *l = Live {
-                    number,
-                    frames: vec![Bytes::from(encode::start_frame(
-                        self.origin,
-                        self.lots.len(),
-                    ))],
-                    ended: false,
-                };
+                *l = self.begun_live(number);
             }
             if !l.ended {
                 l.frames.push(end);
@@ -452,14 +459,7 @@ impl Preview {
         // Each lot is encoded as it comes, on this thread while the
         // workers derive the next, and sent to the pages fetching the
         // model being made.
-        self.live.send_replace(Live {
-            number,
-            frames: vec![Bytes::from(encode::start_frame(
-                self.origin,
-                self.lots.len(),
-            ))],
-            ended: false,
-        });
+        self.live.send_replace(self.begun_live(number));
         let mut results = Vec::with_capacity(self.lots.len());
         let mut bounds = None;
         let mut encode_ms = 0.0;

@@ -135,7 +135,7 @@ async fn live(State(app): State<App>, Query(q): Query<LiveQuery>) -> Response {
         let abandoned = |sent: usize| {
             let mut end = Vec::new();
             if sent == 0 {
-                end = encode::start_frame(preview.origin, preview.lots.len());
+                end = preview.start_frame();
             }
             end.extend_from_slice(&encode::end_frame(false, None, None));
             Bytes::from(end)

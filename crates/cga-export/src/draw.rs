@@ -183,7 +183,7 @@ impl MeshArrays for DrawMesh {
 
     fn push_fan(&mut self, f: &FaceData, uvs: Option<&[DVec2]>, first: u32, leaf: u32) {
         let corners = fan_corners(f, first);
-        let n = f.mesh.face_loops(f.face)[0].len as usize;
+        let n = f.loops[0].len as usize;
         let base = self.positions.len() as u32;
         self.positions
             .extend(corners.clone().map(|c| f32s(corner_position(f, c))));

@@ -467,7 +467,7 @@ fn add_face(
         *src = mesh.uvs[set].as_deref().or(uvs);
     }
     let sources = &sources[..bucket.sets.len()];
-    let loops = mesh.face_loops(f.face);
+    let loops = f.loops;
     match f.normals {
         Some(normals) if shared => {
             bucket.reserve(loops.iter().map(|l| l.len as usize).sum());

@@ -1,6 +1,6 @@
 //! Per-face helpers shared by the writers: face normals and finiteness checks.
 
-use cga_geometry::{DVec3, Mesh};
+use cga_geometry::{DVec3, Loop, Mesh};
 
 /// Unit normal of a face from its outer loop (Newell's method, which works
 /// for any planar polygon, convex or not, and averages slightly non-planar
@@ -27,16 +27,17 @@ pub(crate) fn face_normal(mesh: &Mesh, positions: &[DVec3], face: usize) -> Opti
 }
 
 /// The two normals the writers need of a face, in one pass over its outer
-/// loop: the unit normal the triangulation works with
-/// (`cga_geometry::measure::face_normal_at`: Newell's method relative to the
-/// first corner; zero if degenerate) and [`face_normal`]. Each is computed
+/// loop (`outer`): the Newell vector relative to the first corner that the
+/// triangulation works with (`cga_geometry::measure::newell`, not made
+/// unit: a quad's triangles are mostly told without it, see
+/// `triangulate_loops_newell`) and [`face_normal`]. Each is computed
 /// exactly as its own function computes it.
 pub(crate) fn face_normals(
     mesh: &Mesh,
     positions: &[DVec3],
-    face: usize,
+    outer: Loop,
 ) -> (DVec3, Option<DVec3>) {
-    let idx = mesh.loop_indices(mesh.outer_loop(face));
+    let idx = mesh.loop_indices(outer);
     let (Some(&first), Some(&last)) = (idx.first(), idx.last()) else {
         return (DVec3::ZERO, None);
     };
@@ -58,14 +59,8 @@ pub(crate) fn face_normals(
         // `newell` gives zero for edges and points.
         rel = DVec3::ZERO;
     }
-    let len = rel.length();
-    let unit = if len > 0.0 && len.is_finite() {
-        rel / len
-    } else {
-        DVec3::ZERO
-    };
     let len = abs.length();
-    (unit, (len > 0.0 && len.is_finite()).then(|| abs / len))
+    (rel, (len > 0.0 && len.is_finite()).then(|| abs / len))
 }
 
 /// Whether every position, UV (set 0) and normal of the face is finite;
@@ -154,7 +149,8 @@ mod tests {
         m.add_face(&[&[0, 1]], 0);
         m.add_face(&[&[0, 0, 0, 0]], 0);
         for f in 0..m.faces.len() {
-            let (unit, normal) = face_normals(&m, &m.positions, f);
+            let (newell, normal) = face_normals(&m, &m.positions, m.outer_loop(f));
+            let unit = cga_geometry::measure::unit_newell(newell);
             let want = cga_geometry::measure::face_normal_at(&m, &m.positions, f);
             assert_eq!(
                 unit.to_array().map(f64::to_bits),

@@ -318,7 +318,8 @@ pub(crate) struct FaceData<'a> {
     pub positions: &'a [DVec3],
     /// The per-corner normals as placed, if the mesh has normals.
     pub normals: Option<&'a [DVec3]>,
-    pub face: usize,
+    /// The face's loops, the outer one first (`Mesh::face_loops`).
+    pub loops: &'a [cga_geometry::Loop],
     /// Output material id (from `FacePrep`: the face's material slot, which
     /// the writer maps to its id).
     pub material: u32,
@@ -731,11 +732,16 @@ impl ModelWriter {
 fn check_mesh(mesh: &Mesh, material_slots: usize) -> Result<(), ExportError> {
     let bad = |msg: String| Err(ExportError::InvalidMesh(msg));
     let corners = mesh.corners.len();
-    if let Some(c) = mesh
-        .corners
-        .iter()
-        .position(|&p| p as usize >= mesh.positions.len())
-    {
+    // Every leaf is checked: the passes below look at all entries without
+    // stopping early (which the compiler vectorises) and look for the
+    // culprit only when one is out of range.
+    let in_range = |max: Option<u32>, len: usize| max.is_none_or(|m| (m as usize) < len);
+    if !in_range(mesh.corners.iter().copied().max(), mesh.positions.len()) {
+        let c = mesh
+            .corners
+            .iter()
+            .position(|&p| p as usize >= mesh.positions.len())
+            .unwrap_or_default();
         return bad(format!(
             "corner {c} refers to position {} of {}",
             mesh.corners[c],
@@ -757,21 +763,30 @@ fn check_mesh(mesh: &Mesh, material_slots: usize) -> Result<(), ExportError> {
             return bad(format!("{} normals for {corners} corners", n.len()));
         }
     }
-    for (i, l) in mesh.loops.iter().enumerate() {
-        if l.start as u64 + l.len as u64 > corners as u64 {
-            return bad(format!("loop {i} runs past the {corners} corners"));
-        }
+    let loop_past = |l: &cga_geometry::Loop| l.start as u64 + l.len as u64 > corners as u64;
+    if mesh.loops.iter().fold(false, |bad, l| bad | loop_past(l)) {
+        let i = mesh.loops.iter().position(loop_past).unwrap_or_default();
+        return bad(format!("loop {i} runs past the {corners} corners"));
     }
-    for (i, f) in mesh.faces.iter().enumerate() {
-        if f.loop_count == 0 || f.first_loop as u64 + f.loop_count as u64 > mesh.loops.len() as u64
-        {
-            return bad(format!("face {i} has loops out of range"));
-        }
-        if f.material as usize >= material_slots {
-            return bad(format!(
-                "face {i} uses material slot {} of {material_slots}",
-                f.material,
-            ));
+    let loops_out = |f: &cga_geometry::Face| {
+        f.loop_count == 0 || f.first_loop as u64 + f.loop_count as u64 > mesh.loops.len() as u64
+    };
+    let slot_out = |f: &cga_geometry::Face| f.material as usize >= material_slots;
+    if mesh
+        .faces
+        .iter()
+        .fold(false, |bad, f| bad | loops_out(f) | slot_out(f))
+    {
+        for (i, f) in mesh.faces.iter().enumerate() {
+            if loops_out(f) {
+                return bad(format!("face {i} has loops out of range"));
+            }
+            if slot_out(f) {
+                return bad(format!(
+                    "face {i} uses material slot {} of {material_slots}",
+                    f.material,
+                ));
+            }
         }
     }
     Ok(())

@@ -169,7 +169,7 @@ impl ObjWriter {
     pub(crate) fn add_face(&mut self, f: &FaceData) -> Result<(), ExportError> {
         let mesh = f.mesh;
         let uvs = mesh.uvs[0].as_deref();
-        let loops = mesh.face_loops(f.face);
+        let loops = f.loops;
         for &l in loops {
             for c in mesh.loop_corners(l) {
                 let position = mesh.corners[c] as usize;

@@ -3,7 +3,7 @@
 //! writing, and map material slots to output materials.
 
 use cga_geometry::mesh::SharedVec;
-use cga_geometry::triangulate::triangulate_face_with_normal;
+use cga_geometry::triangulate::triangulate_loops_newell;
 use cga_geometry::{DAffine3, DVec3, Material, Mesh};
 
 use crate::faces::{face_is_finite, face_normals};
@@ -81,14 +81,23 @@ fn each_face(
     mut emit: impl FnMut(&FaceData) -> Result<(), ExportError>,
 ) -> Result<u64, ExportError> {
     // Most meshes are finite throughout: then no face needs the check.
-    let all_finite = positions.iter().all(|p| p.is_finite())
-        && mesh.uvs[0]
-            .as_ref()
-            .is_none_or(|u| u.iter().all(|t| t.is_finite()))
-        && normals.is_none_or(|n| n.iter().all(|v| v.is_finite()));
+    // (Folds without stopping early, which the compiler vectorises.)
+    let finite3 = |v: &[DVec3]| {
+        v.iter().fold(true, |ok, p| {
+            ok & p.x.is_finite() & p.y.is_finite() & p.z.is_finite()
+        })
+    };
+    let all_finite = finite3(positions)
+        && mesh.uvs[0].as_ref().is_none_or(|u| {
+            u.iter()
+                .fold(true, |ok, t| ok & t.x.is_finite() & t.y.is_finite())
+        })
+        && normals.is_none_or(finite3);
     let mut skipped = 0;
     for face in 0..mesh.faces.len() {
-        if mesh.outer_loop(face).len < 3 {
+        // Looked up once: every step below reads them.
+        let loops = mesh.face_loops(face);
+        if loops[0].len < 3 {
             continue;
         }
         if !all_finite && !face_is_finite(mesh, positions, normals, face) {
@@ -96,8 +105,8 @@ fn each_face(
             continue;
         }
         triangles.clear();
-        let (unit, normal) = face_normals(mesh, positions, face);
-        triangulate_face_with_normal(mesh, positions, face, unit, triangles);
+        let (newell, normal) = face_normals(mesh, positions, loops[0]);
+        triangulate_loops_newell(mesh, positions, loops, newell, triangles);
         if triangles.is_empty() {
             continue;
         }
@@ -110,7 +119,7 @@ fn each_face(
             mesh,
             positions,
             normals,
-            face,
+            loops,
             material: mesh.faces[face].material,
             normal,
             triangles,

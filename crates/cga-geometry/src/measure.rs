@@ -46,7 +46,12 @@ pub fn face_normal(mesh: &Mesh, face: usize) -> DVec3 {
 /// [`face_normal`] with the mesh's vertices at `positions` instead of its
 /// own (the same mesh moved, as the exporter places a shape's geometry).
 pub fn face_normal_at(mesh: &Mesh, positions: &[DVec3], face: usize) -> DVec3 {
-    let v = newell(positions, mesh.loop_indices(mesh.outer_loop(face)));
+    unit_newell(newell(positions, mesh.loop_indices(mesh.outer_loop(face))))
+}
+
+/// A Newell vector ([`newell`]) made unit, or zero when it has no length or
+/// its length is not finite: [`face_normal_at`] of the loop.
+pub fn unit_newell(v: DVec3) -> DVec3 {
     let len = v.length();
     if len > 0.0 && len.is_finite() {
         v / len

@@ -11,7 +11,7 @@ use std::cell::RefCell;
 use earcut::Earcut;
 use glam::{DVec2, DVec3};
 
-use crate::mesh::Mesh;
+use crate::mesh::{Loop, Mesh};
 
 /// Reused per-thread buffers: exporting a city triangulates millions of
 /// faces, so none of them should allocate.
@@ -79,18 +79,115 @@ pub fn triangulate_face_with_normal(
     n: DVec3,
     out: &mut Vec<[u32; 3]>,
 ) {
-    let Some(f) = mesh.faces.get(face) else {
+    if face < mesh.faces.len() {
+        triangulate_loops_with_normal(mesh, positions, mesh.face_loops(face), n, out);
+    }
+}
+
+/// [`triangulate_loops_with_normal`] given the face's Newell vector
+/// relative to its first corner (`measure::newell` of the outer loop, not
+/// made unit), with the same triangles.
+///
+/// A quad's triangles are decided by the sign of the areas of two of its
+/// triangles, which the projection onto the face's plane measures; most
+/// quads are far from both signs' border, and there the sign of a product
+/// of the edges' cross product and the Newell vector is certain to be the
+/// same (`quad_diagonal`): the face's unit normal and plane basis (two
+/// square roots and two divisions) are only made for quads near it and for
+/// other faces.
+pub fn triangulate_loops_newell(
+    mesh: &Mesh,
+    positions: &[DVec3],
+    loops: &[Loop],
+    newell: DVec3,
+    out: &mut Vec<[u32; 3]>,
+) {
+    if let [outer] = loops {
+        if outer.len == 4 {
+            // The unit normal is zero exactly when this is not positive and
+            // finite (`measure::unit_newell`): no triangles then.
+            let d = newell.length_squared();
+            if !(d > 0.0 && d.is_finite()) {
+                return;
+            }
+            if let Some(first_diagonal) = quad_diagonal(mesh, positions, outer.start, newell) {
+                let s = outer.start;
+                if first_diagonal {
+                    out.push([s, s + 1, s + 2]);
+                    out.push([s, s + 2, s + 3]);
+                } else {
+                    out.push([s + 1, s + 2, s + 3]);
+                    out.push([s + 1, s + 3, s]);
+                }
+                return;
+            }
+        }
+    }
+    let unit = crate::measure::unit_newell(newell);
+    triangulate_loops_with_normal(mesh, positions, loops, unit, out);
+}
+
+/// Whether the quad whose corners start at `s` is cut along its first
+/// diagonal (corners 0–2) by [`triangulate_loops_with_normal`], when that
+/// is certain without projecting it; `None` when it is not.
+///
+/// The projection decides by the signs of the areas of triangles 0-1-2
+/// and 0-2-3 in the plane's basis. Mathematically they are the signs of
+/// `c · n` for the triangles' cross products `c` of the edges from corner
+/// 0 (`r1 × r2`, `r2 × r3`, computed as the Newell vector computes them)
+/// and the Newell vector `n`. The projection's rounding errors grow with
+/// the coordinates' magnitude `P` (it projects positions, not their
+/// differences), this test's with the edges' `L`; both stay below
+/// `64 ε (L P + L²) |n| + 72 ε L⁴` in the worst case, with `ε = 2⁻⁵³` and
+/// lengths bounded by `√3` times their largest coordinate. A sign counts
+/// only beyond `10⁻¹²` times those terms (over 40 times the bound): a
+/// facade's quad 400 m from the origin decides this way down to areas of
+/// a few square micrometres.
+fn quad_diagonal(mesh: &Mesh, positions: &[DVec3], s: u32, n: DVec3) -> Option<bool> {
+    let s = s as usize;
+    let p = |k: usize| positions[mesh.corners[s + k] as usize];
+    let (p0, p1, p2, p3) = (p(0), p(1), p(2), p(3));
+    let (r1, r2, r3) = (p1 - p0, p2 - p0, p3 - p0);
+    let a1 = r1.cross(r2).dot(n);
+    let a2 = r2.cross(r3).dot(n);
+    let l = r1.abs().max(r2.abs()).max(r3.abs()).max_element();
+    let big = p0
+        .abs()
+        .max(p1.abs())
+        .max(p2.abs())
+        .max(p3.abs())
+        .max_element();
+    let t = 1e-12 * (l * (big + l) * n.abs().max_element() + l * l * l * l);
+    // Comparisons with NaN or infinite bounds are false: undecided.
+    if a1 > t && a2 > t {
+        Some(true)
+    } else if a1 < -t || a2 < -t {
+        Some(false)
+    } else {
+        None
+    }
+}
+
+/// [`triangulate_face_with_normal`] for a face given by its loops (the
+/// outer one first), for callers that looked them up already.
+pub fn triangulate_loops_with_normal(
+    mesh: &Mesh,
+    positions: &[DVec3],
+    loops: &[Loop],
+    n: DVec3,
+    out: &mut Vec<[u32; 3]>,
+) {
+    let Some(&outer) = loops.first() else {
         return;
     };
-    let loops = mesh.face_loops(face);
-    let outer = loops[0];
     if outer.len < 3 || n == DVec3::ZERO {
         return;
     }
+    let single = loops.len() == 1;
     let s = outer.start;
     // Fast paths for the overwhelmingly common triangles and quads (a
     // triangle needs no projection).
-    if f.loop_count == 1 && outer.len == 3 {
+    if single && outer.len == 3 {
         out.push([s, s + 1, s + 2]);
         return;
     }
@@ -99,7 +196,7 @@ pub fn triangulate_face_with_normal(
         let p = positions[mesh.corners[c] as usize];
         DVec2::new(p.dot(u), p.dot(v))
     };
-    if f.loop_count == 1 && outer.len == 4 {
+    if single && outer.len == 4 {
         // Not `[0, 1, 2, 3].map(..)`: that is not inlined, and this runs
         // for most faces of a model.
         let s0 = s as usize;
@@ -320,6 +417,87 @@ mod tests {
             let tris = check(&m);
             let expected = n - 2 + if hole_idx.is_empty() { 0 } else { hole_idx.len() + 2 };
             proptest::prop_assert_eq!(tris.len(), expected);
+        }
+    }
+
+    /// One quad's triangles through the Newell-vector path and through the
+    /// projection with the unit normal.
+    fn quad_both_ways(corners: [DVec3; 4]) -> (Vec<[u32; 3]>, Vec<[u32; 3]>) {
+        let mut m = Mesh::new();
+        m.positions.extend(corners);
+        m.add_face(&[&[0, 1, 2, 3]], 0);
+        let n = crate::measure::newell(&m.positions, &m.corners);
+        let (mut fast, mut reference) = (Vec::new(), Vec::new());
+        triangulate_loops_newell(&m, &m.positions, m.face_loops(0), n, &mut fast);
+        let unit = crate::measure::unit_newell(n);
+        triangulate_loops_with_normal(&m, &m.positions, m.face_loops(0), unit, &mut reference);
+        (fast, reference)
+    }
+
+    #[test]
+    fn quads_decided_without_projecting_are_those_the_projection_gives() {
+        let far = DVec3::new(2_683_000.0, 431.0, -1_247_000.0);
+        // Convex, concave at corner 1 or 3 (the other diagonal), a bow
+        // tie, collinear halves, collapsed, far away and tiny.
+        let cases = [
+            [v(0., 0., 0.), v(1., 0., 0.), v(1., 1., 0.), v(0., 1., 0.)],
+            [v(0., 0., 0.), v(1., 0., 0.), v(0.2, 0.2, 0.), v(0., 1., 0.)],
+            [v(0., 0., 0.), v(1., 0., 0.), v(1., 1., 0.), v(0.8, 0.2, 0.)],
+            [v(0., 0., 0.), v(1., 1., 0.), v(1., 0., 0.), v(0., 1., 0.)],
+            [v(0., 0., 0.), v(1., 0., 0.), v(2., 0., 0.), v(0., 1., 0.)],
+            [v(0., 0., 0.), v(1., 0., 0.), v(1., 0., 0.), v(0., 0., 0.)],
+        ];
+        for c in cases {
+            for (shift, scale) in [
+                (DVec3::ZERO, 1.0),
+                (far, 1.0),
+                (far, 1e-4),
+                (DVec3::ZERO, 1e-9),
+            ] {
+                let q = c.map(|p| shift + p * scale);
+                let (fast, reference) = quad_both_ways(q);
+                assert_eq!(fast, reference, "{q:?}");
+            }
+        }
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig { cases: 4000, .. Default::default() })]
+
+        /// Random quads, far from the origin or not, large or tiny, planar
+        /// or not, and many with a corner on or a hair from the line of a
+        /// diagonal (where the two ways of deciding could part): the same
+        /// triangles both ways.
+        #[test]
+        fn quads_give_the_projections_triangles(
+            xy in proptest::array::uniform4(proptest::array::uniform2(-1.0f64..1.0)),
+            lift in proptest::array::uniform4(-1.0f64..1.0),
+            tilt in proptest::array::uniform3(-1.0f64..1.0),
+            far in 0usize..4,
+            size in 0usize..4,
+            border in 0usize..3,
+            hair in -1.0f64..1.0,
+        ) {
+            let shift = [0.0, 1e3, 1.2e6, 1e7][far];
+            let scale = [1e-6, 1e-2, 1.0, 30.0][size];
+            let mut q: [DVec2; 4] = xy.map(DVec2::from);
+            if border > 0 {
+                // Corner 3 on the line through corners 0 and 2 (or corner 1
+                // on it), moved off it by a relative hair.
+                let (a, b, k) = if border == 1 { (0, 2, 3) } else { (0, 2, 1) };
+                let t = q[k].x;
+                q[k] = q[a] + (q[b] - q[a]) * (1.0 + t) + (q[b] - q[a]).perp() * hair * 1e-12;
+            }
+            let n = DVec3::new(tilt[0], tilt[1], tilt[2] + 1.5).normalize();
+            let (u, w) = plane_basis(n);
+            let base = DVec3::new(shift, 0.3 * shift, -0.7 * shift);
+            let flat = (size + far) % 2 == 0;
+            let corners: [DVec3; 4] = std::array::from_fn(|i| {
+                let off = if flat { 0.0 } else { lift[i] * 1e-3 };
+                base + (u * q[i].x + w * q[i].y + n * off) * scale
+            });
+            let (fast, reference) = quad_both_ways(corners);
+            proptest::prop_assert_eq!(fast, reference);
         }
     }
 }

@@ -6,8 +6,11 @@
 //!     cargo run --release -p cga --example meshes_bench -- RULES.cga LOTSPEC [RUNS]
 //!
 //! LOTSPEC as the `cga` command's `--lot` takes it (e.g.
-//! `grid:5x4:lots/candler_footprint.obj`).
+//! `grid:5x4:lots/candler_footprint.obj`). `DIGEST=1` also prints a digest
+//! of the meshes made (every coordinate's bits, the indices, the leaves'
+//! numbers), to tell that a change to the collection left them the same.
 
+use std::hash::{DefaultHasher, Hash, Hasher};
 use std::time::Instant;
 
 use cga::{Engine, Options, Target};
@@ -71,11 +74,62 @@ fn main() {
         lots.len()
     );
     // DRAWING=1 also times meshes to draw (what the preview collects).
-    if std::env::var_os("DRAWING").is_some() {
+    let drawing = std::env::var_os("DRAWING").is_some();
+    if drawing {
         let (best, median) = time(&|| Target::Drawing([0.0; 3]));
         println!(
             "{} lots, meshes to draw: best {best:.1} ms, median {median:.1} ms",
             lots.len()
         );
     }
+    if std::env::var_os("DIGEST").is_some() {
+        let digest = |target: Target<'static>| {
+            let mut out = Vec::new();
+            rules
+                .generate_lots(&lots, &options, target, |r| out.push(r))
+                .expect("generates");
+            out.sort_by_key(|r| r.index);
+            let mut h = DefaultHasher::new();
+            for r in &out {
+                digest_lot(r, &mut h);
+            }
+            h.finish()
+        };
+        println!("plain meshes digest: {:016x}", digest(Target::Meshes));
+        if drawing {
+            println!(
+                "meshes to draw digest: {:016x}",
+                digest(Target::Drawing([0.0; 3]))
+            );
+        }
+    }
+}
+
+/// Feeds a lot's meshes to `h`: materials, every coordinate's bits,
+/// indices and leaf numbers.
+fn digest_lot(r: &cga::LotResult, h: &mut DefaultHasher) {
+    let bits = |v: &[f64], h: &mut DefaultHasher| v.iter().for_each(|x| x.to_bits().hash(h));
+    for m in &r.model.meshes {
+        m.material.hash(h);
+        m.positions.iter().for_each(|p| bits(p, h));
+        m.normals.iter().for_each(|n| bits(n, h));
+        m.uvs.iter().for_each(|t| bits(t, h));
+        m.indices.hash(h);
+        m.triangle_leaf.hash(h);
+    }
+    for m in &r.drawing.meshes {
+        m.material.hash(h);
+        m.positions
+            .iter()
+            .for_each(|p| p.iter().for_each(|x| x.to_bits().hash(h)));
+        m.uvs
+            .iter()
+            .for_each(|t| t.iter().for_each(|x| x.to_bits().hash(h)));
+        m.vertex_normals().hash(h);
+        m.indices().hash(h);
+        m.triangle_leaf.hash(h);
+    }
+    format!("{:?}", r.model.materials).hash(h);
+    format!("{:?}", r.drawing.materials).hash(h);
+    r.leaves.len().hash(h);
 }

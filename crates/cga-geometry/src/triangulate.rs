@@ -111,20 +111,25 @@ pub fn triangulate_loops_newell(
                 return;
             }
             if let Some(first_diagonal) = quad_diagonal(mesh, positions, outer.start, newell) {
-                let s = outer.start;
-                if first_diagonal {
-                    out.push([s, s + 1, s + 2]);
-                    out.push([s, s + 2, s + 3]);
-                } else {
-                    out.push([s + 1, s + 2, s + 3]);
-                    out.push([s + 1, s + 3, s]);
-                }
+                push_quad(outer.start, first_diagonal, out);
                 return;
             }
         }
     }
     let unit = crate::measure::unit_newell(newell);
     triangulate_loops_with_normal(mesh, positions, loops, unit, out);
+}
+
+/// The two triangles of the quad whose corners start at `s`, cut along
+/// its first diagonal (corners 0–2) or its second (1–3).
+fn push_quad(s: u32, first_diagonal: bool, out: &mut Vec<[u32; 3]>) {
+    if first_diagonal {
+        out.push([s, s + 1, s + 2]);
+        out.push([s, s + 2, s + 3]);
+    } else {
+        out.push([s + 1, s + 2, s + 3]);
+        out.push([s + 1, s + 3, s]);
+    }
 }
 
 /// Whether the quad whose corners start at `s` is cut along its first
@@ -215,13 +220,8 @@ pub fn triangulate_loops_with_normal(
         let area = |a: DVec2, b: DVec2, c: DVec2| (b - a).perp_dot(c - a);
         // Use the diagonal a–c if both halves turn left, else b–d (one of the
         // two diagonals of a simple quad always lies inside it).
-        if area(q[0], q[1], q[2]) > 0.0 && area(q[0], q[2], q[3]) > 0.0 {
-            out.push([s, s + 1, s + 2]);
-            out.push([s, s + 2, s + 3]);
-        } else {
-            out.push([s + 1, s + 2, s + 3]);
-            out.push([s + 1, s + 3, s]);
-        }
+        let first_diagonal = area(q[0], q[1], q[2]) > 0.0 && area(q[0], q[2], q[3]) > 0.0;
+        push_quad(s, first_diagonal, out);
         return;
     }
 

@@ -1024,9 +1024,12 @@ impl<'a> Interp<'a> {
 
     /// [`child`](Interp::child) without counting it.
     fn successor(&mut self, parent: &Shape) -> Box<Shape> {
-        let mut c = Box::new(parent.clone());
+        let rng = parent.child_rng(parent.next_random().to_bits());
+        // Written straight into its box: `Box::new(parent.clone())` made
+        // the clone on the stack and copied its 480 bytes into the box.
+        let mut c = Box::write(Box::new_uninit(), parent.clone());
         c.parent_center = parent.scope.center();
-        c.rng.set(parent.child_rng(parent.next_random().to_bits()));
+        c.rng.set(rng);
         if self.context.is_some() {
             c.ctx = self.context_child(parent.ctx);
         }

@@ -33,11 +33,12 @@
 
 use std::sync::Arc;
 
+use cga_geometry::topology::FxHashMap;
 use cga_geometry::{DVec3, Mesh};
 
 use crate::derive::{Interp, RtError, ShapeState};
 use crate::expr::OpCall;
-use crate::shape::{local_bounds, Shape};
+use crate::shape::{local_bounds, Geometry, Shape};
 
 /// One trim plane, in object coordinates: the geometry with
 /// `normal · (p - point) >= 0` is kept.
@@ -219,6 +220,11 @@ pub fn apply(shape: &mut Shape, bounds: Option<(DVec3, DVec3)>, need: Need, logs
     if need == Need::Emptiness && keeps_a_face(shape, &cutting, tol) {
         return;
     }
+    let remembered = RememberedTrim::of(&shape.geometry, &cutting);
+    if let Some(done) = remembered.as_ref().and_then(RememberedTrim::recall) {
+        shape.geometry = Geometry::new(done);
+        return;
+    }
     // The first cut reads the shape's mesh, each later one the last cut's.
     let source = shape.geometry.local().clone();
     let mut cut: Option<Mesh> = None;
@@ -235,7 +241,88 @@ pub fn apply(shape: &mut Shape, bounds: Option<(DVec3, DVec3)>, need: Need, logs
         ));
     }
     if let Some(mesh) = cut {
-        shape.set_local_mesh(mesh);
+        let done = Arc::new(mesh);
+        if let Some(r) = remembered {
+            r.remember(done.clone());
+        }
+        shape.geometry = Geometry::new(done);
+    }
+}
+
+/// A trim of shared geometry (an inserted asset, placed by a map not yet
+/// applied) by given planes, remembered per thread with its result: the
+/// same asset is trimmed by the same scope-local planes again and again
+/// (a ledge at every floor's corner of every building; Candler: 1,380
+/// trims of 529 kinds on 20 buildings, each a cut of some 84,000
+/// instructions). The result is a function of the mesh's contents, the map
+/// and the planes, so a trim recalled is the trim made, bit for bit. The
+/// mesh is named by its address and held by the entry, so that the address
+/// names no other mesh while the entry lives; meshes of one shape alone
+/// (held once) are not remembered, since nothing else can ask for them.
+struct RememberedTrim {
+    source: Arc<Mesh>,
+    key: TrimKey,
+}
+
+#[derive(PartialEq, Eq, Hash)]
+struct TrimKey {
+    mesh: usize,
+    to_scope: Option<[u64; 12]>,
+    planes: Box<[[u64; 4]]>,
+}
+
+/// Trims a thread remembers at most: the table is emptied when full, so
+/// memory stays bounded on cities of many assets.
+const TRIMS_REMEMBERED: usize = 1 << 10;
+
+/// Per trim: the mesh trimmed (held so that its address stays its own)
+/// and the result.
+type Trims = FxHashMap<TrimKey, (Arc<Mesh>, Arc<Mesh>)>;
+
+thread_local! {
+    static TRIMS: std::cell::RefCell<Trims> = std::cell::RefCell::new(Trims::default());
+}
+
+impl RememberedTrim {
+    /// The trim of `geometry` by `cutting` (scope-local planes), if its
+    /// mesh is shared.
+    fn of(geometry: &Geometry, cutting: &[(DVec3, f64)]) -> Option<RememberedTrim> {
+        let (mesh, to_scope) = geometry.raw();
+        if Arc::strong_count(mesh) < 2 {
+            return None;
+        }
+        let planes = cutting
+            .iter()
+            .map(|(n, offset)| [n.x, n.y, n.z, *offset].map(f64::to_bits))
+            .collect();
+        Some(RememberedTrim {
+            source: mesh.clone(),
+            key: TrimKey {
+                mesh: Arc::as_ptr(mesh) as usize,
+                to_scope: to_scope.map(|t| t.to_cols_array().map(f64::to_bits)),
+                planes,
+            },
+        })
+    }
+
+    /// The result of the same trim made before on this thread.
+    fn recall(&self) -> Option<Arc<Mesh>> {
+        TRIMS
+            .try_with(|t| t.borrow().get(&self.key).map(|(_, done)| done.clone()))
+            .ok()
+            .flatten()
+    }
+
+    /// Remembers `done` as the result of this trim.
+    fn remember(self, done: Arc<Mesh>) {
+        // Fails only while the thread shuts down: then nothing is kept.
+        let _ = TRIMS.try_with(|t| {
+            let mut t = t.borrow_mut();
+            if t.len() >= TRIMS_REMEMBERED {
+                t.clear();
+            }
+            t.insert(self.key, (self.source, done));
+        });
     }
 }
 
@@ -412,6 +499,62 @@ mod tests {
     fn coplanar_neighbours_give_the_perpendicular_plane() {
         let p = bisecting_plane(DVec3::ZERO, DVec3::Y, -DVec3::X, DVec3::X).unwrap();
         assert!((p.normal + DVec3::X).length() < 1e-12);
+    }
+
+    /// A shape holding `mesh` (a unit cube) scaled by `scale`, in a scope
+    /// of size 2 at the origin, with one vertical trim plane through
+    /// (1, 0, 0) that cuts it diagonally.
+    fn trimmed_shape(mesh: Arc<Mesh>, scale: f64) -> Shape {
+        let mut s = crate::lot::initial_shape(&crate::lot::rect(4.0, 3.0), 0, 0);
+        s.scope.frame = crate::shape::Frame {
+            origin: DVec3::ZERO,
+            axes: cga_geometry::DMat3::IDENTITY,
+        };
+        s.scope.size = DVec3::splat(2.0);
+        let mut g = Geometry::new(mesh);
+        g.transform(cga_geometry::DAffine3::from_scale(DVec3::splat(scale)));
+        s.geometry = g;
+        let plane = bisecting_plane(DVec3::X, DVec3::new(1.0, 1.0, 0.0), -DVec3::X, -DVec3::Z);
+        s.trim.planes = Some(Arc::from([plane.unwrap()]));
+        s
+    }
+
+    #[test]
+    fn a_trim_of_shared_geometry_is_recalled_as_made() {
+        let asset = Arc::new(cga_geometry::primitive::cube(DVec3::ONE));
+        // Trimmed as an insert trims: the map not yet applied, the box known.
+        let trimmed = |mesh: &Arc<Mesh>, scale: f64| {
+            let mut s = trimmed_shape(mesh.clone(), scale);
+            let bounds = Some((DVec3::ZERO, DVec3::splat(scale)));
+            apply(&mut s, bounds, Need::Geometry, &mut []);
+            s.geometry.raw().0.clone()
+        };
+        let first = trimmed(&asset, 2.0);
+        // The plane keeps z >= x - 1: the prism over the triangle (1, 0),
+        // (2, 0), (2, 1) of the xz-plane goes, and the cut stays open. Left:
+        // 3.5 m² of the bottom and of the top, half of the faces x = 2 and
+        // z = 0, the faces x = 0 and z = 2 whole.
+        let area = cga_geometry::measure::mesh_area(&first);
+        assert!((area - 19.0).abs() < 1e-9, "{area}");
+        // The same asset, map and planes again: the trim made, not a new cut.
+        let second = trimmed(&asset, 2.0);
+        assert!(Arc::ptr_eq(&first, &second));
+        // What a cut of a mesh of its own (never remembered) gives, bit for
+        // bit.
+        let own = trimmed(&Arc::new((*asset).clone()), 2.0);
+        assert!(!Arc::ptr_eq(&own, &first));
+        let bits = |m: &Mesh| -> Vec<u64> {
+            m.positions
+                .iter()
+                .flat_map(|p| p.to_array().map(f64::to_bits))
+                .collect()
+        };
+        assert_eq!(bits(&own), bits(&first));
+        assert_eq!(*own, *first);
+        // Another map is another trim.
+        let other = trimmed(&asset, 1.5);
+        assert!(!Arc::ptr_eq(&other, &first));
+        assert_ne!(bits(&other), bits(&first));
     }
 
     #[test]

@@ -779,3 +779,64 @@ fn replayed_cuts_equal_cutting_anew() {
     let _ = split_along_axis(&big, 1, &[1.0]);
     assert_eq!(replays(), before);
 }
+
+/// Cuts come back after many others (a city's tiles are cut in a few
+/// hundred kinds, each again and again but not in a row): up to
+/// `replay::ENTRIES` kinds are all replayed, and the memory the entries
+/// hold stays within `replay::BUDGET_BYTES` however large they are.
+#[test]
+fn replays_reach_back_many_kinds_within_a_budget() {
+    let replays = || replay::REPLAYED.with(|r| r.get());
+    let size = || SCRATCH.with(|c| c.borrow().replays.size());
+    forget_replays();
+    // 600 tiles of different widths, each cut at the same place.
+    let tile =
+        |w: f64| Mesh::polygon(&[v(0., 0., 0.), v(w, 0., 0.), v(w, 3.5, 0.), v(0., 3.5, 0.)]);
+    let widths: Vec<f64> = (0..600).map(|i| 2.0 + i as f64 / 64.0).collect();
+    let cut_all = || {
+        for &w in &widths {
+            assert_eq!(split_along_axis(&tile(w), 0, &[1.0]).len(), 2);
+        }
+    };
+    cut_all();
+    assert_eq!(size().0, 600);
+    let before = replays();
+    cut_all();
+    assert_eq!(replays(), before + 600);
+    // Beyond the number of entries, the oldest are forgotten.
+    for i in 0..replay::ENTRIES {
+        let _ = split_along_axis(&tile(20.0 + i as f64 / 64.0), 0, &[1.0]);
+    }
+    assert_eq!(size().0, replay::ENTRIES);
+    let before = replays();
+    let _ = split_along_axis(&tile(widths[0]), 0, &[1.0]);
+    assert_eq!(replays(), before);
+    // The bytes held, not only the count, bound the entries: with a budget
+    // of 64 KiB, 30-gons cut by 31 planes into 32 parts (a few KiB each)
+    // are kept a few at a time, and the newest is still replayed.
+    SCRATCH.with(|c| c.borrow_mut().replays = replay::Replays::with_budget(64 << 10));
+    let gon = |r: f64| {
+        let pts: Vec<DVec3> = (0..30)
+            .map(|i| {
+                let a = i as f64 * std::f64::consts::TAU / 30.0;
+                v(r * a.cos(), r * a.sin(), 0.0)
+            })
+            .collect();
+        Mesh::polygon(&pts)
+    };
+    let planes: Vec<f64> = (0..31).map(|i| -0.9 + i as f64 * 0.06).collect();
+    for k in 0..100 {
+        let parts = split_along_axis(&gon(1.0 + k as f64 / 1024.0), 0, &planes);
+        assert_eq!(parts.len(), 32);
+        let (entries, bytes) = size();
+        assert!(bytes <= 64 << 10, "{bytes}");
+        assert!((1..100).contains(&entries), "{entries}");
+    }
+    let (entries, bytes) = size();
+    assert!(entries >= 4 && bytes > 32 << 10, "{entries} {bytes}");
+    let before = replays();
+    let _ = split_along_axis(&gon(1.0 + 99.0 / 1024.0), 0, &planes);
+    assert_eq!(replays(), before + 1);
+    forget_replays();
+    assert_eq!(size(), (0, 0));
+}

@@ -27,6 +27,7 @@ use glam::{DVec2, DVec3};
 
 use crate::measure::face_normal;
 use crate::mesh::{Face, Loop, Mesh};
+use crate::remembered::{mesh_bits_len, push_mesh_bits, Key, Remembered};
 use crate::topology::{mesh_tolerance, weld_points};
 
 /// How faces are moved (CGA's `extrusionType`).
@@ -77,8 +78,145 @@ pub fn extrude(mesh: &Mesh, how: Extrusion, distance: f64) -> Mesh {
 }
 
 /// [`extrude`], also returning the role of every face of the result.
+///
+/// A small mesh's extrusion is remembered per thread and replayed for the
+/// next mesh with the same geometry, extrusion and distance (see
+/// [`ExtrusionPlan`]): a facade's window frames and sills are extruded
+/// alike, thousands of times (Candler: 16,400 extrusions of 241 kinds on
+/// 20 buildings, 4,241 when their texture coordinates count).
 pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, Vec<ExtrudeRole>) {
     let distance = if distance.is_finite() { distance } else { 0.0 };
+    let key = replay_key(mesh, how, distance);
+    if let Some(key) = &key {
+        let replayed = EXTRUSIONS
+            .try_with(|e| e.borrow().get(key).map(|plan| plan.replay(mesh)))
+            .ok()
+            .flatten();
+        if let Some(done) = replayed {
+            return done;
+        }
+    }
+    let (out, roles, sources) = extrude_anew(mesh, how, distance);
+    if let Some(key) = key {
+        let plan = ExtrusionPlan {
+            positions: out.positions.clone(),
+            corners: out.corners.clone(),
+            loops: out.loops.clone(),
+            faces: out.faces.clone(),
+            roles: roles.clone(),
+            sources,
+        };
+        let bytes = plan.bytes();
+        // Fails only while the thread shuts down: then nothing is kept.
+        let _ = EXTRUSIONS.try_with(|e| e.borrow_mut().insert(key, plan, bytes));
+    }
+    (out, roles)
+}
+
+/// Inputs up to this many corners are remembered for replay.
+const REPLAY_MAX_CORNERS: usize = 64;
+
+/// Extrusions remembered per thread at most, and the bytes they hold.
+const REPLAY_ENTRIES: usize = 1024;
+const REPLAY_BUDGET_BYTES: usize = 4 << 20;
+
+thread_local! {
+    static EXTRUSIONS: std::cell::RefCell<Remembered<ExtrusionPlan>> =
+        std::cell::RefCell::new(Remembered::new(REPLAY_ENTRIES, REPLAY_BUDGET_BYTES));
+}
+
+/// What an extrusion made of a mesh's geometry: everything but the
+/// texture coordinates, and the source corner of each corner, whose
+/// coordinates it copies. The geometry, the face roles and the sources
+/// depend only on the mesh's positions, corners, loops, faces, the kind
+/// of extrusion and the distance (every bit of them), so a replay gives
+/// what extruding anew gives. Meshes with normals (read for edge and
+/// vertex shapes) or edge and vertex tags (carried by rules of their own)
+/// are not remembered.
+struct ExtrusionPlan {
+    positions: Vec<DVec3>,
+    corners: Vec<u32>,
+    loops: Vec<Loop>,
+    faces: Vec<Face>,
+    roles: Vec<ExtrudeRole>,
+    sources: Vec<u32>,
+}
+
+impl ExtrusionPlan {
+    /// The extrusion of `mesh` (whose key is the plan's).
+    fn replay(&self, mesh: &Mesh) -> (Mesh, Vec<ExtrudeRole>) {
+        let mut out = Mesh::new();
+        out.share_slots(mesh);
+        out.positions = self.positions.clone();
+        out.corners = self.corners.clone();
+        out.loops = self.loops.clone();
+        out.faces = self.faces.clone();
+        for (set, uvs) in mesh.uvs.iter().enumerate() {
+            if let Some(uvs) = uvs {
+                out.uvs[set] = Some(
+                    self.sources
+                        .iter()
+                        .map(|&c| uvs.get(c as usize).copied().unwrap_or(DVec2::ZERO))
+                        .collect(),
+                );
+            }
+        }
+        #[cfg(test)]
+        REPLAYED.with(|r| r.set(r.get() + 1));
+        (out, self.roles.clone())
+    }
+
+    /// Bytes the plan holds (what the budget counts).
+    fn bytes(&self) -> usize {
+        use std::mem::size_of;
+        self.positions.len() * size_of::<DVec3>()
+            + (self.corners.len() + self.sources.len()) * size_of::<u32>()
+            + self.loops.len() * size_of::<Loop>()
+            + self.faces.len() * size_of::<Face>()
+            + self.roles.len() * size_of::<ExtrudeRole>()
+    }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Extrusions replayed on this thread, for tests.
+    static REPLAYED: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
+/// Forgets this thread's remembered extrusions (for tests that compare a
+/// replay with extruding anew).
+#[cfg(test)]
+fn forget_extrusions() {
+    EXTRUSIONS.with(|e| *e.borrow_mut() = Remembered::new(REPLAY_ENTRIES, REPLAY_BUDGET_BYTES));
+}
+
+/// The key of extruding `mesh` by `distance` as `how` says, if it is
+/// remembered (see [`ExtrusionPlan`]).
+fn replay_key(mesh: &Mesh, how: Extrusion, distance: f64) -> Option<Key> {
+    if mesh.corners.len() > REPLAY_MAX_CORNERS
+        || mesh.normals.is_some()
+        || mesh.edge_tags.is_some()
+        || mesh.vertex_tags.is_some()
+    {
+        return None;
+    }
+    let (kind, dir) = match how {
+        Extrusion::FaceNormal => (0, DVec3::ZERO),
+        Extrusion::Direction(d) => (1, d),
+        Extrusion::DirectionFlatTop(d) => (2, d),
+        Extrusion::VertexNormal => (3, DVec3::ZERO),
+    };
+    let mut data = Vec::with_capacity(5 + mesh_bits_len(mesh));
+    data.push(kind);
+    data.extend(dir.to_array().map(f64::to_bits));
+    data.push(distance.to_bits());
+    push_mesh_bits(&mut data, mesh);
+    Some(Key::new(data))
+}
+
+/// [`extrude_with_roles`] worked out, also giving the source corner of
+/// every corner of the result.
+fn extrude_anew(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, Vec<ExtrudeRole>, Vec<u32>) {
     let tol = mesh_tolerance(mesh);
     let weld = weld_points(&mesh.positions, tol);
     let vid = |corner: usize| weld.id[mesh.corners[corner] as usize];
@@ -256,6 +394,7 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
         uv_out[k].reserve(6 * corners);
     }
     let mut roles = Vec::with_capacity(2 * mesh.faces.len() + corners);
+    let mut sources: Vec<u32> = Vec::with_capacity(6 * corners);
     // One side's loop of (position, source corner), refilled per side.
     let mut side: [Vec<(u32, u32)>; 1] = [Vec::with_capacity(4)];
     let mut emit =
@@ -281,6 +420,7 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
                 }
                 for &(p, src) in l {
                     out.corners.push(p);
+                    sources.push(src);
                     for &k in &has_uv {
                         let uv = mesh.uvs[k].as_ref().and_then(|u| u.get(src as usize));
                         uv_out[k].push(uv.copied().unwrap_or(DVec2::ZERO));
@@ -404,7 +544,7 @@ pub fn extrude_with_roles(mesh: &Mesh, how: Extrusion, distance: f64) -> (Mesh, 
     }
     // Drop welded positions no face uses (duplicates folded by welding).
     compact_positions(&mut out);
-    (out, roles)
+    (out, roles, sources)
 }
 
 /// The normal stored on an edge or vertex shape's corners (their average),
@@ -690,5 +830,72 @@ mod tests {
         assert_eq!(face_area(&q, 0), 6.0);
         assert_eq!(q.positions[3], v(3., 0., 2.));
         assert_eq!(q.loop_indices(q.outer_loop(0)), &[0, 1, 3, 2]);
+    }
+
+    /// A replayed extrusion is the extrusion made anew, with the new
+    /// mesh's texture coordinates: for every kind of extrusion, a quad and
+    /// a face with a hole, up and down; meshes with edge tags are not
+    /// remembered.
+    #[test]
+    fn replayed_extrusions_equal_extruding_anew() {
+        let replays = || REPLAYED.with(|r| r.get());
+        let mut holed = Mesh::new();
+        holed.positions.extend([
+            v(0., 0., 0.),
+            v(4., 0., 0.),
+            v(4., 0., -4.),
+            v(0., 0., -4.),
+            v(1., 0., -1.),
+            v(1., 0., -3.),
+            v(3., 0., -3.),
+            v(3., 0., -1.),
+        ]);
+        holed.add_face(&[&[0, 1, 2, 3], &[4, 5, 6, 7]], 0);
+        let textured = |m: &Mesh, k: f64| {
+            let mut m = m.clone();
+            let n = m.corners.len();
+            m.uvs[0] = Some((0..n).map(|i| DVec2::new(k + i as f64, 0.5 * k)).collect());
+            m.uvs[3] = Some((0..n).map(|i| DVec2::new(-k, i as f64 * k)).collect());
+            m
+        };
+        let hows = [
+            Extrusion::FaceNormal,
+            Extrusion::Direction(DVec3::new(0.0, 1.0, 0.25)),
+            Extrusion::DirectionFlatTop(DVec3::Y),
+            Extrusion::VertexNormal,
+        ];
+        for base in [rect(3.0, 2.0), holed] {
+            for how in hows {
+                for d in [2.5, -1.25] {
+                    forget_extrusions();
+                    let first = extrude_with_roles(&textured(&base, 0.25), how, d);
+                    let before = replays();
+                    let replayed = extrude_with_roles(&textured(&base, 0.75), how, d);
+                    assert_eq!(replays(), before + 1, "{how:?} {d}");
+                    forget_extrusions();
+                    let anew = extrude_with_roles(&textured(&base, 0.75), how, d);
+                    assert_eq!(replayed, anew, "{how:?} {d}");
+                    assert_ne!(first.0.uvs[0], replayed.0.uvs[0]);
+                    assert_eq!(first.0.positions, replayed.0.positions);
+                    assert!(replayed.0.uvs[3].is_some() && replayed.0.uvs[1].is_none());
+                }
+            }
+        }
+        // Another distance is another extrusion.
+        forget_extrusions();
+        let a = extrude(&rect(3.0, 2.0), Extrusion::FaceNormal, 2.0);
+        let before = replays();
+        let b = extrude(&rect(3.0, 2.0), Extrusion::FaceNormal, 2.5);
+        assert_eq!(replays(), before);
+        assert_ne!(a.positions, b.positions);
+        // Edge tags are carried by rules of their own: not remembered.
+        let mut tagged = rect(3.0, 2.0);
+        let t = tagged.intern_tags(crate::tags::TagSet::from_names(["edge.a"]));
+        tagged.edge_tags = Some(vec![t, 0, 0, 0]);
+        let before = replays();
+        let x = extrude(&tagged, Extrusion::FaceNormal, 2.0);
+        let y = extrude(&tagged, Extrusion::FaceNormal, 2.0);
+        assert_eq!(replays(), before);
+        assert_eq!(x, y);
     }
 }

@@ -53,6 +53,7 @@ pub mod occlusion;
 pub mod perimeter;
 pub mod primitive;
 pub mod recompose;
+pub(crate) mod remembered;
 pub mod roof;
 pub mod roof_edges;
 pub mod setback;

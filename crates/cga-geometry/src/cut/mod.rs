@@ -168,7 +168,7 @@ fn cut_with(mesh: &Mesh, normal: DVec3, offsets: &[f64], only_part: Option<usize
     let run = |bufs: &mut Bufs| {
         // All parts of a small mesh: replayed if cut before (see `replay`).
         let key = match only_part {
-            None => replay::Key::of(mesh, normal, offsets),
+            None => replay::key_of(mesh, normal, offsets),
             Some(_) => None,
         };
         if let Some(out) = key.as_ref().and_then(|k| bufs.replays.replay(k, mesh)) {

@@ -12,6 +12,7 @@
 //! | [`cleanup`] | `cleanupGeometry`, `reduceGeometry`, `rectify` |
 //! | [`convexify`] | `convexify` |
 //! | [`cut`] | plane cuts with caps: `split`, trim planes |
+//! | `remembered` | results of cuts and extrusions remembered per thread for replay |
 //! | [`boolean`] | `union`, `subtract`, `intersect` (BSP CSG; 2D overlay for planar operands) |
 //! | [`area_split`] | the area left of a moving plane and its inverse: `splitArea` |
 //! | [`extrude`] | `extrude` |

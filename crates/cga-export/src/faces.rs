@@ -63,6 +63,25 @@ pub(crate) fn face_normals(
     (rel, (len > 0.0 && len.is_finite()).then(|| abs / len))
 }
 
+/// [`face_normals`]'s unit normal of a face whose outer loop `outer` has
+/// four corners (most faces of a model), the same bits: its loop unrolled.
+pub(crate) fn quad_normal(mesh: &Mesh, positions: &[DVec3], outer: Loop) -> Option<DVec3> {
+    let s = outer.start as usize;
+    let p: [DVec3; 4] = std::array::from_fn(|k| positions[mesh.corners[s + k] as usize]);
+    let mut abs = DVec3::ZERO;
+    let mut prev = p[3];
+    for p in p {
+        abs += DVec3::new(
+            (prev.y - p.y) * (prev.z + p.z),
+            (prev.z - p.z) * (prev.x + p.x),
+            (prev.x - p.x) * (prev.y + p.y),
+        );
+        prev = p;
+    }
+    let len = abs.length();
+    (len > 0.0 && len.is_finite()).then(|| abs / len)
+}
+
 /// Whether every position, UV (set 0) and normal of the face is finite;
 /// NaN or infinite values would make the written file invalid.
 pub(crate) fn face_is_finite(
@@ -161,6 +180,14 @@ mod tests {
                 normal.map(|n| n.to_array().map(f64::to_bits)),
                 want.map(|n| n.to_array().map(f64::to_bits))
             );
+            let outer = m.outer_loop(f);
+            if outer.len == 4 {
+                let quad = quad_normal(&m, &m.positions, outer);
+                assert_eq!(
+                    quad.map(|n| n.to_array().map(f64::to_bits)),
+                    want.map(|n| n.to_array().map(f64::to_bits))
+                );
+            }
             assert_eq!(normal.is_some(), f < 3, "face {f}");
         }
     }

@@ -3,10 +3,10 @@
 //! writing, and map material slots to output materials.
 
 use cga_geometry::mesh::SharedVec;
-use cga_geometry::triangulate::triangulate_loops_newell;
+use cga_geometry::triangulate::{triangulate_finite_quad, triangulate_loops_newell};
 use cga_geometry::{DAffine3, DVec3, Material, Mesh};
 
-use crate::faces::{face_is_finite, face_normals};
+use crate::faces::{face_is_finite, face_normals, quad_normal};
 use crate::hash::FastMap;
 use crate::{ExportError, FaceData};
 
@@ -105,8 +105,22 @@ fn each_face(
             continue;
         }
         triangles.clear();
-        let (newell, normal) = face_normals(mesh, positions, loops[0]);
-        triangulate_loops_newell(mesh, positions, loops, newell, triangles);
+        // Quads (most faces) take their own path: the same triangles and
+        // normal with less work (the face is finite here).
+        let normal = match loops {
+            [outer] if outer.len == 4 => {
+                triangulate_finite_quad(mesh, positions, *outer, triangles);
+                if triangles.is_empty() {
+                    continue;
+                }
+                quad_normal(mesh, positions, *outer)
+            }
+            _ => {
+                let (newell, normal) = face_normals(mesh, positions, loops[0]);
+                triangulate_loops_newell(mesh, positions, loops, newell, triangles);
+                normal
+            }
+        };
         if triangles.is_empty() {
             continue;
         }

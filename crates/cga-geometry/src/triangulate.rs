@@ -122,14 +122,67 @@ pub fn triangulate_loops_newell(
 
 /// The two triangles of the quad whose corners start at `s`, cut along
 /// its first diagonal (corners 0–2) or its second (1–3).
+#[inline]
 fn push_quad(s: u32, first_diagonal: bool, out: &mut Vec<[u32; 3]>) {
-    if first_diagonal {
-        out.push([s, s + 1, s + 2]);
-        out.push([s, s + 2, s + 3]);
+    // One check of the room for both.
+    out.extend_from_slice(&if first_diagonal {
+        [[s, s + 1, s + 2], [s, s + 2, s + 3]]
     } else {
-        out.push([s + 1, s + 2, s + 3]);
-        out.push([s + 1, s + 3, s]);
+        [[s + 1, s + 2, s + 3], [s + 1, s + 3, s]]
+    });
+}
+
+/// [`triangulate_loops_newell`] for a face of the one loop `outer` of four
+/// corners whose positions are finite (the writers leave faces with other
+/// values out before they triangulate), without its Newell vector: the
+/// same triangles, with the edges' cross products computed once for both
+/// the Newell vector and the diagonal's test.
+///
+/// For finite corners, `measure::newell` of the loop is
+/// `(0 + r1 × r2) + r2 × r3` for the edges `r` from corner 0: its first two
+/// terms are cross products with `p0 - p0`, zeros of either sign, which
+/// added to +0 leave +0. Finite corners also let the largest magnitudes be
+/// taken without `f64::max`'s care for NaN (Newell vectors of corners that
+/// are finite but whose edges overflow are not finite, and give no
+/// triangles both ways).
+pub fn triangulate_finite_quad(
+    mesh: &Mesh,
+    positions: &[DVec3],
+    outer: Loop,
+    out: &mut Vec<[u32; 3]>,
+) {
+    let s = outer.start as usize;
+    let p = |k: usize| positions[mesh.corners[s + k] as usize];
+    let (p0, p1, p2, p3) = (p(0), p(1), p(2), p(3));
+    let (r1, r2, r3) = (p1 - p0, p2 - p0, p3 - p0);
+    let (c1, c2) = (r1.cross(r2), r2.cross(r3));
+    let n = (DVec3::ZERO + c1) + c2;
+    let d = n.length_squared();
+    if !(d > 0.0 && d.is_finite()) {
+        return;
     }
+    let l = largest_magnitude(&[r1, r2, r3]);
+    let big = largest_magnitude(&[p0, p1, p2, p3]);
+    let a = largest_magnitude(&[n]);
+    match diagonal_by_sign(c1.dot(n), c2.dot(n), l, big, a) {
+        Some(first) => push_quad(outer.start, first, out),
+        None => {
+            let unit = crate::measure::unit_newell(n);
+            triangulate_loops_with_normal(mesh, positions, &[outer], unit, out);
+        }
+    }
+}
+
+/// The largest magnitude of the coordinates of `vs`, none of them NaN:
+/// comparisons instead of `f64::max`, which is several instructions for
+/// its care for NaN, and gives the same number for numbers.
+#[inline(always)]
+fn largest_magnitude(vs: &[DVec3]) -> f64 {
+    let max = |a: f64, b: f64| if a > b { a } else { b };
+    vs.iter().fold(0.0, |m, v| {
+        let v = v.abs();
+        max(max(max(m, v.x), v.y), v.z)
+    })
 }
 
 /// Whether the quad whose corners start at `s` is cut along its first
@@ -165,10 +218,19 @@ fn quad_diagonal(mesh: &Mesh, positions: &[DVec3], s: u32, n: DVec3) -> Option<b
         .max(p2.abs())
         .max(p3.abs())
         .max_element();
+    diagonal_by_sign(a1, a2, l, big, n.abs().max_element())
+}
+
+/// The diagonal a quad is cut along, from the two areas `a1` and `a2`
+/// measured against its Newell vector (see [`quad_diagonal`]), when their
+/// signs are certain: `l` is the largest magnitude of the edges' and `big`
+/// of the corners' coordinates, `n` of the Newell vector's.
+#[inline(always)]
+fn diagonal_by_sign(a1: f64, a2: f64, l: f64, big: f64, n: f64) -> Option<bool> {
     // The least normal number as a floor: products that underflow lose
     // their relative precision (a quad 10⁻⁸⁰ m across), the projection's
     // do not.
-    let t = 1e-12 * (l * (big + l) * n.abs().max_element() + l * l * l * l) + f64::MIN_POSITIVE;
+    let t = 1e-12 * (l * (big + l) * n + l * l * l * l) + f64::MIN_POSITIVE;
     // Comparisons with NaN or infinite bounds are false: undecided.
     if a1 > t && a2 > t {
         Some(true)
@@ -437,6 +499,11 @@ mod tests {
         triangulate_loops_newell(&m, &m.positions, m.face_loops(0), n, &mut fast);
         let unit = crate::measure::unit_newell(n);
         triangulate_loops_with_normal(&m, &m.positions, m.face_loops(0), unit, &mut reference);
+        // The writers' path for finite quads gives the Newell path's
+        // triangles (and so the projection's).
+        let mut writers = Vec::new();
+        triangulate_finite_quad(&m, &m.positions, m.loops[0], &mut writers);
+        assert_eq!(writers, fast, "{corners:?}");
         (fast, reference)
     }
 

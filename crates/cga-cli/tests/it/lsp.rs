@@ -12,7 +12,7 @@ use std::time::Duration;
 
 use serde_json::{json, Value};
 
-use crate::common::{cga, temp_dir};
+use crate::common::{cga, temp_dir, TempDir};
 
 struct Client {
     child: Child,
@@ -183,7 +183,7 @@ Roof --> set(height, twice(3)) roofHip(30) Roof.
 ";
 
 /// A CityEngine workspace: projects `Lib` and `Main` side by side.
-fn workspace() -> (PathBuf, PathBuf, PathBuf) {
+fn workspace() -> (TempDir, PathBuf, PathBuf) {
     let root = temp_dir("lsp");
     let lib = root.join("Lib/rules");
     let main = root.join("Main/rules");
@@ -194,7 +194,8 @@ fn workspace() -> (PathBuf, PathBuf, PathBuf) {
     std::fs::write(root.join("Main/assets/notes.txt"), "").unwrap();
     std::fs::write(lib.join("facade.cga"), FACADE).unwrap();
     std::fs::write(main.join("main.cga"), MAIN).unwrap();
-    (root.clone(), main.join("main.cga"), lib.join("facade.cga"))
+    let (main, lib) = (main.join("main.cga"), lib.join("facade.cga"));
+    (root, main, lib)
 }
 
 #[test]

@@ -3,7 +3,7 @@
 //! Khronos validator accepts, built-in textures, the uv split.
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use crate::common::*;
 
@@ -35,7 +35,7 @@ fn assert_valid_gltf(file: &Path) {
 
 /// A project folder with a wall texture, `assets/facade/bricks.png` (the
 /// pixels of the built-in test pattern, as an ordinary file).
-fn project(name: &str) -> PathBuf {
+fn project(name: &str) -> TempDir {
     let dir = temp_dir(name);
     std::fs::create_dir_all(dir.join("assets/facade")).unwrap();
     std::fs::create_dir_all(dir.join("rules")).unwrap();

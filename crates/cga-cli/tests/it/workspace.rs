@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use crate::common::*;
 
 /// A library project in its own workspace, and a rule file elsewhere that
-/// imports from it and inserts its asset.
-fn setup(name: &str) -> (PathBuf, PathBuf) {
+/// imports from it and inserts its asset (in the second directory).
+fn setup(name: &str) -> (TempDir, TempDir, PathBuf) {
     let ws = temp_dir(&format!("{name}-ws"));
     let lib = ws.join("Lib");
     std::fs::create_dir_all(lib.join("rules")).unwrap();
@@ -30,12 +30,12 @@ f 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 4 8 5 1\n",
         "main.cga",
         "import lib : \"/Lib/rules/lib.cga\"\nLot --> lib.Post\n",
     );
-    (ws, rules)
+    (ws, work, rules)
 }
 
 #[test]
 fn workspace_option_and_environment_find_other_projects() {
-    let (ws, rules) = setup("option");
+    let (ws, _work, rules) = setup("option");
     let rules_s = rules.to_str().unwrap();
     let ws_s = ws.to_str().unwrap();
 

@@ -114,7 +114,10 @@ pub fn gen_with(src: &str, opts: &Opts) -> Gen {
     let dir = scratch_dir();
     let path = dir.join("rules.cga");
     std::fs::write(&path, src).unwrap();
-    gen_file(&path, opts)
+    let generated = gen_file(&path, opts);
+    // Kept only when the test fails (above) for a look at its files.
+    let _ = std::fs::remove_dir_all(&dir);
+    generated
 }
 
 /// Loads and derives a rule file; a rule file that does not load fails the test.
@@ -129,7 +132,9 @@ pub fn gen_seeds(src: &str, opts: &Opts, seeds: &[u64]) -> Vec<Gen> {
     let dir = scratch_dir();
     let path = dir.join("rules.cga");
     std::fs::write(&path, src).unwrap();
-    gen_file_seeds(&path, opts, seeds)
+    let generated = gen_file_seeds(&path, opts, seeds);
+    let _ = std::fs::remove_dir_all(&dir);
+    generated
 }
 
 #[track_caller]

@@ -48,11 +48,7 @@ pub(crate) fn face_normals(
     for &i in idx {
         let p = positions[i as usize];
         rel += (prev - o).cross(p - o);
-        abs += DVec3::new(
-            (prev.y - p.y) * (prev.z + p.z),
-            (prev.z - p.z) * (prev.x + p.x),
-            (prev.x - p.x) * (prev.y + p.y),
-        );
+        abs += newell_term(prev, p);
         prev = p;
     }
     if idx.len() < 3 {
@@ -63,6 +59,17 @@ pub(crate) fn face_normals(
     (rel, (len > 0.0 && len.is_finite()).then(|| abs / len))
 }
 
+/// The term of the edge from `prev` to `p` in a loop's Newell vector
+/// (absolute coordinates), as [`face_normals`] and [`quad_normal`] sum it.
+#[inline(always)]
+fn newell_term(prev: DVec3, p: DVec3) -> DVec3 {
+    DVec3::new(
+        (prev.y - p.y) * (prev.z + p.z),
+        (prev.z - p.z) * (prev.x + p.x),
+        (prev.x - p.x) * (prev.y + p.y),
+    )
+}
+
 /// [`face_normals`]'s unit normal of a face whose outer loop `outer` has
 /// four corners (most faces of a model), the same bits: its loop unrolled.
 pub(crate) fn quad_normal(mesh: &Mesh, positions: &[DVec3], outer: Loop) -> Option<DVec3> {
@@ -71,11 +78,7 @@ pub(crate) fn quad_normal(mesh: &Mesh, positions: &[DVec3], outer: Loop) -> Opti
     let mut abs = DVec3::ZERO;
     let mut prev = p[3];
     for p in p {
-        abs += DVec3::new(
-            (prev.y - p.y) * (prev.z + p.z),
-            (prev.z - p.z) * (prev.x + p.x),
-            (prev.x - p.x) * (prev.y + p.y),
-        );
+        abs += newell_term(prev, p);
         prev = p;
     }
     let len = abs.length();

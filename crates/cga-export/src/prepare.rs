@@ -118,12 +118,12 @@ fn each_face(
             _ => {
                 let (newell, normal) = face_normals(mesh, positions, loops[0]);
                 triangulate_loops_newell(mesh, positions, loops, newell, triangles);
+                if triangles.is_empty() {
+                    continue;
+                }
                 normal
             }
         };
-        if triangles.is_empty() {
-            continue;
-        }
         // No normal means zero area: nothing to see, and no valid normal
         // to write.
         let Some(normal) = normal.or_else(|| triangles_normal(mesh, positions, triangles)) else {

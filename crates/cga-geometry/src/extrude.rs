@@ -715,10 +715,11 @@ mod tests {
         assert!((volume(&m) - 2000.0).abs() < 1e-9);
     }
 
-    #[test]
-    fn holes_give_inner_sides() {
-        let mut lot = Mesh::new();
-        lot.positions.extend([
+    /// A 4 m square face with a 2 m square hole in its middle, on the
+    /// ground.
+    fn square_with_hole() -> Mesh {
+        let mut m = Mesh::new();
+        m.positions.extend([
             v(0., 0., 0.),
             v(4., 0., 0.),
             v(4., 0., -4.),
@@ -728,7 +729,13 @@ mod tests {
             v(3., 0., -3.),
             v(3., 0., -1.),
         ]);
-        lot.add_face(&[&[0, 1, 2, 3], &[4, 5, 6, 7]], 0);
+        m.add_face(&[&[0, 1, 2, 3], &[4, 5, 6, 7]], 0);
+        m
+    }
+
+    #[test]
+    fn holes_give_inner_sides() {
+        let lot = square_with_hole();
         let (m, roles) = extrude_with_roles(&lot, Extrusion::FaceNormal, 2.0);
         let c = counts(&m, &Topology::new(&m));
         assert_eq!((c.vertices, c.faces, c.holes), (16, 10, 2));
@@ -839,18 +846,7 @@ mod tests {
     #[test]
     fn replayed_extrusions_equal_extruding_anew() {
         let replays = || REPLAYED.with(|r| r.get());
-        let mut holed = Mesh::new();
-        holed.positions.extend([
-            v(0., 0., 0.),
-            v(4., 0., 0.),
-            v(4., 0., -4.),
-            v(0., 0., -4.),
-            v(1., 0., -1.),
-            v(1., 0., -3.),
-            v(3., 0., -3.),
-            v(3., 0., -1.),
-        ]);
-        holed.add_face(&[&[0, 1, 2, 3], &[4, 5, 6, 7]], 0);
+        let holed = square_with_hole();
         let textured = |m: &Mesh, k: f64| {
             let mut m = m.clone();
             let n = m.corners.len();

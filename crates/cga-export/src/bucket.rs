@@ -37,6 +37,12 @@ pub(crate) struct Bucket {
     pub features: Vec<f32>,
     pub min: [f32; 3],
     pub max: [f32; 3],
+    /// Data appended whole, before the arrays above (see
+    /// [`Bucket::append`]): each segment laid out as this bucket, its
+    /// indices numbering the vertices of the whole bucket. The arrays
+    /// above take pushes only while there are none
+    /// ([`Bucket::consolidate`]).
+    pub sealed: Vec<Bucket>,
 }
 
 pub(crate) fn too_many_vertices() -> ExportError {
@@ -100,6 +106,11 @@ impl Bucket {
 
     /// Bytes of vertex data held.
     pub fn bytes(&self) -> usize {
+        self.sealed.iter().map(Bucket::own_bytes).sum::<usize>() + self.own_bytes()
+    }
+
+    /// Bytes of vertex data in this segment's own arrays.
+    fn own_bytes(&self) -> usize {
         self.positions.len() * 12
             + self.normals.len() * 12
             + self.coords.iter().map(|c| c.len() * 8).sum::<usize>()
@@ -107,8 +118,31 @@ impl Bucket {
             + self.indices.len() * 12
     }
 
+    /// The segments of the data in order: those appended whole, then the
+    /// bucket's own arrays.
+    pub fn segments(&self) -> impl Iterator<Item = &Bucket> {
+        self.sealed.iter().chain(std::iter::once(self))
+    }
+
+    /// Calls `f` on each segment in order (see [`Bucket::segments`]).
+    pub fn each_segment_mut(&mut self, mut f: impl FnMut(&mut Bucket)) {
+        self.sealed.iter_mut().for_each(&mut f);
+        f(self);
+    }
+
+    /// Vertices held.
+    pub fn vertex_count(&self) -> usize {
+        self.segments().map(|s| s.positions.len()).sum()
+    }
+
+    /// Whether any triangle is held.
+    pub fn has_triangles(&self) -> bool {
+        self.segments().any(|s| !s.indices.is_empty())
+    }
+
     /// Empties the arrays (keeping their room), as for a new primitive.
     pub fn clear(&mut self) {
+        self.sealed.clear();
         self.positions.clear();
         self.normals.clear();
         self.coords.iter_mut().for_each(Vec::clear);
@@ -121,8 +155,10 @@ impl Bucket {
         self.max = [f32::NEG_INFINITY; 3];
     }
 
-    /// A copy of the data in arrays of exactly its size.
+    /// A copy of the data in arrays of exactly its size (of a bucket
+    /// filled by pushes alone).
     pub fn exact_copy(&self) -> Bucket {
+        debug_assert!(self.sealed.is_empty());
         Bucket {
             positions: self.positions.to_vec(),
             normals: self.normals.to_vec(),
@@ -134,6 +170,7 @@ impl Bucket {
             features: self.features.to_vec(),
             min: self.min,
             max: self.max,
+            sealed: Vec::new(),
         }
     }
 
@@ -152,6 +189,9 @@ impl Bucket {
     /// Starts writing UV set 0, with (0, 0) for the vertices so far: the
     /// first mesh with UVs of an untextured material.
     pub fn start_coords(&mut self) {
+        for s in &mut self.sealed {
+            s.start_coords();
+        }
         self.sets.push(0);
         self.coords.push(vec![[0.0; 2]; self.positions.len()]);
     }
@@ -205,46 +245,122 @@ impl Bucket {
         }
     }
 
-    /// Moves the data of `other` (filled for the same material) to the end
-    /// of this bucket, leaving `other` empty with its room: the result is
-    /// what pushing `other`'s vertices here would have given. Where the two
-    /// write different UV sets or tangents (a texture file that changed
+    /// Moves the data of `other` (filled for the same material, by pushes
+    /// alone) to the end of this bucket, leaving `other` empty: the result
+    /// is what pushing `other`'s vertices here would have given. Where the
+    /// two write different UV sets or tangents (a texture file that changed
     /// between the encoder's look and the writer's), missing arrays are
     /// filled with (0, 0) and default tangents and extra ones are dropped.
+    ///
+    /// The arrays are kept as they are, as a segment of their own (see
+    /// [`Bucket::sealed`]), their indices renumbered in place: a batch's
+    /// data is not copied again on its way to the file.
     pub fn append(&mut self, other: &mut Bucket) -> Result<(), ExportError> {
-        let base = self.positions.len();
+        let base = self.vertex_count();
         let added = other.positions.len();
         if base + added > u32::MAX as usize + 1 {
             return Err(too_many_vertices());
         }
+        if added == 0 {
+            other.clear();
+            return Ok(());
+        }
         if self.sets.is_empty() && other.sets == [0] {
             self.start_coords();
         }
-        for (set, coords) in self.sets.iter().zip(&mut self.coords) {
-            match other.sets.iter().position(|s| s == set) {
-                Some(k) => coords.append(&mut other.coords[k]),
-                None => coords.resize(base + added, [0.0; 2]),
+        let mut part = std::mem::replace(other, Bucket::new());
+        part.conform(&self.sets, self.tangents.is_some());
+        if base > 0 {
+            let base = base as u32;
+            for t in &mut part.indices {
+                *t = t.map(|v| v + base);
             }
         }
-        if let Some(tangents) = &mut self.tangents {
-            match &mut other.tangents {
-                Some(t) => tangents.append(t),
-                None => tangents.extend(other.normals.iter().map(|n| {
-                    let n = DVec3::from(n.map(f64::from));
-                    vertex_tangent(n, (n.any_orthonormal_vector(), 1.0))
-                })),
-            }
+        self.widen(part.min, part.max);
+        if !self.positions.is_empty() || !self.indices.is_empty() {
+            let own = self.take_own();
+            self.sealed.push(own);
         }
-        self.positions.append(&mut other.positions);
-        self.normals.append(&mut other.normals);
-        let base = base as u32;
-        self.indices
-            .extend(other.indices.iter().map(|t| t.map(|v| v + base)));
-        if added > 0 {
-            self.widen(other.min, other.max);
-        }
-        other.clear();
+        self.sealed.push(part);
         Ok(())
+    }
+
+    /// Lays out a segment's data as a bucket writing the UV `sets` (and
+    /// tangents if `tangents`) holds it.
+    fn conform(&mut self, sets: &[usize], tangents: bool) {
+        let n = self.positions.len();
+        if self.sets != sets {
+            let mut coords = std::mem::take(&mut self.coords);
+            self.coords = sets
+                .iter()
+                .map(|set| match self.sets.iter().position(|s| s == set) {
+                    Some(k) => std::mem::take(&mut coords[k]),
+                    None => vec![[0.0; 2]; n],
+                })
+                .collect();
+            self.sets = sets.to_vec();
+        }
+        match (tangents, &self.tangents) {
+            (true, None) => {
+                self.tangents = Some(
+                    self.normals
+                        .iter()
+                        .map(|n| {
+                            let n = DVec3::from(n.map(f64::from));
+                            vertex_tangent(n, (n.any_orthonormal_vector(), 1.0))
+                        })
+                        .collect(),
+                )
+            }
+            (false, Some(_)) => self.tangents = None,
+            _ => {}
+        }
+    }
+
+    /// This bucket's own arrays as a segment, leaving them empty (without
+    /// room).
+    fn take_own(&mut self) -> Bucket {
+        Bucket {
+            positions: std::mem::take(&mut self.positions),
+            normals: std::mem::take(&mut self.normals),
+            sets: self.sets.clone(),
+            coords: self.coords.iter_mut().map(std::mem::take).collect(),
+            tex_coords: Vec::new(),
+            tangents: self.tangents.as_mut().map(std::mem::take),
+            indices: std::mem::take(&mut self.indices),
+            features: std::mem::take(&mut self.features),
+            min: [f32::INFINITY; 3],
+            max: [f32::NEG_INFINITY; 3],
+            sealed: Vec::new(),
+        }
+    }
+
+    /// Copies the segments appended whole into this bucket's own arrays,
+    /// so that vertices can be pushed again (their numbers follow the
+    /// bucket's own positions). Feature ids are copied as they are: every
+    /// segment must have its own first (`GltfWriter::sync_features`).
+    pub fn consolidate(&mut self) {
+        if self.sealed.is_empty() {
+            return;
+        }
+        let own = self.take_own();
+        let sealed = std::mem::take(&mut self.sealed);
+        let total: usize =
+            sealed.iter().map(|s| s.positions.len()).sum::<usize>() + own.positions.len();
+        self.positions.reserve_exact(total);
+        self.normals.reserve_exact(total);
+        for s in sealed.iter().chain(std::iter::once(&own)) {
+            self.positions.extend_from_slice(&s.positions);
+            self.normals.extend_from_slice(&s.normals);
+            for (c, from) in self.coords.iter_mut().zip(&s.coords) {
+                c.extend_from_slice(from);
+            }
+            if let (Some(t), Some(from)) = (&mut self.tangents, &s.tangents) {
+                t.extend_from_slice(from);
+            }
+            self.indices.extend_from_slice(&s.indices);
+            self.features.extend_from_slice(&s.features);
+        }
     }
 }
 
@@ -296,9 +412,20 @@ mod tests {
                     .unwrap();
             }
             whole.indices.push([base, base + 1, base]);
+            let data = part.positions.as_ptr();
             parts.append(&mut part).unwrap();
             assert!(part.positions.is_empty() && part.indices.is_empty());
+            // Kept as it was, not copied.
+            assert_eq!(parts.sealed.last().unwrap().positions.as_ptr(), data);
         }
+        assert_eq!(parts.sealed.len(), 3);
+        assert_eq!(parts.vertex_count(), 6);
+        assert!(parts.positions.is_empty());
+        let sealed_indices: Vec<[u32; 3]> =
+            parts.segments().flat_map(|s| s.indices.clone()).collect();
+        assert_eq!(sealed_indices, [[0, 1, 0], [2, 3, 2], [4, 5, 4]]);
+        parts.consolidate();
+        assert!(parts.sealed.is_empty());
         assert_eq!(parts.positions, whole.positions);
         assert_eq!(parts.normals, whole.normals);
         assert_eq!(parts.sets, [0]);
@@ -317,12 +444,47 @@ mod tests {
         let mut target = Bucket::with_layout(vec![0, 5], true);
         let mut part = sample(false);
         target.append(&mut part).unwrap();
+        target.consolidate();
         assert_eq!(target.positions.len(), 2);
         assert_eq!(target.coords, [vec![[0.0; 2]; 2], vec![[0.0; 2]; 2]]);
         let t = target.tangents.as_ref().unwrap();
         assert_eq!(t.len(), 2);
         // Perpendicular to the normal (y), as glTF requires.
         assert!(t.iter().all(|t| t[1].abs() < 1e-6 && t[3] == 1.0));
+    }
+
+    /// Vertices pushed before and after appended segments keep the order
+    /// and numbering of pushing everything.
+    #[test]
+    fn pushes_and_appends_interleave() {
+        let mut b = sample(true);
+        b.append(&mut sample(true)).unwrap();
+        // The pushed vertices became a segment of their own, before the
+        // appended one.
+        assert_eq!(b.sealed.len(), 2);
+        assert!(b.positions.is_empty());
+        b.consolidate();
+        let src = [DVec2::new(0.25, 0.75), DVec2::new(1.0, 0.0)];
+        let v = b
+            .push_vertex(
+                DVec3::new(9.0, 0.0, 0.0),
+                DVec3::X,
+                &[Some(&src[..])],
+                1,
+                (DVec3::Y, 1.0),
+            )
+            .unwrap();
+        assert_eq!(v, 4);
+        b.indices.push([4, 0, 2]);
+        b.append(&mut sample(true)).unwrap();
+        b.consolidate();
+        assert_eq!(b.positions.len(), 7);
+        assert_eq!(b.positions[4], [9.0, 0.0, 0.0]);
+        assert_eq!(b.positions[5], [-1.5, 0.5, 1.5]);
+        assert_eq!(b.indices, [[0, 1, 0], [2, 3, 2], [4, 0, 2], [5, 6, 5]]);
+        assert_eq!(b.coords[0].len(), 7);
+        assert_eq!(b.coords[0][4], [1.0, 1.0]);
+        assert_eq!(b.max[0], 9.0);
     }
 
     #[test]

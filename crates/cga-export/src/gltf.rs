@@ -109,21 +109,30 @@ fn write_le<T: bytemuck::Pod>(w: &mut (impl Write + ?Sized), values: &[T]) -> st
 
 impl Bucket {
     /// Keeps one coordinate array per distinct content: a layer whose UV set
-    /// no mesh had reads set 0's array.
+    /// no mesh had reads set 0's array. (Every segment holds the same sets:
+    /// two sets are equal where they are in each.)
     fn merge_equal_coords(&mut self) {
-        let mut distinct: Vec<Vec<[f32; 2]>> = Vec::new();
-        self.tex_coords.clear();
-        for c in std::mem::take(&mut self.coords) {
+        let mut distinct: Vec<usize> = Vec::new();
+        let mut tex_coords = Vec::with_capacity(self.coords.len());
+        for k in 0..self.coords.len() {
             // Compared as numbers: 0 equals -0, NaN equals nothing.
-            match distinct.iter().position(|d| *d == c) {
-                Some(i) => self.tex_coords.push(i as u32),
+            let equal = |d: usize| self.segments().all(|s| s.coords[d] == s.coords[k]);
+            match distinct.iter().position(|&d| equal(d)) {
+                Some(i) => tex_coords.push(i as u32),
                 None => {
-                    self.tex_coords.push(distinct.len() as u32);
-                    distinct.push(c);
+                    tex_coords.push(distinct.len() as u32);
+                    distinct.push(k);
                 }
             }
         }
-        self.coords = distinct;
+        self.tex_coords = tex_coords;
+        self.each_segment_mut(|s| {
+            let mut all = std::mem::take(&mut s.coords);
+            s.coords = distinct
+                .iter()
+                .map(|&d| std::mem::take(&mut all[d]))
+                .collect();
+        });
     }
 
     /// Each UV set in an array of its own (no merging), as once anything
@@ -134,33 +143,54 @@ impl Bucket {
 
     /// What the accessors of this bucket's data as a primitive need.
     fn primitive(&self, material: u32) -> PrimitiveLayout {
+        let sum = |len: &dyn Fn(&Bucket) -> usize| self.segments().map(len).sum::<usize>();
+        let vertices = sum(&|s| s.positions.len());
         PrimitiveLayout {
             material,
-            vertices: self.positions.len() as u64,
-            positions: self.positions.len() * 12,
-            normals: self.normals.len() * 12,
-            coords: self.coords.iter().map(|c| c.len() * 8).collect(),
-            tangents: self.tangents.as_ref().map(|t| t.len() * 16),
-            indices: self.indices.len() * 12,
-            features: !self.features.is_empty(),
+            vertices: vertices as u64,
+            positions: vertices * 12,
+            normals: sum(&|s| s.normals.len()) * 12,
+            coords: (0..self.coords.len())
+                .map(|k| sum(&|s| s.coords[k].len()) * 8)
+                .collect(),
+            tangents: self
+                .tangents
+                .as_ref()
+                .map(|_| sum(&|s| s.tangents.as_ref().map_or(0, Vec::len)) * 16),
+            indices: sum(&|s| s.indices.len()) * 12,
+            features: self.segments().any(|s| !s.features.is_empty()),
             min: self.min,
             max: self.max,
         }
     }
 
-    /// The arrays in the order of the binary layout.
+    /// The arrays in the order of the binary layout, each attribute's
+    /// segments one after another.
     fn write_arrays(&self, w: &mut (impl Write + ?Sized)) -> std::io::Result<()> {
-        write_le(w, &self.positions)?;
-        write_le(w, &self.normals)?;
-        for coords in &self.coords {
-            write_le(w, coords)?;
+        for s in self.segments() {
+            write_le(w, &s.positions)?;
         }
-        if let Some(tangents) = &self.tangents {
-            write_le(w, tangents)?;
+        for s in self.segments() {
+            write_le(w, &s.normals)?;
         }
-        write_le(w, &self.indices)?;
+        for k in 0..self.coords.len() {
+            for s in self.segments() {
+                write_le(w, &s.coords[k])?;
+            }
+        }
+        if self.tangents.is_some() {
+            for s in self.segments() {
+                write_le(w, s.tangents.as_deref().unwrap_or_default())?;
+            }
+        }
+        for s in self.segments() {
+            write_le(w, &s.indices)?;
+        }
         // Feature ids as floats: exact below 2^24 lots per model.
-        write_le(w, &self.features)
+        for s in self.segments() {
+            write_le(w, &s.features)?;
+        }
+        Ok(())
     }
 }
 
@@ -185,7 +215,7 @@ impl Buckets for ModelBuckets<'_> {
     }
 
     fn bucket(&mut self, id: u32) -> &mut Bucket {
-        &mut self.writer.buckets[id as usize]
+        self.writer.bucket_for_pushes(id)
     }
 }
 
@@ -823,7 +853,7 @@ impl GltfWriter {
         }
         // What was added so far belongs to the lot before.
         self.sync_features();
-        if self.per_lot && self.buckets.iter().any(|b| !b.indices.is_empty()) {
+        if self.per_lot && self.buckets.iter().any(Bucket::has_triangles) {
             self.flush()?;
         }
         self.lots.push(LotNode {
@@ -886,6 +916,17 @@ impl GltfWriter {
         self.buckets[id as usize].append(data)
     }
 
+    /// The bucket of material `id`, ready for vertices pushed one by one
+    /// (encoding on the writing thread): what was appended whole is copied
+    /// into its own arrays first, with the current lot's feature ids.
+    pub(crate) fn bucket_for_pushes(&mut self, id: u32) -> &mut Bucket {
+        if !self.buckets[id as usize].sealed.is_empty() {
+            self.sync_features();
+            self.buckets[id as usize].consolidate();
+        }
+        &mut self.buckets[id as usize]
+    }
+
     /// Writes out the data held if it is more than allowed: between input
     /// meshes, or between the materials of a batch, never inside a mesh
     /// (whose vertices share one numbering).
@@ -915,11 +956,7 @@ impl GltfWriter {
         let (Some(lots), true) = (self.lots_hint, self.per_lot) else {
             return GLB_JSON_ROOM;
         };
-        let primitives = self
-            .buckets
-            .iter()
-            .filter(|b| !b.indices.is_empty())
-            .count() as u64;
+        let primitives = self.buckets.iter().filter(|b| b.has_triangles()).count() as u64;
         let extras = self
             .lots
             .last()
@@ -957,18 +994,20 @@ impl GltfWriter {
         let id = lot as f32;
         let mut bounds: Option<[[f64; 3]; 2]> = self.feature_bounds.get(lot).copied().flatten();
         for b in &mut self.buckets {
-            let from = b.features.len();
-            for p in &b.positions[from..] {
-                let p = p.map(f64::from);
-                bounds = Some(match bounds {
-                    Some([lo, hi]) => [
-                        std::array::from_fn(|k| lo[k].min(p[k])),
-                        std::array::from_fn(|k| hi[k].max(p[k])),
-                    ],
-                    None => [p, p],
-                });
-            }
-            b.features.resize(b.positions.len(), id);
+            b.each_segment_mut(|s| {
+                let from = s.features.len();
+                for p in &s.positions[from..] {
+                    let p = p.map(f64::from);
+                    bounds = Some(match bounds {
+                        Some([lo, hi]) => [
+                            std::array::from_fn(|k| lo[k].min(p[k])),
+                            std::array::from_fn(|k| hi[k].max(p[k])),
+                        ],
+                        None => [p, p],
+                    });
+                }
+                s.features.resize(s.positions.len(), id);
+            });
         }
         if self.feature_bounds.len() <= lot {
             self.feature_bounds.resize(lot + 1, None);
@@ -996,13 +1035,14 @@ impl GltfWriter {
             self.bin_out.as_mut().expect("created above")
         };
         for (id, b) in self.buckets.iter_mut().enumerate() {
-            if b.indices.is_empty() {
+            if !b.has_triangles() {
                 continue;
             }
             b.unmerged_coords();
             b.write_arrays(out).map_err(io)?;
             let p = b.primitive(id as u32);
-            self.written_bytes += b.bytes() as u64 + b.features.len() as u64 * 4;
+            let features: usize = b.segments().map(|s| s.features.len()).sum();
+            self.written_bytes += b.bytes() as u64 + features as u64 * 4;
             self.written.push(p);
             b.clear();
         }
@@ -1050,7 +1090,7 @@ impl GltfWriter {
             .buckets
             .iter()
             .enumerate()
-            .filter(|(_, b)| !b.indices.is_empty())
+            .filter(|(_, b)| b.has_triangles())
             .map(|(id, b)| b.primitive(id as u32))
             .collect();
         // Accessors in the order of the binary data, with their material.
@@ -1317,11 +1357,7 @@ impl GltfWriter {
         let bytes = &mut self.middle;
         for group in &mut self.instances.groups {
             let mut prims = Vec::new();
-            for (id, b) in group
-                .buckets
-                .iter_mut()
-                .filter(|(_, b)| !b.indices.is_empty())
-            {
+            for (id, b) in group.buckets.iter_mut().filter(|(_, b)| b.has_triangles()) {
                 b.unmerged_coords();
                 b.write_arrays(bytes).expect("writing into memory");
                 let p = b.primitive(*id);
@@ -1945,7 +1981,7 @@ fn write_bin(
     let io = |e| ExportError::io(path, e);
     // The arrays hold the bytes to write; arrays larger than the output
     // buffer go to the file directly.
-    for b in held.buckets.iter().filter(|b| !b.indices.is_empty()) {
+    for b in held.buckets.iter().filter(|b| b.has_triangles()) {
         b.write_arrays(w).map_err(io)?;
     }
     w.write_all(held.middle).map_err(io)?;

@@ -155,19 +155,28 @@ impl Bucket {
         self.max = [f32::NEG_INFINITY; 3];
     }
 
-    /// A copy of the data in arrays of exactly its size (of a bucket
-    /// filled by pushes alone).
-    pub fn exact_copy(&self) -> Bucket {
+    /// The data in its arrays (of a bucket filled by pushes alone),
+    /// leaving fresh arrays with room for as much.
+    pub fn take_leaving_room(&mut self) -> Bucket {
         debug_assert!(self.sealed.is_empty());
+        let n = self.positions.len();
+        let triangles = self.indices.len();
         Bucket {
-            positions: self.positions.to_vec(),
-            normals: self.normals.to_vec(),
+            positions: std::mem::replace(&mut self.positions, Vec::with_capacity(n)),
+            normals: std::mem::replace(&mut self.normals, Vec::with_capacity(n)),
             sets: self.sets.clone(),
-            coords: self.coords.iter().map(|c| c.to_vec()).collect(),
+            coords: self
+                .coords
+                .iter_mut()
+                .map(|c| std::mem::replace(c, Vec::with_capacity(n)))
+                .collect(),
             tex_coords: self.tex_coords.clone(),
-            tangents: self.tangents.as_ref().map(|t| t.to_vec()),
-            indices: self.indices.to_vec(),
-            features: self.features.to_vec(),
+            tangents: self
+                .tangents
+                .as_mut()
+                .map(|t| std::mem::replace(t, Vec::with_capacity(n))),
+            indices: std::mem::replace(&mut self.indices, Vec::with_capacity(triangles)),
+            features: std::mem::take(&mut self.features),
             min: self.min,
             max: self.max,
             sealed: Vec::new(),

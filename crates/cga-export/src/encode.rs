@@ -86,21 +86,26 @@ impl Encoded {
         self.buckets.push(bucket);
     }
 
-    /// The batch's data, in arrays of exactly its size, leaving the batch
-    /// empty with its room (each bucket kept with `materials`, the
-    /// materials of its buckets in order).
+    /// The batch's data in its own arrays, leaving the batch empty with
+    /// fresh arrays of room for as much (each bucket kept with `materials`,
+    /// the materials of its buckets in order).
     ///
     /// Batches wait to be appended (a worker's lot waits for the lots
-    /// before it), so their arrays are what the model holds in flight.
-    /// Sending the working arrays themselves and reusing appended batches
-    /// made every bucket of every batch in flight grow, by reallocation
-    /// into fresh memory, to the most any material ever needed (20 Candler
-    /// buildings: twice the page faults and 45 MiB more at the peak, and
-    /// the kernel's zeroing of fresh pages took a quarter of the run's
-    /// time). A copy costs less.
-    fn take_exact(&mut self, materials: Vec<Material>) -> Encoded {
+    /// before it), so their arrays are what the model holds in flight; the
+    /// writer keeps them as they are until it writes them (see
+    /// `Bucket::append`). A batch is about as large as the one before it,
+    /// so its arrays seldom grow past the room they start with. (Copying
+    /// each batch into arrays of its exact size, as before, cost a copy of
+    /// every encoded byte; reusing the arrays of appended batches, before
+    /// that, made every array in flight grow to the most any material ever
+    /// needed.)
+    fn take_batch(&mut self, materials: Vec<Material>) -> Encoded {
         let out = Encoded {
-            buckets: self.buckets.iter().map(Bucket::exact_copy).collect(),
+            buckets: self
+                .buckets
+                .iter_mut()
+                .map(Bucket::take_leaving_room)
+                .collect(),
             materials,
             faces: std::mem::take(&mut self.faces),
             triangles: std::mem::take(&mut self.triangles),
@@ -364,7 +369,7 @@ impl Encoder {
     /// The meshes encoded since the last call, as one batch; the encoder
     /// starts an empty one.
     pub fn take(&mut self) -> Encoded {
-        let batch = self.batch.take_exact(self.table.take_materials());
+        let batch = self.batch.take_batch(self.table.take_materials());
         // Slot ids name this batch's materials.
         self.mesh.forget_ids();
         batch
@@ -605,12 +610,13 @@ mod tests {
         (p.as_ptr(), p.capacity())
     }
 
-    /// A batch holds exactly its data; the encoder keeps its arrays for its
-    /// next batches, each material in the bucket it had before (here the
-    /// materials come in the other order the second time), so that a
-    /// running model reallocates nothing.
+    /// A batch takes the encoder's arrays as they are (no copy); the
+    /// encoder starts fresh ones with room for as much, each material in
+    /// the bucket it had before (here the materials come in the other
+    /// order the second time), so that a batch like the last reallocates
+    /// nothing.
     #[test]
-    fn batches_are_exact_and_each_material_keeps_its_room() {
+    fn batches_take_their_arrays_and_each_material_keeps_its_room() {
         let mut e = Encoder::for_export(&ExportOptions::default());
         let big = cga_geometry::primitive::cube(DVec3::new(2.0, 3.0, 4.0));
         let small = Mesh::polygon(&[DVec3::ZERO, DVec3::X, DVec3::Z]);
@@ -619,23 +625,28 @@ mod tests {
             e.add_placed(&big, None, &wall);
         }
         e.add_placed(&small, None, &roof);
-        let wall_room = room(&e, 0);
-        let roof_room = room(&e, 1);
-        assert!(
-            wall_room.1 >= 20 * 24 && roof_room.1 >= 3,
-            "{wall_room:?} {roof_room:?}"
-        );
+        let wall_data = room(&e, 0).0;
         let batch = e.take();
         assert_eq!(batch.materials.len(), 2);
         assert_eq!(batch.faces, 20 * 6 + 1);
-        for b in &batch.buckets {
-            assert_eq!(b.positions.capacity(), b.positions.len());
-            assert_eq!(b.normals.capacity(), b.normals.len());
-            assert_eq!(b.indices.capacity(), b.indices.len());
-        }
+        assert_eq!(batch.buckets[0].positions.as_ptr(), wall_data, "not copied");
         assert_eq!(batch.buckets[0].positions.len(), 20 * 24);
         assert_eq!(batch.buckets[1].indices.len(), 1);
         assert_eq!(e.bytes(), 0);
+        // The spare buckets: room for what each material held.
+        let spare_room = |name: &str| {
+            let (_, b) = e
+                .batch
+                .spare
+                .iter()
+                .find(|(m, _)| &*m.name == name)
+                .unwrap();
+            assert!(b.positions.is_empty() && b.indices.is_empty());
+            (b.positions.as_ptr(), b.positions.capacity())
+        };
+        let (wall_room, roof_room) = (spare_room("wall"), spare_room("roof"));
+        assert!(wall_room.1 >= 20 * 24 && wall_room.0 != wall_data);
+        assert!((3..20 * 24).contains(&roof_room.1), "{roof_room:?}");
 
         e.add_placed(&small, None, &roof);
         for _ in 0..20 {

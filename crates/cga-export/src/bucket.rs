@@ -110,7 +110,7 @@ impl Bucket {
     }
 
     /// Bytes of vertex data in this segment's own arrays.
-    fn own_bytes(&self) -> usize {
+    pub fn own_bytes(&self) -> usize {
         self.positions.len() * 12
             + self.normals.len() * 12
             + self.coords.iter().map(|c| c.len() * 8).sum::<usize>()

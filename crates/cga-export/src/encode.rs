@@ -212,9 +212,11 @@ impl MeshEncoder {
         let result = prep.faces(mesh, transform, |f| {
             let material = slots.id(f.material, || store.id_of(&materials[f.material as usize]));
             let bucket = store.bucket(material);
-            let before = bucket.bytes();
+            // Buckets taking pushes hold no appended segments: their own
+            // arrays are all they hold.
+            let before = bucket.own_bytes();
             add_face(bucket, vertices, &FaceData { material, ..*f })?;
-            counts.bytes += bucket.bytes() - before;
+            counts.bytes += bucket.own_bytes() - before;
             counts.faces += 1;
             counts.triangles += f.triangles.len() as u64;
             Ok(())
@@ -475,7 +477,6 @@ fn add_face(
     let loops = f.loops;
     match f.normals {
         Some(normals) if shared => {
-            bucket.reserve(loops.iter().map(|l| l.len as usize).sum());
             let corners = loops.iter().flat_map(|&l| mesh.loop_corners(l));
             for c in corners {
                 let position = mesh.corners[c] as usize;

@@ -231,6 +231,8 @@ impl Bucket {
     /// Appends a position and widens the bounds.
     #[inline(always)]
     pub fn push_position(&mut self, p: DVec3) {
+        // Pushed vertices are numbered by the bucket's own arrays.
+        debug_assert!(self.sealed.is_empty(), "consolidate before pushing");
         let p = p.as_vec3().to_array();
         self.widen(p, p);
         self.positions.push(p);
@@ -270,12 +272,12 @@ impl Bucket {
         if base + added > u32::MAX as usize + 1 {
             return Err(too_many_vertices());
         }
+        if self.sets.is_empty() && other.sets == [0] {
+            self.start_coords();
+        }
         if added == 0 {
             other.clear();
             return Ok(());
-        }
-        if self.sets.is_empty() && other.sets == [0] {
-            self.start_coords();
         }
         let mut part = std::mem::replace(other, Bucket::new());
         part.conform(&self.sets, self.tangents.is_some());
@@ -346,8 +348,10 @@ impl Bucket {
 
     /// Copies the segments appended whole into this bucket's own arrays,
     /// so that vertices can be pushed again (their numbers follow the
-    /// bucket's own positions). Feature ids are copied as they are: every
-    /// segment must have its own first (`GltfWriter::sync_features`).
+    /// bucket's own positions). Feature ids are copied as they are: the
+    /// vertices without theirs yet (`GltfWriter::sync_features` gives them)
+    /// are always the last ones, since data only ever comes at the end, so
+    /// the ids copied stay those of the first vertices.
     pub fn consolidate(&mut self) {
         if self.sealed.is_empty() {
             return;
@@ -494,6 +498,35 @@ mod tests {
         assert_eq!(b.coords[0].len(), 7);
         assert_eq!(b.coords[0][4], [1.0, 1.0]);
         assert_eq!(b.max[0], 9.0);
+    }
+
+    /// Feature ids given so far belong to the first vertices, and stay
+    /// theirs when the segments are copied together.
+    #[test]
+    fn consolidating_keeps_feature_ids_with_their_vertices() {
+        let mut b = sample(false);
+        b.features = vec![0.0; 2];
+        b.append(&mut sample(false)).unwrap();
+        b.sealed[1].features = vec![1.0; 2];
+        b.append(&mut sample(false)).unwrap();
+        assert_eq!(b.sealed.len(), 3);
+        b.consolidate();
+        assert_eq!(b.positions.len(), 6);
+        // The last two vertices have no id yet; the others keep theirs.
+        assert_eq!(b.features, [0.0, 0.0, 1.0, 1.0]);
+    }
+
+    /// An empty batch with texture coordinates still starts the model's
+    /// UV set 0, as appending its vertices one by one would.
+    #[test]
+    fn an_empty_batch_with_coordinates_starts_set_0() {
+        let mut b = sample(false);
+        let mut empty = Bucket::new();
+        empty.start_coords();
+        b.append(&mut empty).unwrap();
+        assert_eq!(b.sets, [0]);
+        assert_eq!(b.coords, [vec![[0.0; 2]; 2]]);
+        assert!(b.sealed.is_empty());
     }
 
     #[test]

@@ -918,13 +918,11 @@ impl GltfWriter {
 
     /// The bucket of material `id`, ready for vertices pushed one by one
     /// (encoding on the writing thread): what was appended whole is copied
-    /// into its own arrays first, with the current lot's feature ids.
+    /// into its own arrays first.
     pub(crate) fn bucket_for_pushes(&mut self, id: u32) -> &mut Bucket {
-        if !self.buckets[id as usize].sealed.is_empty() {
-            self.sync_features();
-            self.buckets[id as usize].consolidate();
-        }
-        &mut self.buckets[id as usize]
+        let bucket = &mut self.buckets[id as usize];
+        bucket.consolidate();
+        bucket
     }
 
     /// Writes out the data held if it is more than allowed: between input

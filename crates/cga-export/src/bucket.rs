@@ -159,28 +159,7 @@ impl Bucket {
     /// leaving fresh arrays with room for as much.
     pub fn take_leaving_room(&mut self) -> Bucket {
         debug_assert!(self.sealed.is_empty());
-        let n = self.positions.len();
-        let triangles = self.indices.len();
-        Bucket {
-            positions: std::mem::replace(&mut self.positions, Vec::with_capacity(n)),
-            normals: std::mem::replace(&mut self.normals, Vec::with_capacity(n)),
-            sets: self.sets.clone(),
-            coords: self
-                .coords
-                .iter_mut()
-                .map(|c| std::mem::replace(c, Vec::with_capacity(n)))
-                .collect(),
-            tex_coords: self.tex_coords.clone(),
-            tangents: self
-                .tangents
-                .as_mut()
-                .map(|t| std::mem::replace(t, Vec::with_capacity(n))),
-            indices: std::mem::replace(&mut self.indices, Vec::with_capacity(triangles)),
-            features: std::mem::take(&mut self.features),
-            min: self.min,
-            max: self.max,
-            sealed: Vec::new(),
-        }
+        self.take_arrays(self.positions.len(), self.indices.len())
     }
 
     /// Room for `n` more vertices.
@@ -289,7 +268,7 @@ impl Bucket {
         }
         self.widen(part.min, part.max);
         if !self.positions.is_empty() || !self.indices.is_empty() {
-            let own = self.take_own();
+            let own = self.take_arrays(0, 0);
             self.sealed.push(own);
         }
         self.sealed.push(part);
@@ -328,20 +307,27 @@ impl Bucket {
         }
     }
 
-    /// This bucket's own arrays as a segment, leaving them empty (without
-    /// room).
-    fn take_own(&mut self) -> Bucket {
+    /// This bucket's own arrays as a segment, leaving them empty with room
+    /// for `vertices` and `triangles`.
+    fn take_arrays(&mut self, vertices: usize, triangles: usize) -> Bucket {
+        fn swap_out<T>(v: &mut Vec<T>, room: usize) -> Vec<T> {
+            std::mem::replace(v, Vec::with_capacity(room))
+        }
         Bucket {
-            positions: std::mem::take(&mut self.positions),
-            normals: std::mem::take(&mut self.normals),
+            positions: swap_out(&mut self.positions, vertices),
+            normals: swap_out(&mut self.normals, vertices),
             sets: self.sets.clone(),
-            coords: self.coords.iter_mut().map(std::mem::take).collect(),
-            tex_coords: Vec::new(),
-            tangents: self.tangents.as_mut().map(std::mem::take),
-            indices: std::mem::take(&mut self.indices),
+            coords: self
+                .coords
+                .iter_mut()
+                .map(|c| swap_out(c, vertices))
+                .collect(),
+            tex_coords: self.tex_coords.clone(),
+            tangents: self.tangents.as_mut().map(|t| swap_out(t, vertices)),
+            indices: swap_out(&mut self.indices, triangles),
             features: std::mem::take(&mut self.features),
-            min: [f32::INFINITY; 3],
-            max: [f32::NEG_INFINITY; 3],
+            min: self.min,
+            max: self.max,
             sealed: Vec::new(),
         }
     }
@@ -356,7 +342,7 @@ impl Bucket {
         if self.sealed.is_empty() {
             return;
         }
-        let own = self.take_own();
+        let own = self.take_arrays(0, 0);
         let sealed = std::mem::take(&mut self.sealed);
         let total: usize =
             sealed.iter().map(|s| s.positions.len()).sum::<usize>() + own.positions.len();

@@ -204,7 +204,7 @@ impl MeshArrays for DrawMesh {
         // every face without normals of its own, and most that have them
         // (an inserted box's).
         let flat = match f.normals {
-            None => Some(byte(f.normal)),
+            None => Some(byte(f.normal())),
             Some(own) => {
                 let mut bytes = corners.clone().map(|c| byte(own[c]));
                 let first = bytes.next();
@@ -250,7 +250,7 @@ impl MeshArrays for DrawMesh {
             corner_vertex,
             next,
             |c| {
-                let n = f.normals.map_or(f.normal, |n| n[c]);
+                let n = f.normals.map_or_else(|| f.normal(), |n| n[c]);
                 positions.push(f32s(corner_position(f, c)));
                 normals.push(n.to_array().map(normal_byte));
                 out_uvs.push(f32s(corner_uv(uvs, c)));

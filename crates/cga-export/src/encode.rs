@@ -480,7 +480,7 @@ fn add_face(
             let corners = loops.iter().flat_map(|&l| mesh.loop_corners(l));
             for c in corners {
                 let position = mesh.corners[c] as usize;
-                let n = normals[c].try_normalize().unwrap_or(f.normal);
+                let n = normals[c].try_normalize().unwrap_or_else(|| f.normal());
                 let uv = uvs.map_or([0; 2], |u| u[c].as_vec2().to_array().map(f32::to_bits));
                 let key = VertexKey {
                     material: f.material,
@@ -568,7 +568,7 @@ fn own_vertices(
     match f.normals {
         Some(normals) => {
             for c in corners.clone() {
-                let n = normals[c].try_normalize().unwrap_or(f.normal);
+                let n = normals[c].try_normalize().unwrap_or_else(|| f.normal());
                 bucket.normals.push(n.as_vec3().to_array());
                 if let Some(tangents) = &mut bucket.tangents {
                     tangents.push(vertex_tangent(n, tangent));
@@ -576,10 +576,11 @@ fn own_vertices(
             }
         }
         None => {
-            let n = f.normal.as_vec3().to_array();
+            let normal = f.normal();
+            let n = normal.as_vec3().to_array();
             bucket.normals.extend(std::iter::repeat_n(n, count));
             if let Some(tangents) = &mut bucket.tangents {
-                let t = vertex_tangent(f.normal, tangent);
+                let t = vertex_tangent(normal, tangent);
                 tangents.extend(std::iter::repeat_n(t, count));
             }
         }

@@ -342,7 +342,7 @@ fn usable(textures: &mut Textures, warnings: &mut Vec<String>, path: &Arc<str>) 
 pub(crate) fn face_tangent(f: &FaceData) -> (DVec3, f64) {
     let mesh = f.mesh;
     let Some(uvs) = mesh.uvs[5].as_deref().or(mesh.uvs[0].as_deref()) else {
-        return (f.normal.any_orthonormal_vector(), 1.0);
+        return (f.normal().any_orthonormal_vector(), 1.0);
     };
     for t in f.triangles {
         let c = t.map(|c| c as usize);
@@ -357,7 +357,7 @@ pub(crate) fn face_tangent(f: &FaceData) -> (DVec3, f64) {
         let dpdu = (e1 * d2.y - e2 * d1.y) / det;
         let dpdv = (e2 * d1.x - e1 * d2.x) / det;
         if let Some(t) = dpdu.try_normalize() {
-            let w = if f.normal.cross(t).dot(-dpdv) < 0.0 {
+            let w = if f.normal().cross(t).dot(-dpdv) < 0.0 {
                 -1.0
             } else {
                 1.0
@@ -365,7 +365,7 @@ pub(crate) fn face_tangent(f: &FaceData) -> (DVec3, f64) {
             return (t, w);
         }
     }
-    (f.normal.any_orthonormal_vector(), 1.0)
+    (f.normal().any_orthonormal_vector(), 1.0)
 }
 
 /// Where a CGA texture layer goes in a glTF material.

@@ -323,10 +323,25 @@ pub(crate) struct FaceData<'a> {
     /// Output material id (from `FacePrep`: the face's material slot, which
     /// the writer maps to its id).
     pub material: u32,
-    /// Unit face normal (flat shading when the mesh has no normals).
-    pub normal: DVec3,
+    /// Unit face normal, when it was worth computing: see
+    /// [`normal`](FaceData::normal).
+    pub known_normal: Option<DVec3>,
     /// Triangles as indices into `mesh.corners`.
     pub triangles: &'a [[u32; 3]],
+}
+
+impl FaceData<'_> {
+    /// Unit face normal (flat shading when the mesh has no normals; where
+    /// one of its own normals is zero when it has them). `FacePrep` leaves
+    /// it to be computed here when a face with normals of its own may not
+    /// need it (`prepare::deferred_normal`).
+    #[inline]
+    pub fn normal(&self) -> DVec3 {
+        match self.known_normal {
+            Some(n) => n,
+            None => crate::prepare::deferred_normal(self),
+        }
+    }
 }
 
 enum Sink {

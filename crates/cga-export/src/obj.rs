@@ -199,8 +199,8 @@ impl ObjWriter {
                     }
                 };
                 let n = match f.normals {
-                    Some(normals) => normals[c].try_normalize().unwrap_or(f.normal),
-                    None => f.normal,
+                    Some(normals) => normals[c].try_normalize().unwrap_or_else(|| f.normal()),
+                    None => f.normal(),
                 };
                 let key = [n.x, n.y, n.z].map(f64::to_bits);
                 let vn = match self.vn_ids.get(&key) {

@@ -216,7 +216,7 @@ impl MeshArrays for PlainMesh {
                 .extend(corners.clone().map(|c| normals[c].to_array())),
             None => self
                 .normals
-                .extend(std::iter::repeat_n(f.normal.to_array(), n)),
+                .extend(std::iter::repeat_n(f.normal().to_array(), n)),
         }
         self.uvs.extend(corners.map(|c| corner_uv(uvs, c)));
         self.indices
@@ -245,7 +245,7 @@ impl MeshArrays for PlainMesh {
             positions.len() as u32,
             |c| {
                 positions.push(corner_position(f, c));
-                normals.push(f.normals.map_or(f.normal, |n| n[c]).to_array());
+                normals.push(f.normals.map_or_else(|| f.normal(), |n| n[c]).to_array());
                 out_uvs.push(corner_uv(uvs, c));
             },
             |ids| {

@@ -113,7 +113,14 @@ fn each_face(
                 if triangles.is_empty() {
                     continue;
                 }
-                quad_normal(mesh, positions, *outer)
+                // A face with normals of its own needs its face normal
+                // only where one of them is zero: left for later (see
+                // `deferred_normal`) where the face is sure to be written.
+                if normals.is_some() && cut_along_first_diagonal(outer.start, triangles) {
+                    Deferred
+                } else {
+                    Known(quad_normal(mesh, positions, *outer))
+                }
             }
             _ => {
                 let (newell, normal) = face_normals(mesh, positions, loops[0]);
@@ -121,13 +128,17 @@ fn each_face(
                 if triangles.is_empty() {
                     continue;
                 }
-                normal
+                Known(normal)
             }
         };
         // No normal means zero area: nothing to see, and no valid normal
         // to write.
-        let Some(normal) = normal.or_else(|| triangles_normal(mesh, positions, triangles)) else {
-            continue;
+        let known_normal = match normal {
+            Deferred => None,
+            Known(n) => match n.or_else(|| triangles_normal(mesh, positions, triangles)) {
+                Some(n) => Some(n),
+                None => continue,
+            },
         };
         emit(&FaceData {
             mesh,
@@ -135,11 +146,40 @@ fn each_face(
             normals,
             loops,
             material: mesh.faces[face].material,
-            normal,
+            known_normal,
             triangles,
         })?;
     }
     Ok(skipped)
+}
+
+/// A face's normal as `each_face` finds it: computed (`None` for zero
+/// area, unless its triangles have a normal), or left for later.
+enum FaceNormal {
+    Known(Option<DVec3>),
+    Deferred,
+}
+use FaceNormal::{Deferred, Known};
+
+/// Whether a quad whose corners start at `s` is cut into `triangles`
+/// along its first diagonal (corners 0–2), as `triangulate_finite_quad`
+/// cuts it when both halves turn the same way.
+fn cut_along_first_diagonal(s: u32, triangles: &[[u32; 3]]) -> bool {
+    triangles == [[s, s + 1, s + 2], [s, s + 2, s + 3]]
+}
+
+/// The normal of a face `FacePrep` wrote without one (a quad with normals
+/// of its own, cut along its first diagonal): what it would have given,
+/// [`quad_normal`] or else the triangles' normal. The second always
+/// exists for such a quad, so the face was rightly written: its two
+/// triangles' cross products are those whose sum the triangulation found
+/// non-zero and finite (`triangulate_finite_quad` sums them from zero in
+/// the same order), and a finite non-zero vector normalises.
+pub(crate) fn deferred_normal(f: &FaceData) -> DVec3 {
+    let outer = f.loops[0];
+    quad_normal(f.mesh, f.positions, outer)
+        .or_else(|| triangles_normal(f.mesh, f.positions, f.triangles))
+        .unwrap_or_default()
 }
 
 /// Area-weighted normal of triangles, for faces whose outer loop alone is
@@ -214,5 +254,72 @@ impl SlotIds {
     /// Forgets every id (the ids they map to start again).
     pub fn clear(&mut self) {
         self.known.clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::faces::face_normals;
+    use cga_geometry::primitive::cube;
+
+    /// The normal each face is written with, and whether it was left for
+    /// later, for a cube whose corners carry normals (one of them zero).
+    fn written_normals(transform: Option<&DAffine3>) -> Vec<(Option<DVec3>, DVec3, DVec3)> {
+        let mut mesh = cube(DVec3::new(2.0, 3.0, 4.0));
+        let mut normals: Vec<DVec3> = (0..mesh.corners.len())
+            .map(|c| DVec3::new(0.1, 0.2, 1.0 + c as f64))
+            .collect();
+        normals[5] = DVec3::ZERO;
+        mesh.normals = Some(normals);
+        let mut prep = FacePrep::default();
+        let mut out = Vec::new();
+        let skipped = prep
+            .faces(&mesh, transform, |f| {
+                let (_, reference) = face_normals(f.mesh, f.positions, f.loops[0]);
+                out.push((
+                    f.known_normal,
+                    f.normal(),
+                    reference.expect("a face of a cube has area"),
+                ));
+                Ok(())
+            })
+            .expect("no writer error");
+        assert_eq!(skipped, 0);
+        out
+    }
+
+    #[test]
+    fn a_quad_with_normals_of_its_own_gets_its_face_normal_when_asked() {
+        let turned =
+            DAffine3::from_rotation_y(0.3) * DAffine3::from_translation(DVec3::new(5.0, 1.0, -2.0));
+        for transform in [None, Some(&turned)] {
+            let faces = written_normals(transform);
+            assert_eq!(faces.len(), 6, "every face of the cube is written");
+            for (known, normal, reference) in faces {
+                // Convex quads are cut along their first diagonal: their
+                // normal is left for later, and is the one computed then.
+                assert_eq!(known, None);
+                assert_eq!(normal, reference);
+                assert!((normal.length() - 1.0).abs() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn a_face_without_normals_of_its_own_has_its_normal_computed() {
+        let mut mesh = cube(DVec3::ONE);
+        mesh.normals = None;
+        let mut prep = FacePrep::default();
+        let mut known = Vec::new();
+        prep.faces(&mesh, None, |f| {
+            known.push(f.known_normal);
+            Ok(())
+        })
+        .expect("no writer error");
+        assert_eq!(known.len(), 6);
+        assert!(known
+            .iter()
+            .all(|n| n.is_some_and(|n| (n.length() - 1.0).abs() < 1e-12)));
     }
 }

@@ -118,13 +118,18 @@ pub fn perpendicular(v: DVec3, candidates: &[DVec3]) -> DVec3 {
 }
 
 /// The frame of a face: x along its first edge, z along `normal`.
-pub fn face_frame(pts: &[DVec3], normal: DVec3, stored: Option<DVec3>) -> (DVec3, DMat3) {
-    let origin = pts.first().copied().unwrap_or(DVec3::ZERO);
+/// (`pts` in loop order; an iterator, so that a face's loop is read in
+/// place.)
+pub fn face_frame(
+    pts: impl IntoIterator<Item = DVec3>,
+    normal: DVec3,
+    stored: Option<DVec3>,
+) -> (DVec3, DMat3) {
+    let mut pts = pts.into_iter();
+    let origin = pts.next().unwrap_or(DVec3::ZERO);
     // "The first edge": from the first vertex to the next distinct one.
     let x = pts
-        .iter()
-        .skip(1)
-        .map(|&p| p - origin)
+        .map(|p| p - origin)
         .find(|d| d.length_squared() > 1e-24)
         .unwrap_or(DVec3::X);
     let z = if normal != DVec3::ZERO {
@@ -303,6 +308,34 @@ impl SubmeshBuilder {
         }
     }
 
+    /// Appends corners `run` of `src` in order, as [`corner`](Self::corner)
+    /// would one by one (with their stored normals), each attribute array
+    /// extended at once: a component's faces are runs of whole loops, and
+    /// per-corner checks of ten UV sets cost more than the copying.
+    fn run_of_corners(&mut self, src: &Mesh, out: &mut Mesh, run: std::ops::Range<usize>) {
+        for c in run.clone() {
+            let p = self.position(src, out, src.corners[c]);
+            out.corners.push(p);
+        }
+        for (dst, s) in out.uvs.iter_mut().zip(&src.uvs) {
+            if let (Some(dst), Some(s)) = (dst.as_mut(), s.as_ref()) {
+                extend_from_run(dst, s, run.clone());
+            }
+        }
+        if let Some(dst) = out.normals.as_mut() {
+            extend_from_run(dst, src.normals.as_deref().unwrap_or_default(), run.clone());
+        }
+        let tags = [
+            (&mut out.edge_tags, &src.edge_tags),
+            (&mut out.vertex_tags, &src.vertex_tags),
+        ];
+        for (dst, s) in tags {
+            if let Some(dst) = dst.as_mut() {
+                extend_from_run(dst, s.as_deref().unwrap_or_default(), run.clone());
+            }
+        }
+    }
+
     /// Appends face `face` of `src` with its holes.
     pub fn add_face(&mut self, src: &Mesh, out: &mut Mesh, face: usize) {
         let (material, group) = self.slots(src, face);
@@ -310,9 +343,7 @@ impl SubmeshBuilder {
         let loops = src.face_loops(face);
         for &l in loops {
             let start = out.corners.len() as u32;
-            for c in src.loop_corners(l) {
-                self.corner(src, out, c, None);
-            }
+            self.run_of_corners(src, out, src.loop_corners(l));
             out.loops.push(Loop { start, len: l.len });
         }
         out.faces.push(Face {
@@ -418,6 +449,15 @@ impl SubmeshBuilder {
     }
 }
 
+/// Appends `src[run]` to `dst`, the default value where `src` is shorter
+/// (as attributes missing on a corner are read).
+fn extend_from_run<T: Copy + Default>(dst: &mut Vec<T>, src: &[T], run: std::ops::Range<usize>) {
+    match src.get(run.clone()) {
+        Some(values) => dst.extend_from_slice(values),
+        None => dst.extend(run.map(|c| src.get(c).copied().unwrap_or_default())),
+    }
+}
+
 /// The elements `used` of `src`, in that order: `src` itself (shared) when
 /// that is all of it in order.
 fn pick<T: Clone>(src: &SharedVec<T>, used: &[u32]) -> SharedVec<T> {
@@ -434,6 +474,7 @@ mod tests {
     use super::*;
     use crate::measure::{face_area, mesh_area};
     use crate::primitive::cube;
+    use crate::DVec2;
 
     #[test]
     fn union_find_keeps_the_first_member_as_root() {
@@ -458,6 +499,53 @@ mod tests {
             total += mesh_area(&out);
         }
         assert!((total - 2.0 * (6.0 + 8.0 + 12.0)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn faces_copy_every_corner_attribute_as_corner_by_corner() {
+        let mut src = cube(DVec3::new(2.0, 3.0, 4.0));
+        let n = src.corners.len();
+        src.uvs[2] = Some((0..n).map(|c| DVec2::new(c as f64, -(c as f64))).collect());
+        // Shorter than the corners: the missing ones read as zero.
+        src.uvs[3] = Some(vec![DVec2::ONE; n - 3]);
+        src.normals = Some((0..n).map(|c| DVec3::new(0.0, c as f64, 1.0)).collect());
+        src.edge_tags = Some((0..n as u32).collect());
+        src.vertex_tags = Some((0..n as u32).map(|c| 100 + c).collect());
+        let mut b = SubmeshBuilder::new(&src);
+        for f in 0..src.faces.len() {
+            let mut out = b.begin(&src, false);
+            b.add_face(&src, &mut out, f);
+            b.finish(&src, &mut out);
+            let mut reference = b.begin(&src, false);
+            let first_loop = reference.loops.len() as u32;
+            for &l in src.face_loops(f) {
+                let start = reference.corners.len() as u32;
+                for c in src.loop_corners(l) {
+                    b.corner(&src, &mut reference, c, None);
+                }
+                reference.loops.push(Loop { start, len: l.len });
+            }
+            reference.faces.push(Face {
+                first_loop,
+                loop_count: src.face_loops(f).len() as u32,
+                ..src.faces[f]
+            });
+            b.finish(&src, &mut reference);
+            assert_eq!(out.positions, reference.positions, "face {f}");
+            assert_eq!(out.corners, reference.corners);
+            assert_eq!(out.uvs, reference.uvs);
+            assert_eq!(out.normals, reference.normals);
+            assert_eq!(out.edge_tags, reference.edge_tags);
+            assert_eq!(out.vertex_tags, reference.vertex_tags);
+            let last = src.loop_corners(src.outer_loop(f)).end - 1;
+            let expected_uv3 = if last < n - 3 {
+                DVec2::ONE
+            } else {
+                DVec2::ZERO
+            };
+            assert_eq!(out.uvs[3].as_ref().unwrap()[3], expected_uv3, "face {f}");
+            assert_eq!(out.edge_tags.as_ref().unwrap()[3], last as u32);
+        }
     }
 
     #[test]

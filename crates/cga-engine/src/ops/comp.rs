@@ -650,9 +650,8 @@ impl Components {
             Item::Faces { start, .. } => {
                 let f = self.face_list[start as usize] as usize;
                 let l = mesh.outer_loop(f);
-                let pts: Vec<DVec3> = mesh.loop_points(l).collect();
                 face_frame(
-                    &pts,
+                    mesh.loop_points(l),
                     self.face_normals[f],
                     stored_normal(mesh, l.start as usize),
                 )
@@ -661,7 +660,7 @@ impl Components {
                 let l = mesh.loops[lp as usize];
                 let mut pts: Vec<DVec3> = mesh.loop_points(l).collect();
                 reverse_keep_first(&mut pts);
-                face_frame(&pts, self.face_normals[face as usize], None)
+                face_frame(pts, self.face_normals[face as usize], None)
             }
             Item::Edge(e) => {
                 // The direction of the edge's first use (or an eave's roof face).

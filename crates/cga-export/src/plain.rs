@@ -120,6 +120,15 @@ pub(crate) fn fan_start(f: &FaceData) -> Option<u32> {
         return None;
     };
     let (s, n) = (outer.start, outer.len);
+    // A quad (most faces): two triangles, checked as arrays.
+    if n == 4 {
+        let &[[a, b, c], [d, e, g]] = f.triangles else {
+            return None;
+        };
+        let first = a.checked_sub(s).filter(|&k| k < 4)?;
+        let at = |i: u32| s + (first + i) % 4;
+        return ([b, c, d, e, g] == [at(1), at(2), at(0), at(2), at(3)]).then_some(first);
+    }
     let first = f.triangles.first()?[0].checked_sub(s)?;
     if f.triangles.len() + 2 != n as usize || first >= n {
         return None;
@@ -205,8 +214,11 @@ impl MeshArrays for PlainMesh {
     }
 
     fn push_fan(&mut self, f: &FaceData, uvs: Option<&[DVec2]>, first: u32, leaf: u32) {
-        let corners = fan_corners(f, first);
         let n = f.loops[0].len as usize;
+        if n == 4 {
+            return self.push_quad_fan(f, uvs, first, leaf);
+        }
+        let corners = fan_corners(f, first);
         let base = self.positions.len() as u32;
         self.positions
             .extend(corners.clone().map(|c| corner_position(f, c)));
@@ -261,6 +273,30 @@ impl MeshArrays for PlainMesh {
         fit(&mut self.uvs);
         fit(&mut self.indices);
         fit(&mut self.triangle_leaf);
+    }
+}
+
+impl PlainMesh {
+    /// [`MeshArrays::push_fan`] for a quad (most faces): the same values,
+    /// its four corners read as an array rather than round the loop.
+    fn push_quad_fan(&mut self, f: &FaceData, uvs: Option<&[DVec2]>, first: u32, leaf: u32) {
+        let s = f.loops[0].start as usize;
+        let k = first as usize;
+        let corners = [0, 1, 2, 3].map(|i| s + (k + i) % 4);
+        let base = self.positions.len() as u32;
+        self.positions
+            .extend_from_slice(&corners.map(|c| corner_position(f, c)));
+        match f.normals {
+            Some(normals) => self
+                .normals
+                .extend_from_slice(&corners.map(|c| normals[c].to_array())),
+            None => self.normals.extend_from_slice(&[f.normal().to_array(); 4]),
+        }
+        self.uvs
+            .extend_from_slice(&corners.map(|c| corner_uv(uvs, c)));
+        self.indices
+            .extend_from_slice(&[[base, base + 1, base + 2], [base, base + 2, base + 3]]);
+        self.triangle_leaf.extend_from_slice(&[leaf; 2]);
     }
 }
 
@@ -423,6 +459,37 @@ impl<M: MeshArrays> Collector<M> {
 pub(crate) mod tests {
     use super::*;
     use cga_geometry::DVec3;
+
+    #[test]
+    fn a_quad_is_a_fan_from_any_of_its_corners_or_none() {
+        let mut mesh = cga_geometry::primitive::quad(2.0, 3.0);
+        // Corners 5..9 of a mesh whose first loop is elsewhere.
+        mesh.corners.splice(0..0, [0; 5]);
+        mesh.loops[0].start = 5;
+        let fan = |triangles: &[[u32; 3]]| {
+            fan_start(&FaceData {
+                mesh: &mesh,
+                positions: &mesh.positions,
+                normals: None,
+                loops: &mesh.loops,
+                material: 0,
+                known_normal: Some(DVec3::Y),
+                triangles,
+            })
+        };
+        let c = |k: u32| 5 + k % 4;
+        for first in 0..4 {
+            let triangles = [
+                [c(first), c(first + 1), c(first + 2)],
+                [c(first), c(first + 2), c(first + 3)],
+            ];
+            assert_eq!(fan(&triangles), Some(first));
+        }
+        assert_eq!(fan(&[[5, 6, 8], [6, 7, 8]]), None);
+        assert_eq!(fan(&[[5, 6, 7], [5, 8, 7]]), None);
+        assert_eq!(fan(&[[9, 6, 7], [9, 7, 8]]), None);
+        assert_eq!(fan(&[[5, 6, 7]]), None);
+    }
 
     #[test]
     fn a_cube_gives_twelve_triangles_of_one_material() {

@@ -272,6 +272,8 @@ impl Components {
         match self.kind {
             Kind::Faces => {
                 self.face_list = (0..n_faces as u32).collect();
+                self.items.reserve_exact(n_faces);
+                self.item_normals.reserve_exact(n_faces);
                 for f in 0..n_faces as u32 {
                     self.items.push(Item::Faces { start: f, len: 1 });
                     self.item_normals.push(self.face_normals[f as usize]);

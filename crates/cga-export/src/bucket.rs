@@ -156,10 +156,15 @@ impl Bucket {
     }
 
     /// The data in its arrays (of a bucket filled by pushes alone),
-    /// leaving fresh arrays with room for as much.
+    /// leaving fresh arrays with room for as much and a quarter more.
     pub fn take_leaving_room(&mut self) -> Bucket {
         debug_assert!(self.sealed.is_empty());
-        self.take_arrays(self.positions.len(), self.indices.len())
+        // The next batch of a material is about as large, often a little
+        // larger: without the slack its arrays grew (a copy of each) in a
+        // batch of every few (20 Candler buildings: 17 M instructions).
+        // Room never written is not memory the process touches.
+        let slack = |n: usize| n + n / 4;
+        self.take_arrays(slack(self.positions.len()), slack(self.indices.len()))
     }
 
     /// Room for `n` more vertices.

@@ -162,9 +162,21 @@ pub fn triangulate_finite_quad(
         return;
     }
     let l = largest_magnitude(&[r1, r2, r3]);
-    let big = largest_magnitude(&[p0, p1, p2, p3]);
     let a = largest_magnitude(&[n]);
-    match diagonal_by_sign(c1.dot(n), c2.dot(n), l, big, a) {
+    let (a1, a2) = (c1.dot(n), c2.dot(n));
+    // Most quads are convex and far from degenerate: both areas are
+    // positive beyond the threshold even with a bound on the corners'
+    // magnitude from corner 0 alone (every corner is within `l` of it in
+    // each coordinate; the factor covers the rounding of the edges). A
+    // larger `big` only raises the threshold, so what this decides the
+    // exact test decides the same way; the rest take that test.
+    let big_bound = (largest_magnitude(&[p0]) + l) * (1.0 + 1e-9);
+    if diagonal_by_sign(a1, a2, l, big_bound, a) == Some(true) {
+        push_quad(outer.start, true, out);
+        return;
+    }
+    let big = largest_magnitude(&[p0, p1, p2, p3]);
+    match diagonal_by_sign(a1, a2, l, big, a) {
         Some(first) => push_quad(outer.start, first, out),
         None => {
             let unit = crate::measure::unit_newell(n);

@@ -395,6 +395,9 @@ pub struct Interp<'a> {
     /// derivation.
     arg_pool: Vec<Vec<Arg>>,
     frame_pool: Vec<Vec<Value>>,
+    /// The room of splits, one per level of splits in progress (see
+    /// `ops::split::SplitScratch`).
+    pub(crate) split_scratch: Vec<crate::ops::split::SplitScratch>,
     pub(crate) memo: MeshMemo,
     pub(crate) material_memo: MaterialMemo,
     /// The final materials of recently emitted leaves (see `leaf_materials`).
@@ -687,6 +690,7 @@ impl<'a> Interp<'a> {
             emitted: EmitCache::default(),
             arg_pool: Vec::new(),
             frame_pool: Vec::new(),
+            split_scratch: Vec::new(),
             memo: MeshMemo::default(),
             material_memo: MaterialMemo::default(),
             context: None,

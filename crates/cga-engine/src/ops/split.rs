@@ -20,7 +20,7 @@ use super::transform::selector;
 use crate::derive::{Arg, Interp, RtError, ShapeState, SizeKind};
 use crate::expr::{OpCall, RBlock, RBody, RExpr, RPart};
 use crate::shape::{Geometry, Shape};
-use crate::split_layout::{Placed, Size, SplitPattern};
+use crate::split_layout::{Placed, Size, SplitLayouter, SplitPattern};
 
 /// Parts thinner than this (in scene units) are not created. Relative
 /// splits that recurse forever (the golden-ratio example "stops when the
@@ -50,16 +50,52 @@ pub fn exec(
         Some(a) => selector(a, &["adjust", "noAdjust"])? == "adjust",
         None => true,
     };
+    // The pattern and layout of this split stay in use while its parts'
+    // rules run (splits of their own included): each split level takes a
+    // scratch of its own from the pool and gives it back.
+    let mut scratch = cx.split_scratch.pop().unwrap_or_default();
+    let result = split_axis(cx, st, call, frame, block, axis, adjust, &mut scratch);
+    cx.split_scratch.push(scratch);
+    result
+}
 
-    let mut pattern = SplitPattern::new(block.repeat);
+/// The room a split fills and empties again: its evaluated pattern, the
+/// layout's own scratch and the parts placed. A building's facade makes
+/// thousands of splits; allocating these anew for each was five
+/// allocations a split.
+#[derive(Default)]
+pub(crate) struct SplitScratch {
+    pattern: SplitPattern,
+    layouter: SplitLayouter,
+    placed: Vec<Placed>,
+}
+
+/// `split` along scope axis `axis`, with `scratch` as its room.
+#[allow(clippy::too_many_arguments)]
+fn split_axis(
+    cx: &mut Interp,
+    st: &mut ShapeState,
+    call: &OpCall,
+    frame: &[Value],
+    block: &RBlock<RBody>,
+    axis: usize,
+    adjust: bool,
+    scratch: &mut SplitScratch,
+) -> Result<(), RtError> {
+    let SplitScratch {
+        pattern,
+        layouter,
+        placed,
+    } = scratch;
+    pattern.reset(block.repeat);
     let mut bodies: Vec<&RBody> = Vec::new();
-    add_parts(cx, frame, &st.shape, block, &mut pattern, &mut bodies)?;
+    add_parts(cx, frame, &st.shape, block, pattern, &mut bodies)?;
     let size = st.shape.scope.size[axis];
-    let placed: Vec<Placed> = crate::split_layout::layout(&pattern, size.abs())
-        .map_err(|e| RtError::new(format!("split: {e}"), call.span))?
-        .into_iter()
-        .filter(|p| p.end - p.start >= MIN_PART_SIZE)
-        .collect();
+    layouter
+        .layout(pattern, size.abs(), placed)
+        .map_err(|e| RtError::new(format!("split: {e}"), call.span))?;
+    placed.retain(|p| p.end - p.start >= MIN_PART_SIZE);
+    let placed = &placed[..];
     st.has_successor = true;
     if placed.is_empty() {
         return Ok(());
@@ -67,7 +103,7 @@ pub fn exec(
     cx.check_shape_budget(placed.len(), call.span)?;
 
     let sign = if size < 0.0 { -1.0 } else { 1.0 };
-    let pieces = cut_parts(st.shape.geometry.local(), axis, sign, &placed);
+    let pieces = cut_parts(st.shape.geometry.local(), axis, sign, placed);
     let total = placed.len() as f64;
     for (part, piece) in placed.iter().zip(pieces) {
         let mut child = cx.child(&st.shape, call.span)?;

@@ -300,6 +300,35 @@ fn split_index_and_total() {
     assert_eq!(g.prints(), ["(2)[0,0]", "(2)[0,3]", "(2)[1,3]", "(2)[2,3]"]);
 }
 
+/// Splits within the parts of a split, each level with a pattern of its
+/// own (a repeat inside fixed parts, floating parts inside a repeat), and a
+/// split after them on the same level: every part keeps its own index,
+/// total and size, as the levels' patterns and layouts are in use at once.
+#[test]
+fn nested_and_sibling_splits_keep_their_own_parts() {
+    let src = "Lot --> extrude(6) split(y) { 2 : A | ~1 : B | 1 : C }\n\
+               A --> split(x) { 4 : print(\"a \" + split.index + \"/\" + split.total + \" \" + scope.sx) X. }*\n\
+               B --> split(x) { { ~1 : Q | 2 : R }* | 1 : S }\n\
+               Q --> split(z) { '0.5 : print(\"q \" + split.index + \"/\" + split.total + \" \" + scope.sz) X. }*\n\
+               R --> print(\"r \" + split.index + \"/\" + split.total + \" \" + scope.sx) X.\n\
+               S --> print(\"s \" + split.index + \"/\" + split.total + \" \" + scope.sx) X.\n\
+               C --> split(x) { ~1 : print(\"c \" + split.index + \"/\" + split.total + \" \" + scope.sx) X. | 3 : X. }\n";
+    let g = gen_with(src, &Opts::rect(20.0, 10.0)).ok();
+    // A: five 4 m parts of 20 m. B: 19 m of repeats of (floating, 2 m),
+    // then 1 m: six repeats, each Q split in two halves of the lot's 10 m
+    // depth. C: 17 m floating, then 3 m.
+    // In derivation order: C's rule runs before those of B's parts.
+    let mut expected: Vec<String> = (0..5).map(|i| format!("a {i}/5 4")).collect();
+    expected.push("c 0/2 17".to_string());
+    for k in 0..6 {
+        expected.push("q 0/2 5".to_string());
+        expected.push("q 1/2 5".to_string());
+        expected.push(format!("r {}/13 2", 2 * k + 1));
+    }
+    expected.push("s 12/13 1".to_string());
+    assert_eq!(g.prints(), expected);
+}
+
 // ---------------------------------------------------------------------------
 // case chains
 // ---------------------------------------------------------------------------

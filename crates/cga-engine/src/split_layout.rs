@@ -431,6 +431,12 @@ impl Slot {
 #[derive(Clone, Debug, Default)]
 pub struct SplitLayouter {
     slots: Vec<Slot>,
+    /// Rule 1b's candidates: the counts being tried, a copy of them that
+    /// rule 2 completes, and the best so far (kept to spare the
+    /// allocations of a facade's thousands of splits).
+    candidate: Vec<Slot>,
+    trial: Vec<Slot>,
+    best: Vec<Slot>,
 }
 
 /// Lays out `pattern` on `length` into a new vector. Convenience for [`SplitLayouter::layout`].
@@ -668,24 +674,28 @@ impl SplitLayouter {
         tol: f64,
         budget: &mut Budget,
     ) -> Result<(), LayoutError> {
-        let trial = |slots: &[Slot], rest: f64| -> f64 {
-            let mut slots = slots.to_vec();
+        let trial = |slots: &[Slot], into: &mut Vec<Slot>, rest: f64| -> f64 {
+            into.clear();
+            into.extend_from_slice(slots);
             let mut rest = rest;
             let mut scratch = Budget::new(0);
-            match assign_floating_repeats(
-                &mut slots,
-                &mut rest,
-                floating_outside,
-                tol,
-                &mut scratch,
-            ) {
+            match assign_floating_repeats(into, &mut rest, floating_outside, tol, &mut scratch) {
                 Ok(floating) => stretch(rest, floating, tol),
                 Err(_) => f64::INFINITY,
             }
         };
-        let mut slots = self.slots.clone();
+        let SplitLayouter {
+            slots: own,
+            candidate: slots,
+            trial: tried,
+            best: best_slots,
+        } = self;
+        slots.clear();
+        slots.extend_from_slice(own);
+        best_slots.clear();
+        best_slots.extend_from_slice(slots);
         let mut r = *rest;
-        let mut best = (trial(&slots, r), slots.clone(), r);
+        let mut best = (trial(slots, tried, r), r);
         let mut previous = best.0;
         // Each give-back raises the floating scale; past its best the stretch only grows.
         for _ in 0..MAX_PARTS {
@@ -697,23 +707,24 @@ impl SplitLayouter {
             };
             slots[j].count -= 1;
             r += slots[j].fixed;
-            let st = trial(&slots, r);
+            let st = trial(slots, tried, r);
             if st < best.0 - STRETCH_EPSILON {
-                best = (st, slots.clone(), r);
+                best = (st, r);
+                best_slots.clear();
+                best_slots.extend_from_slice(slots);
             } else if st > previous + STRETCH_EPSILON {
                 break;
             }
             previous = st;
         }
-        let (_, chosen, chosen_rest) = best;
-        let given_back: usize = self
-            .slots
+        let (_, chosen_rest) = best;
+        let given_back: usize = own
             .iter()
-            .zip(&chosen)
+            .zip(best_slots.iter())
             .map(|(a, b)| (a.count - b.count) as usize * a.parts)
             .sum();
         budget.add(-(given_back as f64))?;
-        self.slots = chosen;
+        std::mem::swap(own, best_slots);
         *rest = chosen_rest;
         Ok(())
     }

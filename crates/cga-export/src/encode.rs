@@ -96,11 +96,10 @@ impl Encoded {
     /// `Bucket::append`). A batch is about as large as the one before it,
     /// so its arrays (with a quarter more room, see
     /// `Bucket::take_leaving_room`) seldom grow past the room they start
-    /// with. (Copying
-    /// each batch into arrays of its exact size, as before, cost a copy of
-    /// every encoded byte; reusing the arrays of appended batches, before
-    /// that, made every array in flight grow to the most any material ever
-    /// needed.)
+    /// with. (Copying each batch into arrays of its exact size, as before,
+    /// cost a copy of every encoded byte; reusing the arrays of appended
+    /// batches, before that, made every array in flight grow to the most
+    /// any material ever needed.)
     fn take_batch(&mut self, materials: Vec<Material>) -> Encoded {
         let out = Encoded {
             buckets: self

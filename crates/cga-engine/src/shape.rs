@@ -293,6 +293,37 @@ pub struct Shape {
 }
 
 impl Shape {
+    /// An empty shape sharing nothing that other shapes change: what a
+    /// shape's state keeps once the shape went on as its own successor
+    /// (`Interp::last_child`). Nothing reads it.
+    pub(crate) fn husk() -> Shape {
+        let frame = Frame {
+            origin: DVec3::ZERO,
+            axes: DMat3::IDENTITY,
+        };
+        Shape {
+            scope: Scope {
+                frame,
+                size: DVec3::ZERO,
+                rot: DVec3::ZERO,
+            },
+            pivot: frame,
+            geometry: Geometry::empty(),
+            parent_center: DVec3::ZERO,
+            material: Arc::new(MaterialOverrides::default()),
+            attrs: None,
+            split_index: 0.0,
+            split_total: 0.0,
+            comp: None,
+            trim: TrimFlags::default(),
+            projections: None,
+            rng: Cell::new(0),
+            seedian: 0.0,
+            name: 0,
+            ctx: 0,
+        }
+    }
+
     /// The value of attribute `id` set on this shape, if any.
     pub fn attr_override(&self, id: AttrId) -> Option<&Value> {
         self.attrs

@@ -329,6 +329,58 @@ fn nested_and_sibling_splits_keep_their_own_parts() {
     assert_eq!(g.prints(), expected);
 }
 
+/// A shape's last statement hands the shape itself on as its successor
+/// (its box, its random stream, its material and geometry); any other
+/// statement hands on a copy. Both successors are the same: with `NIL`
+/// after each successor (the shape then ends deleted, which leaves no leaf
+/// of its own) the prints, the random numbers, `center`'s reference to the
+/// parent's scope and every leaf's geometry and material are those of the
+/// rules without it. Split parts and component shapes, whose states end
+/// with a rule too, take their turn in between.
+#[test]
+fn a_last_statement_hands_on_the_same_successor_as_any_other() {
+    let rules = |end: &str| {
+        format!(
+            "Lot --> extrude(4) A{end}\n\
+             A --> t(1,0,0) set(material.color.r, 0.5) B{end}\n\
+             B --> print(rand()) s('0.5,'1,'1) center(x) print(scope.tx) split(x) {{ 1 : P{end} | ~1 : Q{end} }}*\n\
+             P --> print(\"p \" + split.index + \" \" + rand()) comp(f) {{ top : T{end} | side : S. }}\n\
+             Q --> print(\"q \" + rand()) color(\"#336699\") X.{end}\n\
+             T --> print(\"t \" + rand() + \" \" + scope.sx) Y.{end}\n"
+        )
+    };
+    let last = gen_with(&rules(""), &Opts::rect(10.0, 6.0)).ok();
+    let copied = gen_with(&rules(" NIL"), &Opts::rect(10.0, 6.0)).ok();
+    assert_eq!(last.prints(), copied.prints());
+    // B is 5 m wide after `s('0.5,...)`, centred in A's 10 m: x from 3.5
+    // (A was moved by 1 m); three repeats of a 1 m part P and a floating
+    // part Q of 2/3 m.
+    let prints = last.prints();
+    assert_eq!(prints[1], "3.5");
+    assert_eq!(prints.iter().filter(|p| p.starts_with("p ")).count(), 3);
+    assert_eq!(prints.iter().filter(|p| p.starts_with("q ")).count(), 3);
+    assert_eq!(
+        prints[2..5],
+        [
+            "p 0 0.10567514085496",
+            "q 0.683141746106393",
+            "p 2 0.970772588856274"
+        ]
+    );
+    assert_eq!(prints.iter().filter(|p| p.starts_with("t ")).count(), 3);
+    let (a, b) = (last.meshes(), copied.meshes());
+    assert_eq!(a.len(), b.len());
+    // Q's three boxes, and per P its four sides and its top.
+    assert_eq!(a.len(), 3 + 3 * 5);
+    for (m, n) in a.iter().zip(b) {
+        assert_eq!(m.positions, n.positions);
+        assert_eq!(m.materials[0].color, n.materials[0].color);
+    }
+    assert!(a
+        .iter()
+        .all(|m| m.materials[0].color[0] == 0.5 || m.materials[0].color == [0.2, 0.4, 0.6]));
+}
+
 // ---------------------------------------------------------------------------
 // case chains
 // ---------------------------------------------------------------------------

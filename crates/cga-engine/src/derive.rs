@@ -220,6 +220,9 @@ pub struct ShapeState {
     /// `shape` is a husk from `Interp::husks`: the shape itself went to its
     /// successor (see `Interp::last_child`).
     husked: bool,
+    /// The operation running is the last statement of the shape's
+    /// operations: it may hand the shape itself on to its last successor.
+    pub(crate) at_last: bool,
 }
 
 impl ShapeState {
@@ -229,6 +232,7 @@ impl ShapeState {
             has_successor: false,
             deleted: false,
             husked: false,
+            at_last: false,
         }
     }
 }
@@ -1026,7 +1030,11 @@ impl<'a> Interp<'a> {
     /// not mistaken for an inserted asset. Cloning the shape into a new box
     /// and dropping the old one cost an allocation, a free, a copy of its
     /// 480 bytes and two atomic operations per shared part.
-    fn last_child(&mut self, st: &mut ShapeState, span: Span) -> Result<Box<Shape>, RtError> {
+    pub(crate) fn last_child(
+        &mut self,
+        st: &mut ShapeState,
+        span: Span,
+    ) -> Result<Box<Shape>, RtError> {
         self.count_shape(span)?;
         let husk = match self.husks.pop() {
             Some(h) => h,
@@ -1034,6 +1042,8 @@ impl<'a> Interp<'a> {
         };
         let mut c = std::mem::replace(&mut st.shape, husk);
         st.husked = true;
+        // Messages about the statement name the shape's rule.
+        st.shape.name = c.name;
         // What `successor` does to its copy of the parent, in the same order
         // (the parent's stream moves on before the child's is derived).
         let rng = c.child_rng(c.next_random().to_bits());
@@ -1344,6 +1354,7 @@ impl<'a> Interp<'a> {
                         }
                     }
                 }
+                st.at_last = last;
                 let skip = non_finite_arg(call.op, &args);
                 let r = match skip {
                     Some(k) => Err(RtError::non_finite(

@@ -105,8 +105,14 @@ fn split_axis(
     let sign = if size < 0.0 { -1.0 } else { 1.0 };
     let pieces = cut_parts(st.shape.geometry.local(), axis, sign, placed);
     let total = placed.len() as f64;
-    for (part, piece) in placed.iter().zip(pieces) {
-        let mut child = cx.child(&st.shape, call.span)?;
+    let last = placed.len() - 1;
+    for (k, (part, piece)) in placed.iter().zip(pieces).enumerate() {
+        // A split that ends the shape's operations hands the shape itself
+        // on to its last part (see `Interp::last_child`).
+        let mut child = match st.at_last && k == last {
+            true => cx.last_child(st, call.span)?,
+            false => cx.child(&st.shape, call.span)?,
+        };
         if cx.builds_parts(bodies[part.part]) {
             place_part(
                 &mut child,

@@ -1364,7 +1364,8 @@ pub(crate) fn run(
     let mesh = st.shape.geometry.local().clone();
     let mut comps = Components::new(mesh, kind, &st.shape, cx.initial.pivot.axes);
     let mut taken = vec![false; comps.len()];
-    for entry in entries {
+    let last_entry = entries.len().saturating_sub(1);
+    for (e, entry) in entries.into_iter().enumerate() {
         let (text, expr) = split_head(entry.head);
         let selected = select(cx, frame, &st.shape, &mut comps, expr, &mut taken)?;
         if selected.is_empty() {
@@ -1384,7 +1385,13 @@ pub(crate) fn run(
         // of its geometry shows.
         let build = kind != Kind::Faces || cx.builds_parts(entry.body);
         for (i, set) in sets.iter().enumerate() {
-            let mut child = cx.child(&st.shape, entry.head.span)?;
+            // A component split that ends the shape's operations hands the
+            // shape itself on to the last component of its last entry
+            // (earlier entries' selections still read the shape).
+            let mut child = match st.at_last && e == last_entry && i + 1 == sets.len() {
+                true => cx.last_child(st, entry.head.span)?,
+                false => cx.child(&st.shape, entry.head.span)?,
+            };
             if skip {
                 continue;
             }

@@ -331,8 +331,8 @@ fn nested_and_sibling_splits_keep_their_own_parts() {
 
 /// A shape's last statement hands the shape itself on as its successor
 /// (its box, its random stream, its material and geometry), and a split
-/// that is the last statement hands it on to its last part; any other
-/// statement hands on a copy. Both successors are the same: with `NIL`
+/// or component split that is the last statement hands it on to its last
+/// part or component; any other statement hands on a copy. Both successors are the same: with `NIL`
 /// after each successor (the shape then ends deleted, which leaves no leaf
 /// of its own) the prints, the random numbers, `center`'s reference to the
 /// parent's scope and every leaf's geometry and material are those of the
@@ -345,7 +345,7 @@ fn a_last_statement_hands_on_the_same_successor_as_any_other() {
             "Lot --> extrude(4) A{end}\n\
              A --> t(1,0,0) set(material.color.r, 0.5) B{end}\n\
              B --> print(rand()) s('0.5,'1,'1) center(x) print(scope.tx) split(x) {{ 1 : P{end} | ~1 : Q{end} }}*{end}\n\
-             P --> print(\"p \" + split.index + \" \" + rand()) comp(f) {{ top : T{end} | side : S. }}\n\
+             P --> print(\"p \" + split.index + \" \" + rand()) comp(f) {{ top : T{end} | side : S. }}{end}\n\
              Q --> print(\"q \" + rand()) color(\"#336699\") X.{end}\n\
              T --> print(\"t \" + rand() + \" \" + scope.sx) Y.{end}\n"
         )

@@ -1038,7 +1038,7 @@ impl<'a> Interp<'a> {
         self.count_shape(span)?;
         let husk = match self.husks.pop() {
             Some(h) => h,
-            None => Box::new(Shape::husk()),
+            None => Box::new(Shape::blank()),
         };
         let mut c = std::mem::replace(&mut st.shape, husk);
         st.husked = true;

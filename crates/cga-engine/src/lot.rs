@@ -15,8 +15,7 @@ use std::sync::Arc;
 use cga_geometry::{DMat3, DVec3, Mesh};
 use cga_value::Value;
 
-use crate::material_attr::MaterialOverrides;
-use crate::shape::{Frame, Geometry, Scope, Shape, TrimFlags};
+use crate::shape::{Frame, Geometry, Scope, Shape};
 
 /// One lot: its polygon (object coordinates) and per-lot attribute values.
 #[derive(Clone, Debug)]
@@ -237,17 +236,10 @@ pub fn initial_shape(lot: &Lot, seed: u64, name: u32) -> Shape {
         pivot,
         geometry: Geometry::new(Arc::new(mesh)),
         parent_center: scope.center(),
-        material: Arc::new(MaterialOverrides::default()),
-        attrs: None,
-        split_index: 0.0,
-        split_total: 0.0,
-        comp: None,
-        trim: TrimFlags::default(),
-        projections: None,
         rng: std::cell::Cell::new(seed_stream(seed as f64)),
         seedian: seed as f64,
         name,
-        ctx: 0,
+        ..Shape::blank()
     }
 }
 

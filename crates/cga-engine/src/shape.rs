@@ -293,10 +293,12 @@ pub struct Shape {
 }
 
 impl Shape {
-    /// An empty shape sharing nothing that other shapes change: what a
-    /// shape's state keeps once the shape went on as its own successor
-    /// (`Interp::last_child`). Nothing reads it.
-    pub(crate) fn husk() -> Shape {
+    /// A shape with nothing set: no geometry, the identity frame for scope
+    /// and pivot, its own default material, no attributes, component or
+    /// projection info. The initial shape starts from it, and it is the
+    /// husk a shape's state keeps once the shape went on as its own
+    /// successor (`Interp::last_child`), sharing nothing other shapes change.
+    pub(crate) fn blank() -> Shape {
         let frame = Frame {
             origin: DVec3::ZERO,
             axes: DMat3::IDENTITY,

@@ -153,7 +153,8 @@ class Limits:
 class Mesh:
     """The triangles of one material: ``positions`` and ``normals``
     (n, 3) float64, ``uvs`` (n, 2) float64, ``indices`` (m, 3) uint32 into
-    them (counter-clockwise seen from the normal's side). y is up."""
+    them (counter-clockwise seen from the normal's side). y is up. Generated
+    with ``geometry="positions"``: ``normals`` and ``uvs`` are None."""
 
     __slots__ = ("material", "positions", "normals", "uvs", "indices", "_material_index")
 
@@ -396,7 +397,11 @@ class Rules:
         ``attrs``: attribute values for every lot (a dict), or one dict
         per lot (a list). ``seed``: the run's seed. ``jobs``: threads
         (default: all cores). ``geometry=False``: reports, prints and
-        errors only. ``output``: write the models into this ``.glb``,
+        errors only; ``geometry="positions"``: meshes of positions and
+        triangles alone (the same triangles, each leaf's faces sharing a
+        vertex where they meet, as its mesh has it; ``normals`` and
+        ``uvs`` are None), lighter and faster when only the shape of the
+        model counts (volumes, footprints, ``to_trimesh()``). ``output``: write the models into this ``.glb``,
         ``.gltf`` or ``.obj`` file as they are generated (memory stays
         flat however many lots); the returned models then have no meshes.
         ``progress``: a tqdm bar (True; by default from 1,000 lots when
@@ -415,6 +420,12 @@ class Rules:
         if invalid not in ("raise", "report"):
             raise ValueError(f"invalid must be 'raise' or 'report', not {invalid!r}")
         skip = invalid == "report"
+        if isinstance(geometry, str):
+            if geometry != "positions":
+                raise ValueError(f'geometry must be True, False or "positions", not {geometry!r}')
+            kind = "positions"
+        else:
+            kind = "meshes" if geometry else "none"
         native_lots, common = _normalize(lots, attrs, self._native.attribute_names(), skip=skip)
         if self.has_errors:
             raise RuleError(self.diagnostics)
@@ -424,7 +435,7 @@ class Rules:
             lim = (limits.max_depth, limits.max_shapes, float(limits.max_seconds), limits.max_faces)
         try:
             models, stats, bad = self._native.generate(
-                native_lots, common, int(seed), start_rule, jobs, bool(geometry),
+                native_lots, common, int(seed), start_rule, jobs, kind,
                 None if output is None else os.path.abspath(os.fspath(output)),
                 callback, lim, int(first_index), skip,
             )
@@ -471,6 +482,9 @@ def write(models, path):
     the models find them. Returns the counts written (``faces``,
     ``triangles``) and ``warnings``."""
     models = list(models)
+    if any(k.normals is None for m in models for k in m.meshes):
+        raise ValueError('models generated with geometry="positions" have no normals or '
+                         'texture coordinates to write: generate them with geometry=True')
     rules = next((m._rules._native for m in models if m._rules is not None), None)
     data = [
         (m._native_materials,

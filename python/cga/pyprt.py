@@ -177,7 +177,10 @@ class ModelGenerator:
         kind = ENCODERS[geometry_encoder]
         emit_geometry = options.get("emitGeometry", True)
         if kind is None:
-            models = rules.generate(lots, attrs=per_lot, geometry=emit_geometry, progress=False)
+            # Vertices and faces alone, as PyEncoder gives them: positions
+            # shared where a leaf's faces meet.
+            geometry = "positions" if emit_geometry else False
+            models = rules.generate(lots, attrs=per_lot, geometry=geometry, progress=False)
             return [GeneratedModel(m.index, m) for m in models]
         out_dir = options.get("outputPath", ".")
         os.makedirs(out_dir, exist_ok=True)

@@ -194,7 +194,9 @@ impl NativeRules {
 
     /// Generates `lots`: each `(name, polygons, gis_axes, attrs)` with
     /// polygons as lists of `(n, 3)` float64 rings. `geometry`: keep plain
-    /// meshes; `output`: write them into this file instead (streamed).
+    /// meshes (`"meshes"`), positions and triangles alone (`"positions"`)
+    /// or none (`"none"`); `output`: write the models into this file
+    /// instead (streamed).
     /// `progress(done)` is called on this thread at most ten times a second.
     /// `first_index`: the index of the first lot in a larger run (a Dask
     /// partition's place): lots then get the seeds they have in that run.
@@ -212,7 +214,7 @@ impl NativeRules {
         seed: u64,
         start_rule: Option<String>,
         jobs: Option<usize>,
-        geometry: bool,
+        geometry: &str,
         output: Option<PathBuf>,
         progress: Option<Bound<'py, PyAny>>,
         limits: Option<(usize, usize, f64, usize)>,
@@ -277,11 +279,17 @@ impl NativeRules {
         // within milliseconds.
         let (tx, rx) = mpsc::channel::<LotResult>();
         let rx = Mutex::new(rx);
-        let target = if geometry && output.is_none() {
-            Target::Meshes
-        } else {
-            Target::Nothing
+        let target = match (geometry, &output) {
+            (_, Some(_)) | ("none", _) => Target::Nothing,
+            ("meshes", None) => Target::Meshes,
+            ("positions", None) => Target::Positions,
+            (other, None) => {
+                return Err(PyValueError::new_err(format!(
+                    "geometry must be True, False or \"positions\", not {other:?}"
+                )))
+            }
         };
+        let positions_only = matches!(target, Target::Positions);
         let run = || -> Result<Option<cga::ExportStats>, Error> {
             let tx = tx;
             let send = |r: LotResult| {
@@ -322,7 +330,7 @@ impl NativeRules {
                 match got {
                     Ok(result) => {
                         if failure.is_none() {
-                            match model_dict(py, result) {
+                            match model_dict(py, result, positions_only) {
                                 Ok(d) => models.push(d),
                                 Err(e) => {
                                     cancel.cancel();
@@ -579,7 +587,13 @@ fn array<'py, T: numpy::Element, const N: usize>(
 }
 
 /// A lot's result as a dict (its index: its place in the whole run).
-fn model_dict(py: Python<'_>, r: LotResult) -> PyResult<Bound<'_, PyDict>> {
+/// `positions_only`: its meshes have no normals or texture coordinates
+/// (given as None).
+fn model_dict(
+    py: Python<'_>,
+    r: LotResult,
+    positions_only: bool,
+) -> PyResult<Bound<'_, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("index", r.index)?;
     d.set_item("name", &r.name)?;
@@ -620,8 +634,14 @@ fn model_dict(py: Python<'_>, r: LotResult) -> PyResult<Bound<'_, PyDict>> {
                 [
                     material.into_py_any(py)?,
                     array(py, positions).into_any().unbind(),
-                    array(py, normals).into_any().unbind(),
-                    array(py, uvs).into_any().unbind(),
+                    match positions_only {
+                        true => py.None(),
+                        false => array(py, normals).into_any().unbind(),
+                    },
+                    match positions_only {
+                        true => py.None(),
+                        false => array(py, uvs).into_any().unbind(),
+                    },
                     array(py, indices).into_any().unbind(),
                 ],
             )

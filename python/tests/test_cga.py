@@ -298,6 +298,39 @@ def test_to_trimesh(box):
     assert t.bounds.tolist() == [[0, 0, -30], [20, 10, 0]]
 
 
+def triangles_by_position(model):
+    """The model's triangles as sorted rows of their nine coordinates."""
+    rows = [m.positions[m.indices.astype(np.int64)].reshape(-1, 9) for m in model.meshes]
+    return sorted(map(tuple, np.vstack(rows).tolist()))
+
+
+def test_positions_alone(tmp_path, box):
+    mass = cga.Rules.from_string("attr h = 10\nLot --> extrude(h) Mass.\n")
+    lot = shapely.box(0, 0, 20, 30)
+    [m] = mass.generate(lot, geometry="positions")
+    [full] = mass.generate(lot)
+    [k] = m.meshes
+    # One leaf, a closed box: its six faces share its eight corners.
+    assert k.positions.shape == (8, 3) and k.indices.shape == (12, 3)
+    assert k.normals is None and k.uvs is None
+    assert full.meshes[0].positions.shape == (24, 3)
+    assert triangles_by_position(m) == triangles_by_position(full)
+    # Shared corners make a closed surface: its signed volume is the box's.
+    p = k.positions[k.indices.astype(np.int64)]
+    volume = np.einsum("ij,ij->i", p[:, 0], np.cross(p[:, 1], p[:, 2])).sum() / 6
+    assert volume == pytest.approx(20 * 30 * 10)
+    # The box of comp's faces: each face its own leaf, the same triangles
+    # and reports.
+    [b] = box.generate(lot, geometry="positions")
+    [bf] = box.generate(lot)
+    assert triangles_by_position(b) == triangles_by_position(bf)
+    assert b.reports == bf.reports == {"roof": 600.0, "walls": 4.0}
+    with pytest.raises(ValueError, match="positions"):
+        cga.write([b], str(tmp_path / "b.glb"))
+    with pytest.raises(ValueError, match="geometry must be"):
+        box.generate(lot, geometry="normals")
+
+
 def test_prints_and_progress(box):
     rules = cga.Rules.from_string('Lot --> print("lot " + geometry.area) X.')
     seen = []

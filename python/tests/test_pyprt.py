@@ -67,6 +67,10 @@ def test_candler_geometry_matches_prt(tmp_path):
     assert area == pytest.approx(want["totals"]["area"], rel=1e-3)
     assert v.min(axis=0) == pytest.approx(want["bbox"]["min"], abs=1e-3)
     assert v.max(axis=0) == pytest.approx(want["bbox"]["max"], abs=1e-3)
+    # Vertices shared where a leaf's faces meet, as PRT shares them: about
+    # as many as PRT gives (85,777), half of a vertex per face corner.
+    assert len(v) < 1.2 * want["totals"]["vertices"]
+    assert len(np.unique(idx)) == len(v)
     # The GLTF encoder writes a GLB where outputPath and baseName say.
     pyprt.ModelGenerator([shape]).generate_model(
         [{}], rpk, "com.esri.prt.codecs.GLTFEncoder",

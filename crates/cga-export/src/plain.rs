@@ -97,6 +97,20 @@ pub(crate) trait MeshArrays {
         corner_vertex: &mut [u32],
         leaf: u32,
     );
+    /// Adds face `f`: as a fan where its triangles are one (see
+    /// [`fan_start`]), else triangle by triangle.
+    fn push_face(
+        &mut self,
+        f: &FaceData,
+        uvs: Option<&[DVec2]>,
+        corner_vertex: &mut [u32],
+        leaf: u32,
+    ) {
+        match fan_start(f) {
+            Some(first) => self.push_fan(f, uvs, first, leaf),
+            None => self.push_triangles(f, uvs, corner_vertex, leaf),
+        }
+    }
     /// Arrays holding less than half of their room are copied into blocks
     /// of their size.
     fn fit(&mut self);
@@ -300,9 +314,179 @@ impl PlainMesh {
     }
 }
 
-/// Gathers leaves into a [`PlainModel`].
-#[derive(Default)]
-pub struct PlainCollector(Collector<PlainMesh>);
+/// The triangles of one material by their positions alone (see
+/// [`PlainCollector::positions_only`]): a vertex per position of a leaf's
+/// mesh that its faces of this material use, so that faces meeting at a
+/// corner share it, as in the mesh; no normals, no texture coordinates.
+pub(crate) struct SharedPositions {
+    mesh: PlainMesh,
+    /// Per position of the mesh being added: the leaf that last gave it a
+    /// vertex here (`NO_VERTEX`: none yet) and that vertex.
+    vertex_of: Vec<(u32, u32)>,
+}
+
+impl SharedPositions {
+    /// Adds the triangles of face `f` of leaf `leaf`, each corner the
+    /// vertex of its position (made when the leaf first uses it).
+    fn push_shared(&mut self, f: &FaceData, leaf: u32) {
+        let SharedPositions { mesh, vertex_of } = self;
+        if vertex_of.len() < f.positions.len() {
+            vertex_of.resize(f.positions.len(), (NO_VERTEX, 0));
+        }
+        let corners = &f.mesh.corners;
+        for tri in f.triangles {
+            let ids = tri.map(|c| {
+                let p = corners[c as usize] as usize;
+                let slot = &mut vertex_of[p];
+                if slot.0 != leaf {
+                    *slot = (leaf, mesh.positions.len() as u32);
+                    mesh.positions.push(f.positions[p].to_array());
+                }
+                slot.1
+            });
+            mesh.indices.push(ids);
+        }
+        mesh.triangle_leaf
+            .extend(std::iter::repeat_n(leaf, f.triangles.len()));
+    }
+}
+
+impl MeshArrays for SharedPositions {
+    fn with_capacity(material: usize, vertices: usize, triangles: usize) -> SharedPositions {
+        SharedPositions {
+            mesh: PlainMesh {
+                material,
+                positions: Vec::with_capacity(vertices),
+                normals: Vec::new(),
+                uvs: Vec::new(),
+                indices: Vec::with_capacity(triangles),
+                triangle_leaf: Vec::with_capacity(triangles),
+            },
+            vertex_of: Vec::new(),
+        }
+    }
+
+    fn sizes(&self) -> (usize, usize) {
+        self.mesh.sizes()
+    }
+
+    fn push_fan(&mut self, f: &FaceData, _: Option<&[DVec2]>, _: u32, leaf: u32) {
+        self.push_shared(f, leaf);
+    }
+
+    fn push_triangles(&mut self, f: &FaceData, _: Option<&[DVec2]>, _: &mut [u32], leaf: u32) {
+        self.push_shared(f, leaf);
+    }
+
+    fn push_face(&mut self, f: &FaceData, _: Option<&[DVec2]>, _: &mut [u32], leaf: u32) {
+        self.push_shared(f, leaf);
+    }
+
+    fn fit(&mut self) {
+        self.mesh.fit();
+    }
+}
+
+/// Gathers leaves into a [`PlainModel`]: all attributes, a vertex per
+/// face corner ([`new`](PlainCollector::new),
+/// [`with_room`](PlainCollector::with_room)), or positions alone, shared
+/// within each leaf ([`positions_only`](PlainCollector::positions_only)).
+pub struct PlainCollector(PlainKind);
+
+enum PlainKind {
+    Full(Collector<PlainMesh>),
+    Positions(Collector<SharedPositions>),
+}
+
+impl Default for PlainCollector {
+    fn default() -> Self {
+        PlainCollector(PlainKind::Full(Collector::default()))
+    }
+}
+
+impl PlainCollector {
+    pub fn new() -> PlainCollector {
+        PlainCollector::default()
+    }
+
+    /// A collector whose first model starts each mesh with the room given
+    /// (vertices and triangles per material, in order of first use), as
+    /// [`room`](Self::room) of an earlier collector tells it: a
+    /// generation's first lot on a worker then does not grow its arrays by
+    /// doubling (which cost a Candler building 16 M of its 70 M
+    /// instructions of collection).
+    pub fn with_room(room: Vec<(usize, usize)>) -> PlainCollector {
+        PlainCollector(PlainKind::Full(Collector {
+            last_sizes: room,
+            ..Collector::default()
+        }))
+    }
+
+    /// A collector of positions and triangles alone (what a program that
+    /// measures or meshes the geometry needs): the same triangles as
+    /// [`with_room`](Self::with_room) gives, but the faces of a leaf that
+    /// meet at a position of its mesh share one vertex there (per
+    /// material), and normals and texture coordinates are left empty.
+    pub fn positions_only(room: Vec<(usize, usize)>) -> PlainCollector {
+        PlainCollector(PlainKind::Positions(Collector {
+            prep: FacePrep::without_normals(),
+            last_sizes: room,
+            ..Collector::default()
+        }))
+    }
+
+    /// Vertices and triangles of each mesh of the model taken last, by
+    /// material in order of first use.
+    pub fn room(&self) -> &[(usize, usize)] {
+        match &self.0 {
+            PlainKind::Full(c) => &c.last_sizes,
+            PlainKind::Positions(c) => &c.last_sizes,
+        }
+    }
+
+    /// Adds one leaf's geometry given in its own coordinates, placed by
+    /// `transform`, with `materials` for its slots (as
+    /// [`ModelWriter::add_placed`](crate::ModelWriter::add_placed) takes
+    /// them); its triangles are marked with `leaf`, a number no other leaf
+    /// of the model has.
+    pub fn add_placed(
+        &mut self,
+        mesh: &Mesh,
+        transform: Option<&DAffine3>,
+        materials: &SharedVec<Material>,
+        leaf: u32,
+    ) -> Result<(), ExportError> {
+        match &mut self.0 {
+            PlainKind::Full(c) => c.add_placed(mesh, transform, materials, leaf),
+            PlainKind::Positions(c) => c.add_placed(mesh, transform, materials, leaf),
+        }
+    }
+
+    /// The collector of all attributes (tests look at its room).
+    #[cfg(test)]
+    fn full(&self) -> &Collector<PlainMesh> {
+        match &self.0 {
+            PlainKind::Full(c) => c,
+            PlainKind::Positions(_) => panic!("a collector of positions alone"),
+        }
+    }
+
+    /// The model gathered so far; the collector starts a new one.
+    pub fn take(&mut self) -> PlainModel {
+        match &mut self.0 {
+            PlainKind::Full(c) => c.take(),
+            PlainKind::Positions(c) => {
+                let m = c.take();
+                PlainModel {
+                    materials: m.materials,
+                    meshes: m.meshes.into_iter().map(|s| s.mesh).collect(),
+                    faces: m.faces,
+                    skipped_non_finite: m.skipped_non_finite,
+                }
+            }
+        }
+    }
+}
 
 /// Gathers leaves into a [`DrawModel`].
 #[derive(Default)]
@@ -336,57 +520,40 @@ impl<M> Default for Collector<M> {
     }
 }
 
-/// The collectors' public face: the same methods for both kinds of mesh.
-macro_rules! collector_methods {
-    ($name:ident, $mesh:ty) => {
-        impl $name {
-            pub fn new() -> $name {
-                $name::default()
-            }
+impl DrawCollector {
+    pub fn new() -> DrawCollector {
+        DrawCollector::default()
+    }
 
-            /// A collector whose first model starts each mesh with the room
-            /// given (vertices and triangles per material, in order of first
-            /// use), as [`room`](Self::room) of an earlier collector tells
-            /// it: a generation's first lot on a worker then does not grow
-            /// its arrays by doubling (which cost a Candler building 16 M of
-            /// its 70 M instructions of collection).
-            pub fn with_room(room: Vec<(usize, usize)>) -> $name {
-                $name(Collector {
-                    last_sizes: room,
-                    ..Collector::default()
-                })
-            }
+    /// As [`PlainCollector::with_room`].
+    pub fn with_room(room: Vec<(usize, usize)>) -> DrawCollector {
+        DrawCollector(Collector {
+            last_sizes: room,
+            ..Collector::default()
+        })
+    }
 
-            /// Vertices and triangles of each mesh of the model taken last,
-            /// by material in order of first use.
-            pub fn room(&self) -> &[(usize, usize)] {
-                &self.0.last_sizes
-            }
+    /// As [`PlainCollector::room`].
+    pub fn room(&self) -> &[(usize, usize)] {
+        &self.0.last_sizes
+    }
 
-            /// Adds one leaf's geometry given in its own coordinates, placed
-            /// by `transform`, with `materials` for its slots (as
-            /// [`ModelWriter::add_placed`](crate::ModelWriter::add_placed)
-            /// takes them); its triangles are marked with `leaf`.
-            pub fn add_placed(
-                &mut self,
-                mesh: &Mesh,
-                transform: Option<&DAffine3>,
-                materials: &SharedVec<Material>,
-                leaf: u32,
-            ) -> Result<(), ExportError> {
-                self.0.add_placed(mesh, transform, materials, leaf)
-            }
+    /// As [`PlainCollector::add_placed`].
+    pub fn add_placed(
+        &mut self,
+        mesh: &Mesh,
+        transform: Option<&DAffine3>,
+        materials: &SharedVec<Material>,
+        leaf: u32,
+    ) -> Result<(), ExportError> {
+        self.0.add_placed(mesh, transform, materials, leaf)
+    }
 
-            /// The model gathered so far; the collector starts a new one.
-            pub fn take(&mut self) -> PlainModel<$mesh> {
-                self.0.take()
-            }
-        }
-    };
+    /// The model gathered so far; the collector starts a new one.
+    pub fn take(&mut self) -> PlainModel<DrawMesh> {
+        self.0.take()
+    }
 }
-
-collector_methods!(PlainCollector, PlainMesh);
-collector_methods!(DrawCollector, DrawMesh);
 
 impl<M: MeshArrays> Collector<M> {
     fn add_placed(
@@ -427,10 +594,7 @@ impl<M: MeshArrays> Collector<M> {
             let out = &mut model.meshes[id as usize];
             let uvs = f.mesh.uvs[0].as_deref();
             model.faces += 1;
-            match fan_start(f) {
-                Some(first) => out.push_fan(f, uvs, first, leaf),
-                None => out.push_triangles(f, uvs, corner_vertex, leaf),
-            }
+            out.push_face(f, uvs, corner_vertex, leaf);
             Ok(())
         });
         slots.end(materials);
@@ -529,6 +693,85 @@ pub(crate) mod tests {
         assert!(c.take().meshes.is_empty());
     }
 
+    /// The triangles of `m` as triples of positions, in order.
+    fn triangles_by_position(m: &PlainModel) -> Vec<[[f64; 3]; 3]> {
+        m.meshes
+            .iter()
+            .flat_map(|mesh| {
+                mesh.indices
+                    .iter()
+                    .map(|t| t.map(|i| mesh.positions[i as usize]))
+            })
+            .collect()
+    }
+
+    /// Positions alone: the triangles all attributes give, on the same
+    /// places, with a vertex per position a leaf's faces of one material
+    /// use (a cube's 8 corners, not its 24 face corners), and no normals
+    /// or texture coordinates.
+    #[test]
+    fn positions_alone_are_the_same_triangles_on_shared_vertices() {
+        let cube = cga_geometry::primitive::cube(DVec3::new(2.0, 3.0, 4.0));
+        let mut faces = sample_faces();
+        // The sample's last face (a triangle on positions the pentagon
+        // uses) in a second material.
+        let mut materials = faces.materials.clone();
+        materials.push(Material {
+            name: "second".into(),
+            ..Material::default()
+        });
+        let last = faces.faces.len() - 1;
+        faces.faces[last].material = 1;
+        let shift = DAffine3::from_translation(DVec3::new(10.0, 0.0, 0.0));
+        // A cube with normals of its own (an asset's), turned: its faces
+        // are placed without them.
+        let mut asset = cube.clone();
+        asset.normals = Some(
+            (0..asset.corners.len())
+                .map(|c| DVec3::new(c as f64, 1.0, 0.5).normalize())
+                .collect(),
+        );
+        let turn = DAffine3::from_rotation_y(0.3) * shift;
+        let collect = |mut c: PlainCollector| {
+            c.add_placed(&cube, Some(&shift), &cube.materials, 0)
+                .unwrap();
+            c.add_placed(&cube, None, &cube.materials, 1).unwrap();
+            c.add_placed(&faces, Some(&shift), &materials, 2).unwrap();
+            c.add_placed(&asset, Some(&turn), &asset.materials, 3).unwrap();
+            c.take()
+        };
+        let full = collect(PlainCollector::new());
+        let alone = collect(PlainCollector::positions_only(Vec::new()));
+        assert_eq!(triangles_by_position(&alone), triangles_by_position(&full));
+        assert_eq!(alone.materials, full.materials);
+        assert_eq!(alone.faces, full.faces);
+        let [first, second] = &alone.meshes[..] else {
+            panic!("two materials: {:?}", alone.materials);
+        };
+        // Two cubes of 8 vertices each (the same positions twice: each
+        // leaf its own), then the sample's 25 positions; the triangle's
+        // three (the pentagon's too) again in the second material.
+        assert_eq!(first.positions.len(), 8 + 8 + 25 + 8);
+        assert_eq!(second.positions.len(), 3);
+        assert_eq!(second.indices, [[0, 1, 2]]);
+        assert_eq!(first.indices.len(), 12 + 12 + 3 + 2 + 6 + 8 + 12);
+        assert_eq!(first.triangle_leaf, full.meshes[0].triangle_leaf);
+        assert_eq!(second.triangle_leaf, [2]);
+        assert!(alone
+            .meshes
+            .iter()
+            .all(|m| m.normals.is_empty() && m.uvs.is_empty()));
+        // The first cube's corners, moved.
+        assert_eq!(
+            first.positions[..8]
+                .iter()
+                .map(|p| p[0])
+                .fold(f64::INFINITY, f64::min),
+            10.0
+        );
+        assert_eq!(full.meshes[0].positions.len(), 24 + 24 + 5 + 4 + 8 + 8 + 24);
+    }
+
     /// A convex pentagon (a fan from the corner the triangulation picks), a
     /// quad cut along its other diagonal (a fan from its second corner: its
     /// first three are in line), a U-shaped octagon, a square with a hole,
@@ -620,8 +863,8 @@ pub(crate) mod tests {
         let mut next = PlainCollector::with_room(c.room().to_vec());
         next.add_placed(&cube, None, &cube.materials, 0).unwrap();
         // Collecting, the mesh has the room given.
-        assert!(next.0.model.meshes[0].positions.capacity() >= 48);
-        assert!(next.0.model.meshes[0].triangle_leaf.capacity() >= 24);
+        assert!(next.full().model.meshes[0].positions.capacity() >= 48);
+        assert!(next.full().model.meshes[0].triangle_leaf.capacity() >= 24);
         let second = next.take();
         let mut fresh = PlainCollector::new();
         fresh.add_placed(&cube, None, &cube.materials, 0).unwrap();
@@ -639,8 +882,8 @@ pub(crate) mod tests {
         let first = c.take();
         // The next lot's mesh starts with room for the first one's...
         c.add_placed(&cube, None, &cube.materials, 0).unwrap();
-        assert!(c.0.model.meshes[0].positions.capacity() >= 96);
-        assert!(c.0.model.meshes[0].indices.capacity() >= 48);
+        assert!(c.full().model.meshes[0].positions.capacity() >= 96);
+        assert!(c.full().model.meshes[0].indices.capacity() >= 48);
         let second = c.take();
         // ...and, using a quarter of it, is handed over holding about what
         // it uses.

@@ -20,9 +20,20 @@ pub(crate) struct FacePrep {
     normals: Vec<DVec3>,
     /// A placed copy of a mesh whose map mirrors it (its faces reversed).
     mirrored: Option<Box<Mesh>>,
+    /// The caller writes no normals: a mesh's own normals are not placed
+    /// (see [`FacePrep::faces`]).
+    without_normals: bool,
 }
 
 impl FacePrep {
+    /// Scratch room for a caller that writes no normals.
+    pub fn without_normals() -> FacePrep {
+        FacePrep {
+            without_normals: true,
+            ..FacePrep::default()
+        }
+    }
+
     /// Hands every face of `mesh` worth writing to `emit`, placed in the
     /// world by `transform` (positions mapped by it, normals by its inverse
     /// transpose, and faces reversed if it mirrors, exactly as
@@ -31,7 +42,8 @@ impl FacePrep {
     /// is the face's material slot; callers map it. Faces with fewer than 3
     /// corners (edges, points) and faces of zero area are left out, and so
     /// are faces with non-finite values: their number is returned. Stops at
-    /// the first error of `emit`.
+    /// the first error of `emit`. With `without_normals`, placed faces come
+    /// without the mesh's own normals (the same faces and triangles).
     pub fn faces(
         &mut self,
         mesh: &Mesh,
@@ -53,6 +65,15 @@ impl FacePrep {
                 let m: &Mesh = m;
                 (m, &m.positions[..], m.normals.as_deref())
             }
+            // Placed normals are finite (`normalize_or_zero`), and a face's
+            // own normals decide only its normal, never whether it is
+            // written (a face left for `deferred_normal` always has one):
+            // without them the same faces and triangles come out.
+            Some(t) if self.without_normals => {
+                positions.clear();
+                positions.extend(mesh.positions.iter().map(|&p| t.transform_point3(p)));
+                (mesh, &positions[..], None)
+            }
             Some(t) => {
                 positions.clear();
                 positions.extend(mesh.positions.iter().map(|&p| t.transform_point3(p)));
@@ -65,7 +86,7 @@ impl FacePrep {
                 (mesh, &positions[..], n)
             }
         };
-        let result = each_face(view, &mut self.triangles, emit);
+        let result = each_face(view, self.without_normals, &mut self.triangles, emit);
         self.positions = positions;
         self.normals = normals;
         if mirrored.is_some() {
@@ -75,8 +96,11 @@ impl FacePrep {
     }
 }
 
+/// `FacePrep::faces` for a placed mesh; `without_normals`: no face normal
+/// is needed but to tell which faces have none.
 fn each_face(
     (mesh, positions, normals): (&Mesh, &[DVec3], Option<&[DVec3]>),
+    without_normals: bool,
     triangles: &mut Vec<[u32; 3]>,
     mut emit: impl FnMut(&FaceData) -> Result<(), ExportError>,
 ) -> Result<u64, ExportError> {
@@ -114,9 +138,11 @@ fn each_face(
                     continue;
                 }
                 // A face with normals of its own needs its face normal
-                // only where one of them is zero: left for later (see
+                // only where one of them is zero, and one whose caller
+                // writes no normals never: left for later (see
                 // `deferred_normal`) where the face is sure to be written.
-                if normals.is_some() && cut_along_first_diagonal(outer.start, triangles) {
+                let wanted_later = normals.is_some() || without_normals;
+                if wanted_later && cut_along_first_diagonal(outer.start, triangles) {
                     Deferred
                 } else {
                     Known(quad_normal(mesh, positions, *outer))

@@ -68,9 +68,21 @@ fn main() {
     if std::env::var_os("DERIVATION_ONLY").is_some() {
         return;
     }
-    let (best, median) = time(&|| Target::Meshes);
+    // POSITIONS=1 times positions and triangles alone instead of plain
+    // meshes (what `geometry="positions"` asks for in Python).
+    let positions = std::env::var_os("POSITIONS").is_some();
+    let kept = move || match positions {
+        true => Target::Positions,
+        false => Target::Meshes,
+    };
+    let (best, median) = time(&kept);
+    let what = if positions {
+        "positions"
+    } else {
+        "plain meshes"
+    };
     println!(
-        "{} lots, plain meshes:    best {best:.1} ms, median {median:.1} ms",
+        "{} lots, {what}: best {best:.1} ms, median {median:.1} ms",
         lots.len()
     );
     // DRAWING=1 also times meshes to draw (what the preview collects).
@@ -95,7 +107,7 @@ fn main() {
             }
             h.finish()
         };
-        println!("plain meshes digest: {:016x}", digest(Target::Meshes));
+        println!("{what} digest: {:016x}", digest(kept()));
         if drawing {
             println!(
                 "meshes to draw digest: {:016x}",

@@ -25,6 +25,13 @@ pub enum Target<'w> {
     Nothing,
     /// Into each lot's [`LotResult::model`], as plain arrays.
     Meshes,
+    /// Into each lot's [`LotResult::model`], as positions and triangles
+    /// alone: the triangles of [`Target::Meshes`], but the faces of a leaf
+    /// that meet at a position of its mesh share one vertex there (per
+    /// material), and normals and texture coordinates are left empty (the
+    /// rules' texture projections are then skipped, unless they read
+    /// texture coordinates).
+    Positions,
     /// Into each lot's [`LotResult::drawing`], as a viewer draws them
     /// (see [`DrawModel`]): positions relative to this origin.
     Drawing([f64; 3]),
@@ -184,15 +191,16 @@ impl Rules {
         let (mut out, keep) = match target {
             Target::Nothing => (Out::None, None),
             Target::Meshes => (Out::None, Some(Keep::Plain)),
+            Target::Positions => (Out::None, Some(Keep::Positions)),
             Target::Drawing(origin) => (Out::None, Some(Keep::Drawing(DVec3::from(origin)))),
             Target::Writer(w) => (Out::One(w), None),
             Target::PerLot(w) => (Out::PerLot(w), None),
         };
         // Texture coordinates of sets nobody keeps are not computed (see
-        // `cga_engine::uv_use`): reports alone keep none, plain meshes and
-        // meshes to draw set 0, model files all.
+        // `cga_engine::uv_use`): reports alone and positions keep none,
+        // plain meshes and meshes to draw set 0, model files all.
         engine_options.uv_sets_unused = match (&out, &keep) {
-            (Out::None, None) => cga_engine::uv_use::ALL_UV_SETS,
+            (Out::None, None | Some(Keep::Positions)) => cga_engine::uv_use::ALL_UV_SETS,
             (Out::None, Some(_)) => cga_engine::uv_use::ALL_UV_SETS & !1,
             _ => 0,
         };
@@ -222,6 +230,9 @@ impl Rules {
             _ => match keep {
                 Some(Keep::Plain) => {
                     Batcher::Plain(Box::new(self.collector(PlainCollector::with_room)), 0)
+                }
+                Some(Keep::Positions) => {
+                    Batcher::Plain(Box::new(self.collector(PlainCollector::positions_only)), 0)
                 }
                 Some(Keep::Drawing(origin)) => Batcher::Draw(
                     Box::new(self.collector(DrawCollector::with_room)),
@@ -613,6 +624,7 @@ struct Done {
 /// The meshes a generation keeps of each lot.
 enum Keep {
     Plain,
+    Positions,
     /// Positions relative to this origin.
     Drawing(DVec3),
 }
@@ -767,6 +779,78 @@ impl Batcher {
 #[cfg(test)]
 mod tests {
     use crate::{lots, Engine, MemoryWorld, Options, Target};
+
+    /// Positions alone are the plain meshes' triangles on the same places,
+    /// with the vertices of a leaf's faces shared where they meet, without
+    /// normals or texture coordinates (whose projections are skipped), and
+    /// the same reports.
+    #[test]
+    fn positions_alone_are_the_plain_meshes_triangles() {
+        let rules = Engine::new(MemoryWorld::new()).load_text(
+            "/p/rules/r.cga",
+            "Lot --> extrude(10) comp(f) { side : setupProjection(0, scope.xy, 2, 2) projectUV(0) \
+             split(x) { ~2 : color(\"#a04020\") report(\"w\", scope.sx) W. }* | all : Top. }\n",
+        );
+        let lots = [lots::rect(30.0, 12.0), lots::rect(7.0, 5.0)];
+        let run = |target: Target<'static>| {
+            let mut out = Vec::new();
+            rules
+                .generate_lots(&lots, &Options::default(), target, |r| out.push(r))
+                .unwrap();
+            out.sort_by_key(|r| r.index);
+            out
+        };
+        let (plain, alone) = (run(Target::Meshes), run(Target::Positions));
+        let by_position = |m: &crate::PlainModel| -> Vec<[[f64; 3]; 3]> {
+            m.meshes
+                .iter()
+                .flat_map(|k| k.indices.iter().map(|t| t.map(|i| k.positions[i as usize])))
+                .collect()
+        };
+        for (p, a) in plain.iter().zip(&alone) {
+            assert_eq!(by_position(&a.model), by_position(&p.model));
+            assert_eq!(a.reports, p.reports);
+            assert_eq!(a.leaves, p.leaves);
+            assert!(p
+                .model
+                .meshes
+                .iter()
+                .all(|m| m.uvs.len() == m.positions.len()));
+            assert!(a
+                .model
+                .meshes
+                .iter()
+                .all(|m| m.normals.is_empty() && m.uvs.is_empty()));
+        }
+        // 30 x 12 x 10: 15 + 6 wall pieces of 4 corners each side twice
+        // (every piece its own leaf: no sharing between them), the top
+        // and bottom 4 each.
+        let vertices = |r: &crate::LotResult| {
+            r.model
+                .meshes
+                .iter()
+                .map(|m| m.positions.len())
+                .sum::<usize>()
+        };
+        assert_eq!(vertices(&alone[0]), 2 * (15 + 6) * 4 + 4 + 4);
+        assert_eq!(vertices(&alone[0]), vertices(&plain[0]));
+        assert_eq!(alone[0].model.triangles(), 2 * (2 * (15 + 6) + 2));
+        // A box is one leaf: its six faces share its eight corners.
+        let mass = Engine::new(MemoryWorld::new())
+            .load_text("/p/rules/m.cga", "Lot --> extrude(10) Mass.\n");
+        let count = |target: Target<'static>| {
+            let mut out = Vec::new();
+            mass.generate_lots(&lots[..1], &Options::default(), target, |r| out.push(r))
+                .unwrap();
+            let m = &out[0].model;
+            (
+                m.meshes.iter().map(|m| m.positions.len()).sum::<usize>(),
+                m.triangles(),
+            )
+        };
+        assert_eq!(count(Target::Positions), (8, 12));
+        assert_eq!(count(Target::Meshes), (24, 12));
+    }
 
     /// Meshes to draw hold the plain meshes' vertices relative to the
     /// origin asked for, in `f32`, and name the same leaves.

@@ -17,7 +17,8 @@ pub struct LotResult {
     /// The lot's name (file and face, feature id, `rect 20x30`).
     pub name: String,
     /// Triangles by material, when meshes were asked for
-    /// ([`Target::Meshes`](crate::Target::Meshes)); empty otherwise.
+    /// ([`Target::Meshes`](crate::Target::Meshes), or positions alone:
+    /// [`Target::Positions`](crate::Target::Positions)); empty otherwise.
     pub model: PlainModel,
     /// Triangles by material as a viewer draws them, when asked for
     /// ([`Target::Drawing`](crate::Target::Drawing)); empty otherwise.

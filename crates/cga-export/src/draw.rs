@@ -10,7 +10,8 @@
 use cga_geometry::DVec2;
 
 use crate::plain::{
-    corner_position, corner_uv, each_triangle, fan_corners, fit, MeshArrays, PlainModel,
+    corner_position, corner_uv, each_triangle, fan_corners, fit, push_corners, CornerArrays,
+    MeshArrays, PlainModel,
 };
 use crate::FaceData;
 
@@ -181,6 +182,32 @@ impl MeshArrays for DrawMesh {
         (self.positions.len(), self.triangle_leaf.len())
     }
 
+    fn push_face(
+        &mut self,
+        f: &FaceData,
+        uvs: Option<&[DVec2]>,
+        corner_vertex: &mut [u32],
+        leaf: u32,
+        _: u32,
+    ) {
+        push_corners(self, f, uvs, corner_vertex, leaf);
+    }
+
+    fn fit(&mut self) {
+        fit(&mut self.positions);
+        match &mut self.normals {
+            DrawNormals::PerFace(v) | DrawNormals::PerVertex(v) => fit(v),
+        }
+        fit(&mut self.uvs);
+        match &mut self.faces {
+            DrawFaces::Fans(v) => fit(v),
+            DrawFaces::Triangles(v) => fit(v),
+        }
+        fit(&mut self.triangle_leaf);
+    }
+}
+
+impl CornerArrays for DrawMesh {
     fn push_fan(&mut self, f: &FaceData, uvs: Option<&[DVec2]>, first: u32, leaf: u32) {
         let corners = fan_corners(f, first);
         let n = f.loops[0].len as usize;
@@ -260,19 +287,6 @@ impl MeshArrays for DrawMesh {
                 triangle_leaf.push(leaf);
             },
         );
-    }
-
-    fn fit(&mut self) {
-        fit(&mut self.positions);
-        match &mut self.normals {
-            DrawNormals::PerFace(v) | DrawNormals::PerVertex(v) => fit(v),
-        }
-        fit(&mut self.uvs);
-        match &mut self.faces {
-            DrawFaces::Fans(v) => fit(v),
-            DrawFaces::Triangles(v) => fit(v),
-        }
-        fit(&mut self.triangle_leaf);
     }
 }
 

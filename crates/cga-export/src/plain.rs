@@ -82,6 +82,25 @@ pub(crate) trait MeshArrays {
     fn with_capacity(material: usize, vertices: usize, triangles: usize) -> Self;
     /// Vertices and triangles held.
     fn sizes(&self) -> (usize, usize);
+    /// Adds face `f` of leaf `leaf`. `call` numbers the collector's calls
+    /// (one per leaf added, whatever number the caller gives the leaf);
+    /// `corner_vertex` is scratch room, at least a slot per corner of the
+    /// mesh.
+    fn push_face(
+        &mut self,
+        f: &FaceData,
+        uvs: Option<&[DVec2]>,
+        corner_vertex: &mut [u32],
+        leaf: u32,
+        call: u32,
+    );
+    /// Arrays holding less than half of their room are copied into blocks
+    /// of their size.
+    fn fit(&mut self);
+}
+
+/// Meshes with a vertex per face corner (plain meshes, meshes to draw).
+pub(crate) trait CornerArrays {
     /// Adds a face whose triangles are a fan (see [`fan_start`]) from the
     /// corner at `first` of its loop: its vertices are its corners in loop
     /// order from there, as `push_triangles` numbers them (in the order
@@ -97,23 +116,22 @@ pub(crate) trait MeshArrays {
         corner_vertex: &mut [u32],
         leaf: u32,
     );
-    /// Adds face `f`: as a fan where its triangles are one (see
-    /// [`fan_start`]), else triangle by triangle.
-    fn push_face(
-        &mut self,
-        f: &FaceData,
-        uvs: Option<&[DVec2]>,
-        corner_vertex: &mut [u32],
-        leaf: u32,
-    ) {
-        match fan_start(f) {
-            Some(first) => self.push_fan(f, uvs, first, leaf),
-            None => self.push_triangles(f, uvs, corner_vertex, leaf),
-        }
+}
+
+/// [`MeshArrays::push_face`] for meshes of a vertex per corner: as a fan
+/// where the face's triangles are one (see [`fan_start`]), else triangle
+/// by triangle.
+pub(crate) fn push_corners(
+    m: &mut impl CornerArrays,
+    f: &FaceData,
+    uvs: Option<&[DVec2]>,
+    corner_vertex: &mut [u32],
+    leaf: u32,
+) {
+    match fan_start(f) {
+        Some(first) => m.push_fan(f, uvs, first, leaf),
+        None => m.push_triangles(f, uvs, corner_vertex, leaf),
     }
-    /// Arrays holding less than half of their room are copied into blocks
-    /// of their size.
-    fn fit(&mut self);
 }
 
 pub(crate) const NO_VERTEX: u32 = u32::MAX;
@@ -161,7 +179,7 @@ pub(crate) fn fan_start(f: &FaceData) -> Option<u32> {
 }
 
 /// The corners of a face's loop from `first` on, round the loop: the
-/// order [`MeshArrays::push_fan`] writes a fan's vertices in.
+/// order [`CornerArrays::push_fan`] writes a fan's vertices in.
 pub(crate) fn fan_corners(f: &FaceData, first: u32) -> impl Iterator<Item = usize> + Clone {
     let outer = f.loops[0];
     let (s, n) = (outer.start as usize, outer.len as usize);
@@ -227,6 +245,27 @@ impl MeshArrays for PlainMesh {
         (self.positions.len(), self.indices.len())
     }
 
+    fn push_face(
+        &mut self,
+        f: &FaceData,
+        uvs: Option<&[DVec2]>,
+        corner_vertex: &mut [u32],
+        leaf: u32,
+        _: u32,
+    ) {
+        push_corners(self, f, uvs, corner_vertex, leaf);
+    }
+
+    fn fit(&mut self) {
+        fit(&mut self.positions);
+        fit(&mut self.normals);
+        fit(&mut self.uvs);
+        fit(&mut self.indices);
+        fit(&mut self.triangle_leaf);
+    }
+}
+
+impl CornerArrays for PlainMesh {
     fn push_fan(&mut self, f: &FaceData, uvs: Option<&[DVec2]>, first: u32, leaf: u32) {
         let n = f.loops[0].len as usize;
         if n == 4 {
@@ -280,18 +319,10 @@ impl MeshArrays for PlainMesh {
             },
         );
     }
-
-    fn fit(&mut self) {
-        fit(&mut self.positions);
-        fit(&mut self.normals);
-        fit(&mut self.uvs);
-        fit(&mut self.indices);
-        fit(&mut self.triangle_leaf);
-    }
 }
 
 impl PlainMesh {
-    /// [`MeshArrays::push_fan`] for a quad (most faces): the same values,
+    /// [`CornerArrays::push_fan`] for a quad (most faces): the same values,
     /// its four corners read as an array rather than round the loop.
     fn push_quad_fan(&mut self, f: &FaceData, uvs: Option<&[DVec2]>, first: u32, leaf: u32) {
         let s = f.loops[0].start as usize;
@@ -320,15 +351,16 @@ impl PlainMesh {
 /// corner share it, as in the mesh; no normals, no texture coordinates.
 pub(crate) struct SharedPositions {
     mesh: PlainMesh,
-    /// Per position of the mesh being added: the leaf that last gave it a
-    /// vertex here (`NO_VERTEX`: none yet) and that vertex.
+    /// Per position of the mesh being added: the collector's call that
+    /// last gave it a vertex here (`NO_VERTEX`: none yet) and that vertex.
     vertex_of: Vec<(u32, u32)>,
 }
 
 impl SharedPositions {
     /// Adds the triangles of face `f` of leaf `leaf`, each corner the
-    /// vertex of its position (made when the leaf first uses it).
-    fn push_shared(&mut self, f: &FaceData, leaf: u32) {
+    /// vertex of its position, made when the collector's call `call` (the
+    /// leaf's) first uses it.
+    fn push_shared(&mut self, f: &FaceData, leaf: u32, call: u32) {
         let SharedPositions { mesh, vertex_of } = self;
         if vertex_of.len() < f.positions.len() {
             vertex_of.resize(f.positions.len(), (NO_VERTEX, 0));
@@ -338,8 +370,8 @@ impl SharedPositions {
             let ids = tri.map(|c| {
                 let p = corners[c as usize] as usize;
                 let slot = &mut vertex_of[p];
-                if slot.0 != leaf {
-                    *slot = (leaf, mesh.positions.len() as u32);
+                if slot.0 != call {
+                    *slot = (call, mesh.positions.len() as u32);
                     mesh.positions.push(f.positions[p].to_array());
                 }
                 slot.1
@@ -370,16 +402,15 @@ impl MeshArrays for SharedPositions {
         self.mesh.sizes()
     }
 
-    fn push_fan(&mut self, f: &FaceData, _: Option<&[DVec2]>, _: u32, leaf: u32) {
-        self.push_shared(f, leaf);
-    }
-
-    fn push_triangles(&mut self, f: &FaceData, _: Option<&[DVec2]>, _: &mut [u32], leaf: u32) {
-        self.push_shared(f, leaf);
-    }
-
-    fn push_face(&mut self, f: &FaceData, _: Option<&[DVec2]>, _: &mut [u32], leaf: u32) {
-        self.push_shared(f, leaf);
+    fn push_face(
+        &mut self,
+        f: &FaceData,
+        _: Option<&[DVec2]>,
+        _: &mut [u32],
+        leaf: u32,
+        call: u32,
+    ) {
+        self.push_shared(f, leaf, call);
     }
 
     fn fit(&mut self) {
@@ -505,6 +536,8 @@ pub(crate) struct Collector<M> {
     /// Vertices and triangles of each mesh of the model taken last (by
     /// material number, in order of first use).
     last_sizes: Vec<(usize, usize)>,
+    /// Calls of `add_placed` so far (wrapping short of `NO_VERTEX`).
+    calls: u32,
 }
 
 impl<M> Default for Collector<M> {
@@ -516,6 +549,7 @@ impl<M> Default for Collector<M> {
             model: PlainModel::default(),
             corner_vertex: Vec::new(),
             last_sizes: Vec::new(),
+            calls: 0,
         }
     }
 }
@@ -571,7 +605,10 @@ impl<M: MeshArrays> Collector<M> {
             model,
             corner_vertex,
             last_sizes,
+            calls,
         } = self;
+        let call = *calls;
+        *calls = (call + 1) % NO_VERTEX;
         slots.begin(materials);
         // Only long enough: each face marks its own corners before use.
         if corner_vertex.len() < mesh.corners.len() {
@@ -594,7 +631,7 @@ impl<M: MeshArrays> Collector<M> {
             let out = &mut model.meshes[id as usize];
             let uvs = f.mesh.uvs[0].as_deref();
             model.faces += 1;
-            out.push_face(f, uvs, corner_vertex, leaf);
+            out.push_face(f, uvs, corner_vertex, leaf, call);
             Ok(())
         });
         slots.end(materials);
@@ -737,7 +774,8 @@ pub(crate) mod tests {
                 .unwrap();
             c.add_placed(&cube, None, &cube.materials, 1).unwrap();
             c.add_placed(&faces, Some(&shift), &materials, 2).unwrap();
-            c.add_placed(&asset, Some(&turn), &asset.materials, 3).unwrap();
+            c.add_placed(&asset, Some(&turn), &asset.materials, 3)
+                .unwrap();
             c.take()
         };
         let full = collect(PlainCollector::new());
@@ -770,6 +808,14 @@ pub(crate) mod tests {
             10.0
         );
         assert_eq!(full.meshes[0].positions.len(), 24 + 24 + 5 + 4 + 8 + 8 + 24);
+        // Leaves their caller numbers alike still get vertices of their own.
+        let mut c = PlainCollector::positions_only(Vec::new());
+        c.add_placed(&cube, None, &cube.materials, 9).unwrap();
+        c.add_placed(&cube, Some(&shift), &cube.materials, 9)
+            .unwrap();
+        let twice = c.take();
+        assert_eq!(twice.meshes[0].positions.len(), 16);
+        assert_eq!(twice.meshes[0].triangle_leaf, [9; 24]);
     }
 
     /// A convex pentagon (a fan from the corner the triangulation picks), a

@@ -629,19 +629,20 @@ fn model_dict(
                 indices,
                 ..
             } = m;
+            let (normals, uvs) = match positions_only {
+                true => (py.None(), py.None()),
+                false => (
+                    array(py, normals).into_any().unbind(),
+                    array(py, uvs).into_any().unbind(),
+                ),
+            };
             PyTuple::new(
                 py,
                 [
                     material.into_py_any(py)?,
                     array(py, positions).into_any().unbind(),
-                    match positions_only {
-                        true => py.None(),
-                        false => array(py, normals).into_any().unbind(),
-                    },
-                    match positions_only {
-                        true => py.None(),
-                        false => array(py, uvs).into_any().unbind(),
-                    },
+                    normals,
+                    uvs,
                     array(py, indices).into_any().unbind(),
                 ],
             )

@@ -65,19 +65,16 @@ impl FacePrep {
                 let m: &Mesh = m;
                 (m, &m.positions[..], m.normals.as_deref())
             }
-            // Placed normals are finite (`normalize_or_zero`), and a face's
-            // own normals decide only its normal, never whether it is
-            // written (a face left for `deferred_normal` always has one):
-            // without them the same faces and triangles come out.
-            Some(t) if self.without_normals => {
-                positions.clear();
-                positions.extend(mesh.positions.iter().map(|&p| t.transform_point3(p)));
-                (mesh, &positions[..], None)
-            }
             Some(t) => {
                 positions.clear();
                 positions.extend(mesh.positions.iter().map(|&p| t.transform_point3(p)));
-                let n = mesh.normals.as_ref().map(|src| {
+                // Placed normals are finite (`normalize_or_zero`), and a
+                // face's own normals decide only its normal, never whether
+                // it is written (a face left for `deferred_normal` always
+                // has one): without them the same faces and triangles come
+                // out.
+                let own = mesh.normals.as_ref().filter(|_| !self.without_normals);
+                let n = own.map(|src| {
                     let nm = cga_geometry::transform::normal_matrix(t);
                     normals.clear();
                     normals.extend(src.iter().map(|&n| (nm * n).normalize_or_zero()));

@@ -77,7 +77,18 @@ impl FacePrep {
                 let n = own.map(|src| {
                     let nm = cga_geometry::transform::normal_matrix(t);
                     normals.clear();
-                    normals.extend(src.iter().map(|&n| (nm * n).normalize_or_zero()));
+                    // Corners of a flat face repeat one normal: the same
+                    // bits are placed the same (see `LastNormal`). The
+                    // bits the first is compared with are a NaN, whose
+                    // placed normal is zero, as it starts.
+                    let mut last = ([u64::MAX; 3], DVec3::ZERO);
+                    normals.extend(src.iter().map(|&n| {
+                        let bits = n.to_array().map(f64::to_bits);
+                        if bits != last.0 {
+                            last = (bits, (nm * n).normalize_or_zero());
+                        }
+                        last.1
+                    }));
                     &normals[..]
                 });
                 (mesh, &positions[..], n)

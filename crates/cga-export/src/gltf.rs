@@ -32,7 +32,6 @@
 //! aligned because every component is 4 bytes.
 
 use std::collections::HashMap;
-use std::fs::File;
 use std::io::{BufWriter, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
@@ -47,6 +46,7 @@ use crate::encode::Buckets;
 use crate::instances::{Instances, Pending, Trs};
 use crate::json_spool::{self, GlbJson, Spool};
 use crate::materials::{color_to_linear, MaterialTable};
+use crate::output_file::OutputFile;
 use crate::textures::{uri_encode, Textures};
 use crate::{ExportError, ExportStats, FaceData};
 
@@ -672,7 +672,7 @@ pub(crate) struct GltfWriter {
     written: Vec<PrimitiveLayout>,
     written_bytes: u64,
     /// glTF: the `.bin` file, once data is written before the end.
-    bin_out: Option<BufWriter<File>>,
+    bin_out: Option<BufWriter<OutputFile>>,
     /// A node per lot ([`Granularity::Lot`](crate::Granularity)): each
     /// lot's data is written out when the next begins.
     per_lot: bool,
@@ -720,13 +720,7 @@ impl GltfWriter {
     ) -> Result<GltfWriter, ExportError> {
         // Readable too: a GLB's binary data may have to be moved up (see
         // `finish_early_glb`).
-        let file = std::fs::OpenOptions::new()
-            .read(true)
-            .write(true)
-            .create(true)
-            .truncate(true)
-            .open(path)
-            .map_err(|e| ExportError::io(path, e))?;
+        let file = crate::output_file::create(path, true).map_err(|e| ExportError::io(path, e))?;
         Ok(GltfWriter::new(
             Box::new(file),
             path,
@@ -1027,7 +1021,8 @@ impl GltfWriter {
         } else {
             if self.bin_out.is_none() {
                 let bin_path = self.path.with_file_name(&self.bin_name);
-                let file = File::create(&bin_path).map_err(|e| ExportError::io(&bin_path, e))?;
+                let file = crate::output_file::create(&bin_path, false)
+                    .map_err(|e| ExportError::io(&bin_path, e))?;
                 self.bin_out = Some(BufWriter::with_capacity(1 << 16, file));
             }
             self.bin_out.as_mut().expect("created above")
@@ -1313,8 +1308,8 @@ impl GltfWriter {
                 let mut w = match self.bin_out.take() {
                     Some(w) => w,
                     None => {
-                        let file =
-                            File::create(&bin_path).map_err(|e| ExportError::io(&bin_path, e))?;
+                        let file = crate::output_file::create(&bin_path, false)
+                            .map_err(|e| ExportError::io(&bin_path, e))?;
                         BufWriter::with_capacity(1 << 16, file)
                     }
                 };

@@ -37,6 +37,7 @@ mod instances;
 mod json_spool;
 mod materials;
 mod obj;
+mod output_file;
 mod plain;
 mod prepare;
 mod textures;

@@ -10,7 +10,7 @@
 //! triangles, since OBJ has no holes. Numbers are written with at most six
 //! decimals (micrometres for coordinates in metres), trailing zeros dropped.
 
-use std::fs::File;
+use crate::output_file::OutputFile;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -46,7 +46,7 @@ enum MapRef {
 
 pub(crate) struct ObjWriter {
     path: PathBuf,
-    out: BufWriter<File>,
+    out: BufWriter<OutputFile>,
     mtl_name: String,
     line: Vec<u8>,
     v_count: u32,
@@ -68,7 +68,7 @@ pub(crate) struct ObjWriter {
 
 impl ObjWriter {
     pub(crate) fn create(path: &Path, header: Option<String>) -> Result<ObjWriter, ExportError> {
-        let file = File::create(path).map_err(|e| ExportError::io(path, e))?;
+        let file = crate::output_file::create(path, false).map_err(|e| ExportError::io(path, e))?;
         let stem = path
             .file_stem()
             .map_or("model".into(), |s| s.to_string_lossy());
@@ -251,7 +251,8 @@ impl ObjWriter {
             .collect();
 
         let mtl_path = self.path.with_file_name(&self.mtl_name);
-        let file = File::create(&mtl_path).map_err(|e| ExportError::io(&mtl_path, e))?;
+        let file = crate::output_file::create(&mtl_path, false)
+            .map_err(|e| ExportError::io(&mtl_path, e))?;
         let mut mtl = BufWriter::new(file);
         let mut copied = Vec::new();
         for &id in &used {

@@ -1373,3 +1373,68 @@ fn gltf_nodes_per_lot_carry_the_lot_and_its_attributes() {
         .collect();
     assert_eq!(nodes, ["color_ff8000", "color_ffffff"]);
 }
+
+/// Generating again over the last output (GLB, glTF with its `.bin`, OBJ
+/// with its `.mtl`) gives the same files, whose old versions are moved
+/// aside and removed (no hidden file is left in the folder), and keeps
+/// writing through a symbolic link to the file it names.
+#[test]
+fn generating_over_the_last_output_replaces_it() {
+    let dir = temp_dir("regenerate");
+    let rules = rule_file(&dir, "box.cga", BOX);
+    let out_dir = dir.join("out");
+    std::fs::create_dir_all(&out_dir).unwrap();
+    let listing = || {
+        let mut n: Vec<String> = std::fs::read_dir(&out_dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        n.sort();
+        n
+    };
+    for name in ["m.glb", "m.gltf", "m.obj"] {
+        let path = out_dir.join(name);
+        let generate = |lot: &str| {
+            let out = run(&[
+                "generate",
+                rules.to_str().unwrap(),
+                "--lot",
+                lot,
+                "-o",
+                path.to_str().unwrap(),
+            ]);
+            assert!(out.status.success(), "{}", stderr(&out));
+            std::fs::read(&path).unwrap()
+        };
+        let small = generate("rect:10,12");
+        let large = generate("grid:3x3");
+        assert!(large.len() > small.len(), "{name}");
+        assert_eq!(generate("rect:10,12"), small, "{name}");
+    }
+    assert_eq!(
+        listing(),
+        ["m.bin", "m.glb", "m.gltf", "m.mtl", "m.obj"],
+        "nothing hidden is left beside the outputs"
+    );
+    #[cfg(unix)]
+    {
+        let target = out_dir.join("m.glb");
+        let link = dir.join("link.glb");
+        std::os::unix::fs::symlink(&target, &link).unwrap();
+        let out = run(&[
+            "generate",
+            rules.to_str().unwrap(),
+            "-o",
+            link.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        assert!(std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(
+            std::fs::read(&link).unwrap(),
+            std::fs::read(&target).unwrap()
+        );
+    }
+}

@@ -1,0 +1,252 @@
+//! Opening a model file where an older one may stand.
+//!
+//! Regenerating over the last output is the common case, and replacing a
+//! large file in place is slow on the path of the model: truncating it
+//! frees its cached pages before the first lot starts (20 Candler
+//! buildings over their 112 MB GLB: the workers started 70 ms after the
+//! process), and ext4 writes the new content out when the file is closed,
+//! before `close` returns (it guards programs that truncate and rewrite
+//! against losing both versions in a crash): the writing thread's last 80
+//! ms, after the workers had finished.
+//!
+//! So an existing output that is a plain file of one name is moved aside
+//! (renamed to a hidden name in its folder) and unlinked on a thread of
+//! its own while the model is made, and a new file is created in its
+//! place, with the old one's permissions and owner. A symbolic link, a
+//! file with other hard links, or anything else (a device, a pipe) is
+//! opened and truncated as before, so that writing through it still
+//! reaches what it names.
+
+use std::fs::{File, OpenOptions};
+use std::io::{self, Read, Seek, SeekFrom, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::thread::JoinHandle;
+
+/// An output file; dropping it closes the file and waits for the older
+/// file it replaced to be unlinked (so that no hidden file is left behind
+/// when the process ends right after).
+pub(crate) struct OutputFile {
+    file: File,
+    unlinking: Option<JoinHandle<()>>,
+}
+
+/// Creates `path` for writing (and reading, with `read`), replacing what
+/// stands there (see the module docs).
+pub(crate) fn create(path: &Path, read: bool) -> io::Result<OutputFile> {
+    let open = |truncate: bool| {
+        OpenOptions::new()
+            .read(read)
+            .write(true)
+            .create(true)
+            .truncate(truncate)
+            .open(path)
+    };
+    let Some(aside) = move_aside(path) else {
+        return Ok(OutputFile {
+            file: open(true)?,
+            unlinking: None,
+        });
+    };
+    let old_meta = std::fs::metadata(&aside.0);
+    let file = match OpenOptions::new()
+        .read(read)
+        .write(true)
+        .create_new(true)
+        .open(path)
+    {
+        Ok(file) => file,
+        Err(e) => {
+            // Put the old file back where it was.
+            let _ = std::fs::rename(&aside.0, path);
+            return Err(e);
+        }
+    };
+    if let Ok(meta) = old_meta {
+        keep_owner_and_permissions(&file, &meta);
+    }
+    let old = aside.0;
+    let unlinking = std::thread::Builder::new()
+        .name("cga-unlink".into())
+        .spawn({
+            let old = old.clone();
+            move || {
+                let _ = std::fs::remove_file(&old);
+            }
+        })
+        .ok();
+    if unlinking.is_none() {
+        let _ = std::fs::remove_file(&old);
+    }
+    Ok(OutputFile { file, unlinking })
+}
+
+/// The older file at `path`, renamed to a hidden name beside it, when it
+/// is a plain file of one name that could be moved.
+struct Aside(PathBuf);
+
+fn move_aside(path: &Path) -> Option<Aside> {
+    let meta = std::fs::symlink_metadata(path).ok()?;
+    if !meta.file_type().is_file() || !single_name(&meta) || meta.len() == 0 {
+        return None;
+    }
+    // Unique within the process too: two writers may replace files of one
+    // name in different folders, or one after the other.
+    static NEXT: AtomicU64 = AtomicU64::new(0);
+    let n = NEXT.fetch_add(1, Ordering::Relaxed);
+    let name = path.file_name()?.to_string_lossy();
+    let hidden = path.with_file_name(format!(".{name}.cga-old-{}-{n}", std::process::id()));
+    std::fs::rename(path, &hidden).ok()?;
+    Some(Aside(hidden))
+}
+
+/// Gives the new file the old one's permissions and, where the process
+/// may (as root), its owner: as truncating the old file would have kept
+/// them.
+fn keep_owner_and_permissions(file: &File, old: &std::fs::Metadata) {
+    let _ = file.set_permissions(old.permissions());
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let Ok(new) = file.metadata() {
+            if (new.uid(), new.gid()) != (old.uid(), old.gid()) {
+                let _ = std::os::unix::fs::fchown(file, Some(old.uid()), Some(old.gid()));
+            }
+        }
+    }
+}
+
+#[cfg(unix)]
+fn single_name(meta: &std::fs::Metadata) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    meta.nlink() == 1
+}
+
+#[cfg(not(unix))]
+fn single_name(_: &std::fs::Metadata) -> bool {
+    false
+}
+
+impl Drop for OutputFile {
+    fn drop(&mut self) {
+        if let Some(t) = self.unlinking.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+impl Read for OutputFile {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        self.file.read(buf)
+    }
+}
+
+impl Write for OutputFile {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.file.write(buf)
+    }
+
+    fn write_vectored(&mut self, bufs: &[io::IoSlice<'_>]) -> io::Result<usize> {
+        self.file.write_vectored(bufs)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.file.flush()
+    }
+}
+
+impl Seek for OutputFile {
+    fn seek(&mut self, pos: SeekFrom) -> io::Result<u64> {
+        self.file.seek(pos)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dir(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("cga-output-file-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    fn names(d: &Path) -> Vec<String> {
+        let mut n: Vec<String> = std::fs::read_dir(d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        n.sort();
+        n
+    }
+
+    /// An older file is replaced by a new one of the same permissions, and
+    /// nothing else is left in the folder once the output is closed.
+    #[test]
+    fn an_older_file_is_replaced_and_nothing_is_left_beside_it() {
+        let d = dir("replace");
+        let path = d.join("model.glb");
+        std::fs::write(&path, vec![7u8; 1 << 20]).unwrap();
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o600)).unwrap();
+        }
+        #[cfg(unix)]
+        let inode = || {
+            use std::os::unix::fs::MetadataExt;
+            std::fs::metadata(&path).unwrap().ino()
+        };
+        #[cfg(unix)]
+        let old_inode = inode();
+        let mut out = create(&path, true).unwrap();
+        out.write_all(b"new").unwrap();
+        drop(out);
+        assert_eq!(std::fs::read(&path).unwrap(), b"new");
+        // A new file, not the old one truncated (the old one may still
+        // be open elsewhere, and is unlinked).
+        #[cfg(unix)]
+        assert_ne!(inode(), old_inode);
+        assert_eq!(names(&d), ["model.glb"]);
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            let mode = std::fs::metadata(&path).unwrap().permissions().mode();
+            assert_eq!(mode & 0o777, 0o600);
+        }
+        // A new file, and one where none stood.
+        let fresh = d.join("other.glb");
+        create(&fresh, false).unwrap().write_all(b"x").unwrap();
+        assert_eq!(std::fs::read(&fresh).unwrap(), b"x");
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    /// Through a symbolic link or a second hard link the file named is
+    /// written, as opening it would.
+    #[cfg(unix)]
+    #[test]
+    fn links_are_written_through() {
+        let d = dir("links");
+        let target = d.join("target.glb");
+        std::fs::write(&target, b"old content").unwrap();
+        let link = d.join("link.glb");
+        std::os::unix::fs::symlink(&target, &link).unwrap();
+        create(&link, false)
+            .unwrap()
+            .write_all(b"via link")
+            .unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"via link");
+        assert!(std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+
+        let hard = d.join("hard.glb");
+        std::fs::hard_link(&target, &hard).unwrap();
+        create(&hard, false).unwrap().write_all(b"both").unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"both");
+        assert_eq!(names(&d), ["hard.glb", "link.glb", "target.glb"]);
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+}

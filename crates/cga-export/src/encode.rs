@@ -213,11 +213,7 @@ impl MeshEncoder {
         let result = prep.faces(mesh, transform, |f| {
             let material = slots.id(f.material, || store.id_of(&materials[f.material as usize]));
             let bucket = store.bucket(material);
-            // Buckets taking pushes hold no appended segments: their own
-            // arrays are all they hold.
-            let before = bucket.own_bytes();
-            add_face(bucket, vertices, &FaceData { material, ..*f })?;
-            counts.bytes += bucket.own_bytes() - before;
+            counts.bytes += add_face(bucket, vertices, &FaceData { material, ..*f })?;
             counts.faces += 1;
             counts.triangles += f.triangles.len() as u64;
             Ok(())
@@ -463,8 +459,11 @@ impl LastNormal {
 
 impl VertexSharing {
     fn begin(&mut self, mesh: &Mesh) {
-        self.corner_vertex.clear();
-        self.corner_vertex.resize(mesh.corners.len(), 0);
+        // Every corner of a face is given its vertex before the face's
+        // triangles read it: the entries of earlier meshes need no reset.
+        if self.corner_vertex.len() < mesh.corners.len() {
+            self.corner_vertex.resize(mesh.corners.len(), 0);
+        }
         self.first_shared.clear();
         if mesh.normals.is_some() {
             self.first_shared.resize(mesh.positions.len(), NO_ENTRY);
@@ -481,7 +480,7 @@ fn add_face(
     bucket: &mut Bucket,
     sharing: &mut VertexSharing,
     f: &FaceData,
-) -> Result<(), ExportError> {
+) -> Result<usize, ExportError> {
     let VertexSharing {
         corner_vertex,
         first_shared,
@@ -490,9 +489,17 @@ fn add_face(
     } = sharing;
     let mesh = f.mesh;
     let uvs = mesh.uvs[0].as_deref();
+    // Bytes added (see `Bucket::own_bytes`): the coordinates of the
+    // vertices before, when the material starts having them, then the
+    // face's vertices and triangles.
+    #[cfg(debug_assertions)]
+    let own_before = bucket.own_bytes();
+    let mut bytes = 0;
     if uvs.is_some() && bucket.sets.is_empty() {
         bucket.start_coords();
+        bytes += bucket.positions.len() * 8;
     }
+    let vertices_before = bucket.positions.len();
     // Vertices are shared only where one UV set is written (the key
     // holds set 0's coordinates) and no tangents (which are per face).
     let shared = bucket.sets.len() <= 1 && bucket.tangents.is_none();
@@ -569,7 +576,11 @@ fn add_face(
             .iter()
             .map(|t| t.map(|c| corner_vertex[c as usize])),
     );
-    Ok(())
+    let vertex_bytes = 24 + bucket.coords.len() * 8 + bucket.tangents.as_ref().map_or(0, |_| 16);
+    bytes += (bucket.positions.len() - vertices_before) * vertex_bytes + f.triangles.len() * 12;
+    #[cfg(debug_assertions)]
+    debug_assert_eq!(bytes, bucket.own_bytes() - own_before);
+    Ok(bytes)
 }
 
 /// Appends one vertex per corner of face `f` (`corners`, in order) to
@@ -756,5 +767,35 @@ mod tests {
             assert_eq!(g.map(f32::to_bits), w.map(f32::to_bits), "corner {c}");
         }
         assert!((got(written[2])[2] - face_normal.z as f32).abs() < 1e-6);
+    }
+
+    /// The bytes an encoder counts are those its batch holds: faces with
+    /// and without texture coordinates of one untextured material (the
+    /// first with coordinates gives the vertices before theirs), and
+    /// meshes whose corners share vertices.
+    #[test]
+    fn the_bytes_counted_are_the_bytes_held() {
+        let mut e = Encoder::for_export(&ExportOptions::default());
+        let wall = material("wall", 0.25);
+        let plain = Mesh::polygon(&[DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y]);
+        let mut textured = cga_geometry::primitive::cube(DVec3::new(2.0, 3.0, 4.0));
+        assert!(textured.uvs[0].is_some());
+        e.add_placed(&plain, None, &wall);
+        e.add_placed(&textured, None, &wall);
+        textured.normals = Some(vec![DVec3::Y; textured.corners.len()]);
+        e.add_placed(&textured, None, &wall);
+        let counted = e.bytes();
+        let batch = e.take();
+        let held: usize = batch.buckets.iter().map(Bucket::own_bytes).sum();
+        assert_eq!(counted, held);
+        // 4 + 24 vertices, then the cube's 24 corners on 8 positions with
+        // one normal, but their own UVs.
+        let b = &batch.buckets[0];
+        assert!(
+            b.positions.len() > 28 && b.positions.len() < 52,
+            "{}",
+            b.positions.len()
+        );
+        assert_eq!(held, b.positions.len() * 32 + b.indices.len() * 12);
     }
 }

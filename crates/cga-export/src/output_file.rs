@@ -10,9 +10,9 @@
 //! ms, after the workers had finished.
 //!
 //! So an existing output that is a plain file of one name is moved aside
-//! (renamed to a hidden name in its folder) and unlinked on a thread of
-//! its own while the model is made, and a new file is created in its
-//! place, with the old one's permissions and owner. A symbolic link, a
+//! (renamed to a hidden name in its folder) and unlinked, a large one on a
+//! thread of its own while the model is made, and a new file is created in
+//! its place, with the old one's permissions and owner. A symbolic link, a
 //! file with other hard links, or anything else (a device, a pipe) is
 //! opened and truncated as before, so that writing through it still
 //! reaches what it names.
@@ -22,6 +22,11 @@ use std::io::{self, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::thread::JoinHandle;
+
+/// Older files from this size on are unlinked on a thread of their own;
+/// smaller ones (the tiles of a tileset written again) right away, which
+/// costs less than a thread.
+const UNLINK_APART_BYTES: u64 = 4 << 20;
 
 /// An output file; dropping it closes the file and waits for the older
 /// file it replaced to be unlinked (so that no hidden file is left behind
@@ -34,47 +39,39 @@ pub(crate) struct OutputFile {
 /// Creates `path` for writing (and reading, with `read`), replacing what
 /// stands there (see the module docs).
 pub(crate) fn create(path: &Path, read: bool) -> io::Result<OutputFile> {
-    let open = |truncate: bool| {
-        OpenOptions::new()
-            .read(read)
-            .write(true)
-            .create(true)
-            .truncate(truncate)
-            .open(path)
-    };
-    let Some(aside) = move_aside(path) else {
+    let mut options = OpenOptions::new();
+    options.read(read).write(true);
+    let Some(Aside(old)) = move_aside(path) else {
         return Ok(OutputFile {
-            file: open(true)?,
+            file: options.create(true).truncate(true).open(path)?,
             unlinking: None,
         });
     };
-    let old_meta = std::fs::metadata(&aside.0);
-    let file = match OpenOptions::new()
-        .read(read)
-        .write(true)
-        .create_new(true)
-        .open(path)
-    {
+    let file = match options.create_new(true).open(path) {
         Ok(file) => file,
         Err(e) => {
             // Put the old file back where it was.
-            let _ = std::fs::rename(&aside.0, path);
+            let _ = std::fs::rename(&old, path);
             return Err(e);
         }
     };
-    if let Ok(meta) = old_meta {
-        keep_owner_and_permissions(&file, &meta);
+    let old_meta = std::fs::metadata(&old).ok();
+    if let Some(meta) = &old_meta {
+        keep_owner_and_permissions(&file, meta);
     }
-    let old = aside.0;
-    let unlinking = std::thread::Builder::new()
-        .name("cga-unlink".into())
-        .spawn({
-            let old = old.clone();
-            move || {
-                let _ = std::fs::remove_file(&old);
-            }
-        })
-        .ok();
+    let large = old_meta.is_some_and(|m| m.len() >= UNLINK_APART_BYTES);
+    let unlinking = if large {
+        let old = old.clone();
+        let unlink = move || {
+            let _ = std::fs::remove_file(&old);
+        };
+        std::thread::Builder::new()
+            .name("cga-unlink".into())
+            .spawn(unlink)
+            .ok()
+    } else {
+        None
+    };
     if unlinking.is_none() {
         let _ = std::fs::remove_file(&old);
     }
@@ -187,7 +184,8 @@ mod tests {
     fn an_older_file_is_replaced_and_nothing_is_left_beside_it() {
         let d = dir("replace");
         let path = d.join("model.glb");
-        std::fs::write(&path, vec![7u8; 1 << 20]).unwrap();
+        // Large enough to be unlinked on a thread of its own.
+        std::fs::write(&path, vec![7u8; UNLINK_APART_BYTES as usize]).unwrap();
         #[cfg(unix)]
         {
             use std::os::unix::fs::PermissionsExt;
@@ -215,6 +213,14 @@ mod tests {
             let mode = std::fs::metadata(&path).unwrap().permissions().mode();
             assert_eq!(mode & 0o777, 0o600);
         }
+        // A small file, unlinked right away.
+        #[cfg(unix)]
+        let small_inode = inode();
+        create(&path, false).unwrap().write_all(b"newer").unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"newer");
+        #[cfg(unix)]
+        assert_ne!(inode(), small_inode);
+        assert_eq!(names(&d), ["model.glb"]);
         // A new file, and one where none stood.
         let fresh = d.join("other.glb");
         create(&fresh, false).unwrap().write_all(b"x").unwrap();

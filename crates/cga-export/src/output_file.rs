@@ -41,7 +41,7 @@ pub(crate) struct OutputFile {
 pub(crate) fn create(path: &Path, read: bool) -> io::Result<OutputFile> {
     let mut options = OpenOptions::new();
     options.read(read).write(true);
-    let Some(Aside(old)) = move_aside(path) else {
+    let Some(old) = move_aside(path) else {
         return Ok(OutputFile {
             file: options.create(true).truncate(true).open(path)?,
             unlinking: None,
@@ -60,29 +60,27 @@ pub(crate) fn create(path: &Path, read: bool) -> io::Result<OutputFile> {
         keep_owner_and_permissions(&file, meta);
     }
     let large = old_meta.is_some_and(|m| m.len() >= UNLINK_APART_BYTES);
-    let unlinking = if large {
-        let old = old.clone();
-        let unlink = move || {
-            let _ = std::fs::remove_file(&old);
-        };
-        std::thread::Builder::new()
-            .name("cga-unlink".into())
-            .spawn(unlink)
-            .ok()
-    } else {
-        None
-    };
+    let unlinking = large.then(|| unlink_apart(old.clone())).flatten();
     if unlinking.is_none() {
         let _ = std::fs::remove_file(&old);
     }
     Ok(OutputFile { file, unlinking })
 }
 
-/// The older file at `path`, renamed to a hidden name beside it, when it
-/// is a plain file of one name that could be moved.
-struct Aside(PathBuf);
+/// Unlinks `old` on a thread of its own (`None` if none could start).
+fn unlink_apart(old: PathBuf) -> Option<JoinHandle<()>> {
+    let unlink = move || {
+        let _ = std::fs::remove_file(&old);
+    };
+    std::thread::Builder::new()
+        .name("cga-unlink".into())
+        .spawn(unlink)
+        .ok()
+}
 
-fn move_aside(path: &Path) -> Option<Aside> {
+/// Renames the older file at `path` to a hidden name beside it, when it is
+/// a plain file of one name that can be moved: that name.
+fn move_aside(path: &Path) -> Option<PathBuf> {
     let meta = std::fs::symlink_metadata(path).ok()?;
     if !meta.file_type().is_file() || !single_name(&meta) || meta.len() == 0 {
         return None;
@@ -94,7 +92,7 @@ fn move_aside(path: &Path) -> Option<Aside> {
     let name = path.file_name()?.to_string_lossy();
     let hidden = path.with_file_name(format!(".{name}.cga-old-{}-{n}", std::process::id()));
     std::fs::rename(path, &hidden).ok()?;
-    Some(Aside(hidden))
+    Some(hidden)
 }
 
 /// Gives the new file the old one's permissions and, where the process

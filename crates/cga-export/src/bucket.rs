@@ -6,6 +6,7 @@
 
 use cga_geometry::{DVec2, DVec3};
 
+use crate::array_pool::ArrayPool;
 use crate::ExportError;
 
 /// Vertex data of one material, kept as the `f32` and `u32` values the
@@ -157,14 +158,26 @@ impl Bucket {
 
     /// The data in its arrays (of a bucket filled by pushes alone),
     /// leaving fresh arrays with room for as much and a quarter more.
-    pub fn take_leaving_room(&mut self) -> Bucket {
+    /// The new arrays come from `pool` (arrays written out before).
+    pub fn take_leaving_room(&mut self, pool: &ArrayPool) -> Bucket {
         debug_assert!(self.sealed.is_empty());
         // The next batch of a material is about as large, often a little
         // larger: without the slack its arrays grew (a copy of each) in a
         // batch of every few (20 Candler buildings: 17 M instructions).
         // Room never written is not memory the process touches.
         let slack = |n: usize| n + n / 4;
-        self.take_arrays(slack(self.positions.len()), slack(self.indices.len()))
+        let (vertices, triangles) = (slack(self.positions.len()), slack(self.indices.len()));
+        let out = self.take_arrays();
+        self.positions = pool.take_vectors(vertices);
+        self.normals = pool.take_vectors(vertices);
+        for c in &mut self.coords {
+            *c = pool.take_coords(vertices);
+        }
+        if let Some(t) = &mut self.tangents {
+            *t = pool.take_tangents(vertices);
+        }
+        self.indices = pool.take_indices(triangles);
+        out
     }
 
     /// Room for `n` more vertices.
@@ -273,7 +286,7 @@ impl Bucket {
         }
         self.widen(part.min, part.max);
         if !self.positions.is_empty() || !self.indices.is_empty() {
-            let own = self.take_arrays(0, 0);
+            let own = self.take_arrays();
             self.sealed.push(own);
         }
         self.sealed.push(part);
@@ -312,24 +325,16 @@ impl Bucket {
         }
     }
 
-    /// This bucket's own arrays as a segment, leaving them empty with room
-    /// for `vertices` and `triangles`.
-    fn take_arrays(&mut self, vertices: usize, triangles: usize) -> Bucket {
-        fn swap_out<T>(v: &mut Vec<T>, room: usize) -> Vec<T> {
-            std::mem::replace(v, Vec::with_capacity(room))
-        }
+    /// This bucket's own arrays as a segment, leaving them empty.
+    fn take_arrays(&mut self) -> Bucket {
         Bucket {
-            positions: swap_out(&mut self.positions, vertices),
-            normals: swap_out(&mut self.normals, vertices),
+            positions: std::mem::take(&mut self.positions),
+            normals: std::mem::take(&mut self.normals),
             sets: self.sets.clone(),
-            coords: self
-                .coords
-                .iter_mut()
-                .map(|c| swap_out(c, vertices))
-                .collect(),
+            coords: self.coords.iter_mut().map(std::mem::take).collect(),
             tex_coords: self.tex_coords.clone(),
-            tangents: self.tangents.as_mut().map(|t| swap_out(t, vertices)),
-            indices: swap_out(&mut self.indices, triangles),
+            tangents: self.tangents.as_mut().map(std::mem::take),
+            indices: std::mem::take(&mut self.indices),
             features: std::mem::take(&mut self.features),
             min: self.min,
             max: self.max,
@@ -347,7 +352,7 @@ impl Bucket {
         if self.sealed.is_empty() {
             return;
         }
-        let own = self.take_arrays(0, 0);
+        let own = self.take_arrays();
         let sealed = std::mem::take(&mut self.sealed);
         let total: usize =
             sealed.iter().map(|s| s.positions.len()).sum::<usize>() + own.positions.len();

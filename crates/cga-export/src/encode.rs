@@ -14,6 +14,7 @@ use std::sync::Arc;
 use cga_geometry::mesh::SharedVec;
 use cga_geometry::{DAffine3, DVec2, DVec3, Material, Mesh, UV_SETS};
 
+use crate::array_pool::ArrayPool;
 use crate::bucket::{too_many_vertices, Bucket};
 use crate::gltf::{bucket_layout, face_tangent, texture_uses};
 use crate::instances::{decompose, Pending};
@@ -87,8 +88,9 @@ impl Encoded {
     }
 
     /// The batch's data in its own arrays, leaving the batch empty with
-    /// fresh arrays of room for as much (each bucket kept with `materials`,
-    /// the materials of its buckets in order).
+    /// arrays of room for as much from `pool` (arrays the writer wrote out;
+    /// each bucket kept with `materials`, the materials of its buckets in
+    /// order).
     ///
     /// Batches wait to be appended (a worker's lot waits for the lots
     /// before it), so their arrays are what the model holds in flight; the
@@ -100,12 +102,12 @@ impl Encoded {
     /// cost a copy of every encoded byte; reusing the arrays of appended
     /// batches, before that, made every array in flight grow to the most
     /// any material ever needed.)
-    fn take_batch(&mut self, materials: Vec<Material>) -> Encoded {
+    fn take_batch(&mut self, materials: Vec<Material>, pool: &ArrayPool) -> Encoded {
         let out = Encoded {
             buckets: self
                 .buckets
                 .iter_mut()
-                .map(Bucket::take_leaving_room)
+                .map(|b| b.take_leaving_room(pool))
                 .collect(),
             materials,
             faces: std::mem::take(&mut self.faces),
@@ -134,6 +136,8 @@ pub(crate) struct EncoderShared {
     pub origin: Option<DVec3>,
     /// Whether assets are placed as instances (`ExportOptions::instances`).
     pub instancing: bool,
+    /// Arrays the writer wrote out, for the encoders' next batches.
+    pub pool: Arc<ArrayPool>,
 }
 
 impl EncoderShared {
@@ -146,6 +150,7 @@ impl EncoderShared {
             probe,
             origin,
             instancing,
+            pool: Arc::default(),
         }
     }
 }
@@ -368,7 +373,9 @@ impl Encoder {
     /// The meshes encoded since the last call, as one batch; the encoder
     /// starts an empty one.
     pub fn take(&mut self) -> Encoded {
-        let batch = self.batch.take_batch(self.table.take_materials());
+        let batch = self
+            .batch
+            .take_batch(self.table.take_materials(), &self.shared.pool);
         // Slot ids name this batch's materials.
         self.mesh.forget_ids();
         batch
@@ -705,6 +712,53 @@ mod tests {
         assert_eq!(room(&e, 1), wall_room, "wall in the wall's bucket");
         let again = e.take();
         assert_eq!(again.buckets[1].positions, batch.buckets[0].positions);
+    }
+
+    /// Arrays the writer wrote out go round: a lot's data is written when
+    /// the next lot begins, its arrays go to the writer's pool, and the
+    /// encoder's next batch takes them (with their room) instead of new
+    /// ones. The model is the same as without the pool.
+    #[test]
+    fn written_arrays_come_back_to_the_encoder() {
+        use crate::ModelWriter;
+        let glb = |pooled: bool| {
+            let out = std::io::Cursor::new(Vec::new());
+            let mut w = ModelWriter::glb_into(out, "m.glb", ExportOptions::default()).unwrap();
+            let mut e = w.encoder().unwrap();
+            let cube = cga_geometry::primitive::cube(DVec3::new(2.0, 3.0, 4.0));
+            let wall = material("wall", 0.25);
+            let mut arrays = Vec::new();
+            for lot in 0..3 {
+                w.begin_lot(&format!("lot {lot}"), None).unwrap();
+                e.add_placed(&cube, None, &wall);
+                e.add_placed(&cube, None, &wall);
+                if !pooled {
+                    e.shared.pool.clear();
+                }
+                let batch = e.take();
+                let b = &batch.buckets[0];
+                assert_eq!(b.positions.len(), 48);
+                arrays.push([b.positions.as_ptr(), b.normals.as_ptr()]);
+                w.append(batch).unwrap();
+            }
+            let bytes = w.finish_into().unwrap().1.unwrap();
+            (arrays, bytes)
+        };
+        let (arrays, with_pool) = glb(true);
+        // Lot 0's arrays were written when lot 1 began; lot 1's batch left
+        // the encoder arrays from the pool (room for 60 vertices, which
+        // lot 0's have), which lot 2's batch took.
+        assert!(arrays[0].contains(&arrays[2][0]), "{arrays:?}");
+        assert!(arrays[0].contains(&arrays[2][1]), "{arrays:?}");
+        assert!(!arrays[0].contains(&arrays[1][0]), "{arrays:?}");
+        let (_, without) = glb(false);
+        let bytes = |out: Box<dyn crate::Output>| {
+            out.into_any()
+                .downcast::<std::io::Cursor<Vec<u8>>>()
+                .unwrap()
+                .into_inner()
+        };
+        assert_eq!(bytes(with_pool), bytes(without));
     }
 
     /// Normals of its own repeated corner after corner are placed and made

@@ -41,6 +41,7 @@ use cga_geometry::{DAffine3, DVec3, Material};
 use gltf_json as json;
 use json::validation::{Checked::Valid, USize64};
 
+use crate::array_pool::ArrayPool;
 use crate::bucket::Bucket;
 use crate::encode::Buckets;
 use crate::instances::{Instances, Pending, Trs};
@@ -693,6 +694,9 @@ pub(crate) struct GltfWriter {
     feature_bounds: Vec<Option<[[f64; 3]; 2]>>,
     /// The point positions are relative to: every node's translation.
     origin: Option<DVec3>,
+    /// Where arrays written out go for the encoders' next batches (see
+    /// `array_pool`); without one they are freed.
+    pool: Option<Arc<ArrayPool>>,
     /// Assets placed as instances, and the boxes of their placements
     /// (relative to the origin), over all and per lot.
     pub(crate) instances: Instances,
@@ -767,6 +771,7 @@ impl GltfWriter {
             lots_hint: None,
             json_room: GLB_JSON_ROOM,
             features: false,
+            pool: None,
             tail: Vec::new(),
             middle: Vec::new(),
             feature_bounds: Vec::new(),
@@ -811,6 +816,11 @@ impl GltfWriter {
     /// translated by it, and the bounds in the stats are moved back by it.
     pub(crate) fn set_origin(&mut self, origin: Option<DVec3>) {
         self.origin = origin;
+    }
+
+    /// Hands the arrays written out to `pool` instead of freeing them.
+    pub(crate) fn set_pool(&mut self, pool: Arc<ArrayPool>) {
+        self.pool = Some(pool);
     }
 
     /// Gives each lot's vertices its feature id and writes a property
@@ -1037,6 +1047,9 @@ impl GltfWriter {
             let features: usize = b.segments().map(|s| s.features.len()).sum();
             self.written_bytes += b.bytes() as u64 + features as u64 * 4;
             self.written.push(p);
+            if let Some(pool) = &self.pool {
+                b.sealed.drain(..).for_each(|s| pool.give_arrays(s));
+            }
             b.clear();
         }
         self.held = 0;

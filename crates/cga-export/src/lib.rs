@@ -26,6 +26,7 @@
 //! # Ok::<(), cga_export::ExportError>(())
 //! ```
 
+mod array_pool;
 mod bucket;
 pub mod builtin;
 mod draw;
@@ -467,6 +468,7 @@ impl ModelWriter {
         );
         if let Sink::Gltf(w, encoder) = &mut sink {
             w.set_origin(options.origin);
+            w.set_pool(encoders.pool.clone());
             encoder.origin = options.origin;
         }
         ModelWriter {

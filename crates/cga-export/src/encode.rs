@@ -41,6 +41,10 @@ pub struct Encoded {
     pub(crate) error: Option<ExportError>,
     /// Assets placed as instances, in order (see `instances`).
     pub(crate) instances: Vec<Pending>,
+    /// Where the batch's arrays go once written (its encoder's pool, which
+    /// its next batches take from): the writer, any of them, hands them
+    /// back.
+    pub(crate) pool: Option<Arc<ArrayPool>>,
     /// In an encoder's working batch: emptied buckets of its earlier
     /// batches, with the material each held, whose room new materials
     /// take: the same material's bucket where there is one (its arrays are
@@ -88,9 +92,9 @@ impl Encoded {
     }
 
     /// The batch's data in its own arrays, leaving the batch empty with
-    /// arrays of room for as much from `pool` (arrays the writer wrote out;
-    /// each bucket kept with `materials`, the materials of its buckets in
-    /// order).
+    /// arrays of room for as much from `pool` (arrays the writer wrote out,
+    /// where the batch's go back too; each bucket kept with `materials`,
+    /// the materials of its buckets in order).
     ///
     /// Batches wait to be appended (a worker's lot waits for the lots
     /// before it), so their arrays are what the model holds in flight; the
@@ -102,7 +106,7 @@ impl Encoded {
     /// cost a copy of every encoded byte; reusing the arrays of appended
     /// batches, before that, made every array in flight grow to the most
     /// any material ever needed.)
-    fn take_batch(&mut self, materials: Vec<Material>, pool: &ArrayPool) -> Encoded {
+    fn take_batch(&mut self, materials: Vec<Material>, pool: &Arc<ArrayPool>) -> Encoded {
         let out = Encoded {
             buckets: self
                 .buckets
@@ -116,6 +120,7 @@ impl Encoded {
             bytes: std::mem::take(&mut self.bytes),
             error: self.error.take(),
             instances: std::mem::take(&mut self.instances),
+            pool: Some(pool.clone()),
             spare: Vec::new(),
         };
         let kept = out.materials.iter().cloned().zip(self.buckets.drain(..));
@@ -715,7 +720,7 @@ mod tests {
     }
 
     /// Arrays the writer wrote out go round: a lot's data is written when
-    /// the next lot begins, its arrays go to the writer's pool, and the
+    /// the next lot begins, its arrays go back to its encoder's pool, and the
     /// encoder's next batch takes them (with their room) instead of new
     /// ones. The model is the same as without the pool.
     #[test]

@@ -695,7 +695,8 @@ pub(crate) struct GltfWriter {
     /// The point positions are relative to: every node's translation.
     origin: Option<DVec3>,
     /// Where arrays written out go for the encoders' next batches (see
-    /// `array_pool`); without one they are freed.
+    /// `array_pool`; the pool of the batches appended); without one they
+    /// are freed.
     pool: Option<Arc<ArrayPool>>,
     /// Assets placed as instances, and the boxes of their placements
     /// (relative to the origin), over all and per lot.
@@ -818,9 +819,12 @@ impl GltfWriter {
         self.origin = origin;
     }
 
-    /// Hands the arrays written out to `pool` instead of freeing them.
-    pub(crate) fn set_pool(&mut self, pool: Arc<ArrayPool>) {
-        self.pool = Some(pool);
+    /// Hands the arrays written out from now on to `pool` (that of the
+    /// encoders whose batches come) instead of freeing them.
+    pub(crate) fn return_arrays_to(&mut self, pool: &Arc<ArrayPool>) {
+        if !self.pool.as_ref().is_some_and(|p| Arc::ptr_eq(p, pool)) {
+            self.pool = Some(pool.clone());
+        }
     }
 
     /// Gives each lot's vertices its feature id and writes a property

@@ -468,7 +468,6 @@ impl ModelWriter {
         );
         if let Sink::Gltf(w, encoder) = &mut sink {
             w.set_origin(options.origin);
-            w.set_pool(encoders.pool.clone());
             encoder.origin = options.origin;
         }
         ModelWriter {
@@ -680,6 +679,9 @@ impl ModelWriter {
                 "encoded glTF data given to an OBJ writer".into(),
             ));
         };
+        if let Some(pool) = &batch.pool {
+            w.return_arrays_to(pool);
+        }
         // The batch's materials in their order of first use: interned in
         // that order, they get the ids the faces would have given them.
         for (material, data) in batch.materials.iter().zip(&mut batch.buckets) {

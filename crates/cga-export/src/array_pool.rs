@@ -110,6 +110,22 @@ impl ArrayPool {
         self.indices.take(n)
     }
 
+    pub fn give_vectors(&self, v: Vec<[f32; 3]>) {
+        self.vectors.give(v);
+    }
+
+    pub fn give_coords(&self, v: Vec<[f32; 2]>) {
+        self.coords.give(v);
+    }
+
+    pub fn give_tangents(&self, v: Vec<[f32; 4]>) {
+        self.tangents.give(v);
+    }
+
+    pub fn give_indices(&self, v: Vec<[u32; 3]>) {
+        self.indices.give(v);
+    }
+
     /// Frees every array kept.
     #[cfg(test)]
     pub fn clear(&self) {
@@ -123,15 +139,15 @@ impl ArrayPool {
     /// own arrays, not those of segments sealed into it).
     pub fn give_arrays(&self, b: Bucket) {
         debug_assert!(b.sealed.is_empty());
-        self.vectors.give(b.positions);
-        self.vectors.give(b.normals);
+        self.give_vectors(b.positions);
+        self.give_vectors(b.normals);
         for c in b.coords {
-            self.coords.give(c);
+            self.give_coords(c);
         }
         if let Some(t) = b.tangents {
-            self.tangents.give(t);
+            self.give_tangents(t);
         }
-        self.indices.give(b.indices);
+        self.give_indices(b.indices);
     }
 }
 

@@ -187,6 +187,9 @@ pub(crate) struct MeshEncoder {
     prep: FacePrep,
     slots: SlotIds,
     vertices: VertexSharing,
+    /// Where a bucket's arrays grow from (an [`Encoder`]'s batches: the
+    /// arrays its writer wrote out); `None`: from the allocator.
+    pub pool: Option<Arc<ArrayPool>>,
 }
 
 impl MeshEncoder {
@@ -216,14 +219,16 @@ impl MeshEncoder {
             prep,
             slots,
             vertices,
+            pool,
         } = self;
+        let pool = pool.as_deref();
         slots.begin(materials);
         vertices.begin(mesh);
         let mut counts = Counts::default();
         let result = prep.faces(mesh, transform, |f| {
             let material = slots.id(f.material, || store.id_of(&materials[f.material as usize]));
             let bucket = store.bucket(material);
-            counts.bytes += add_face(bucket, vertices, &FaceData { material, ..*f })?;
+            counts.bytes += add_face(bucket, vertices, pool, &FaceData { material, ..*f })?;
             counts.faces += 1;
             counts.triangles += f.triangles.len() as u64;
             Ok(())
@@ -284,6 +289,7 @@ impl Encoder {
         Encoder {
             mesh: MeshEncoder {
                 origin: shared.origin,
+                pool: Some(shared.pool.clone()),
                 ..MeshEncoder::default()
             },
             shared,
@@ -491,6 +497,7 @@ impl VertexSharing {
 fn add_face(
     bucket: &mut Bucket,
     sharing: &mut VertexSharing,
+    pool: Option<&ArrayPool>,
     f: &FaceData,
 ) -> Result<usize, ExportError> {
     let VertexSharing {
@@ -510,6 +517,10 @@ fn add_face(
     if uvs.is_some() && bucket.sets.is_empty() {
         bucket.start_coords();
         bytes += bucket.positions.len() * 8;
+    }
+    if let Some(pool) = pool {
+        let corners = f.loops.iter().map(|l| l.len as usize).sum();
+        bucket.room_from(pool, corners, f.triangles.len());
     }
     let vertices_before = bucket.positions.len();
     // Vertices are shared only where one UV set is written (the key
@@ -764,6 +775,37 @@ mod tests {
                 .into_inner()
         };
         assert_eq!(bytes(with_pool), bytes(without));
+    }
+
+    /// An array of a batch that outgrows its room grows into an array the
+    /// writer wrote out (from the pool: already touched memory), not into
+    /// fresh memory from the allocator, and the short array goes to the
+    /// pool; the data is as pushes alone would give.
+    #[test]
+    fn short_arrays_grow_from_the_pool() {
+        let cube = cga_geometry::primitive::cube(DVec3::new(2.0, 3.0, 4.0));
+        let wall = material("wall", 0.25);
+        let mut plain = Encoder::for_export(&ExportOptions::default());
+        plain.add_placed(&cube, None, &wall);
+        let mut e = Encoder::for_export(&ExportOptions::default());
+        let written: Vec<[f32; 3]> = Vec::with_capacity(1000);
+        let written_at = written.as_ptr();
+        e.shared.pool.give_vectors(written);
+        e.add_placed(&cube, None, &wall);
+        // The first face needed room for 4 vertices: the positions took the
+        // written array (the least room that fits) and kept it; the
+        // normals, with nothing else kept, grew 4 -> 8 -> 16 -> 32, each
+        // from a new array, each short one given to the pool.
+        assert_eq!(room(&e, 0), (written_at, 1000));
+        let normals = &e.batch.buckets[0].normals;
+        assert_eq!((normals.len(), normals.capacity()), (24, 32));
+        for n in [4, 8, 16] {
+            assert_eq!(e.shared.pool.take_vectors(n).capacity(), n);
+        }
+        let (a, b) = (e.take(), plain.take());
+        assert_eq!(a.buckets[0].positions, b.buckets[0].positions);
+        assert_eq!(a.buckets[0].normals, b.buckets[0].normals);
+        assert_eq!(a.buckets[0].indices, b.buckets[0].indices);
     }
 
     /// Normals of its own repeated corner after corner are placed and made

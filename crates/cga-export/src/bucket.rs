@@ -44,6 +44,12 @@ pub(crate) struct Bucket {
     /// above take pushes only while there are none
     /// ([`Bucket::consolidate`]).
     pub sealed: Vec<Bucket>,
+    /// The room of the shortest vertex array when [`Bucket::room_from`]
+    /// last looked (0: not looked since arrays were replaced): while the
+    /// vertices stay within it, a face needs one comparison, not one per
+    /// array. Never more than the true room where arrays only grow; an
+    /// array replaced without resetting it grows as any `Vec` does.
+    vertex_room: usize,
 }
 
 pub(crate) fn too_many_vertices() -> ExportError {
@@ -103,6 +109,7 @@ impl Bucket {
             (true, t) => Some(t.unwrap_or_default()),
             (false, _) => None,
         };
+        self.vertex_room = 0;
     }
 
     /// Bytes of vertex data held.
@@ -189,14 +196,8 @@ impl Bucket {
     /// a GLB: a third of a run's page faults).
     #[inline]
     pub fn room_from(&mut self, pool: &ArrayPool, vertices: usize, triangles: usize) {
-        fn short<T>(v: &Vec<T>, n: usize) -> bool {
-            v.capacity() - v.len() < n
-        }
-        if short(&self.positions, vertices)
-            || short(&self.normals, vertices)
-            || self.coords.iter().any(|c| short(c, vertices))
-            || self.tangents.as_ref().is_some_and(|t| short(t, vertices))
-            || short(&self.indices, triangles)
+        if self.positions.len() + vertices > self.vertex_room
+            || self.indices.capacity() - self.indices.len() < triangles
         {
             self.regrow_from(pool, vertices, triangles);
         }
@@ -247,6 +248,12 @@ impl Bucket {
             |n| pool.take_indices(n),
             |v| pool.give_indices(v),
         );
+        let rooms = [&self.positions, &self.normals]
+            .into_iter()
+            .map(Vec::capacity)
+            .chain(self.coords.iter().map(Vec::capacity))
+            .chain(self.tangents.iter().map(Vec::capacity));
+        self.vertex_room = rooms.min().unwrap_or(0);
     }
 
     /// Room for `n` more vertices.
@@ -269,6 +276,7 @@ impl Bucket {
         }
         self.sets.push(0);
         self.coords.push(vec![[0.0; 2]; self.positions.len()]);
+        self.vertex_room = 0;
     }
 
     /// Appends a vertex at `p` with normal `n`; `sources[k]` is where the
@@ -365,6 +373,7 @@ impl Bucket {
     /// Lays out a segment's data as a bucket writing the UV `sets` (and
     /// tangents if `tangents`) holds it.
     fn conform(&mut self, sets: &[usize], tangents: bool) {
+        self.vertex_room = 0;
         let n = self.positions.len();
         if self.sets != sets {
             let mut coords = std::mem::take(&mut self.coords);
@@ -408,6 +417,7 @@ impl Bucket {
             min: self.min,
             max: self.max,
             sealed: Vec::new(),
+            vertex_room: std::mem::take(&mut self.vertex_room),
         }
     }
 

@@ -141,7 +141,7 @@ fn each_face(
         // normal with less work (the face is finite here).
         let normal = match loops {
             [outer] if outer.len == 4 => {
-                triangulate_finite_quad(mesh, positions, *outer, triangles);
+                let first_diagonal = triangulate_finite_quad(mesh, positions, *outer, triangles);
                 if triangles.is_empty() {
                     continue;
                 }
@@ -150,7 +150,7 @@ fn each_face(
                 // writes no normals never: left for later (see
                 // `deferred_normal`) where the face is sure to be written.
                 let wanted_later = normals.is_some() || without_normals;
-                if wanted_later && cut_along_first_diagonal(outer.start, triangles) {
+                if wanted_later && first_diagonal {
                     Deferred
                 } else {
                     Known(quad_normal(mesh, positions, *outer))
@@ -194,13 +194,6 @@ enum FaceNormal {
     Deferred,
 }
 use FaceNormal::{Deferred, Known};
-
-/// Whether a quad whose corners start at `s` is cut into `triangles`
-/// along its first diagonal (corners 0–2), as `triangulate_finite_quad`
-/// cuts it when both halves turn the same way.
-fn cut_along_first_diagonal(s: u32, triangles: &[[u32; 3]]) -> bool {
-    triangles == [[s, s + 1, s + 2], [s, s + 2, s + 3]]
-}
 
 /// The normal of a face `FacePrep` wrote without one (a quad with normals
 /// of its own, cut along its first diagonal): what it would have given,

@@ -145,12 +145,17 @@ fn push_quad(s: u32, first_diagonal: bool, out: &mut Vec<[u32; 3]>) {
 /// taken without `f64::max`'s care for NaN (Newell vectors of corners that
 /// are finite but whose edges overflow are not finite, and give no
 /// triangles both ways).
+///
+/// Returns whether the triangles appended are exactly the loop's corners
+/// (0, 1, 2) and (0, 2, 3): the cut along the first diagonal. (Told by
+/// the caller comparing the triangles, it cost a stall per quad: the
+/// comparison read back as wide words values just stored one by one.)
 pub fn triangulate_finite_quad(
     mesh: &Mesh,
     positions: &[DVec3],
     outer: Loop,
     out: &mut Vec<[u32; 3]>,
-) {
+) -> bool {
     let s = outer.start as usize;
     let p = |k: usize| positions[mesh.corners[s + k] as usize];
     let (p0, p1, p2, p3) = (p(0), p(1), p(2), p(3));
@@ -159,7 +164,7 @@ pub fn triangulate_finite_quad(
     let n = (DVec3::ZERO + c1) + c2;
     let d = n.length_squared();
     if !(d > 0.0 && d.is_finite()) {
-        return;
+        return false;
     }
     let l = largest_magnitude(&[r1, r2, r3]);
     let a = largest_magnitude(&[n]);
@@ -173,14 +178,20 @@ pub fn triangulate_finite_quad(
     let big_bound = (largest_magnitude(&[p0]) + l) * (1.0 + 1e-9);
     if diagonal_by_sign(a1, a2, l, big_bound, a) == Some(true) {
         push_quad(outer.start, true, out);
-        return;
+        return true;
     }
     let big = largest_magnitude(&[p0, p1, p2, p3]);
     match diagonal_by_sign(a1, a2, l, big, a) {
-        Some(first) => push_quad(outer.start, first, out),
+        Some(first) => {
+            push_quad(outer.start, first, out);
+            first
+        }
         None => {
+            let before = out.len();
             let unit = crate::measure::unit_newell(n);
             triangulate_loops_with_normal(mesh, positions, &[outer], unit, out);
+            let s = outer.start;
+            out[before..] == [[s, s + 1, s + 2], [s, s + 2, s + 3]]
         }
     }
 }
@@ -514,8 +525,9 @@ mod tests {
         // The writers' path for finite quads gives the Newell path's
         // triangles (and so the projection's).
         let mut writers = Vec::new();
-        triangulate_finite_quad(&m, &m.positions, m.loops[0], &mut writers);
+        let first = triangulate_finite_quad(&m, &m.positions, m.loops[0], &mut writers);
         assert_eq!(writers, fast, "{corners:?}");
+        assert_eq!(first, writers == [[0, 1, 2], [0, 2, 3]], "{corners:?}");
         (fast, reference)
     }
 

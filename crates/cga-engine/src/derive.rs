@@ -442,6 +442,9 @@ pub struct Interp<'a> {
     /// The deepest generation applied so far (how deep a remembered
     /// subtree goes: the depth limit).
     deepest: usize,
+    /// The lot's own copies of the program's string and array literals, by
+    /// the address of the program's (see `Interp::own_literal`).
+    pub(crate) literals: cga_geometry::topology::FxHashMap<usize, Value>,
 }
 
 /// Subtrees being remembered inside one another at most (see
@@ -717,6 +720,7 @@ impl<'a> Interp<'a> {
             subtrees_open: 0,
             plane_logs: Vec::new(),
             deepest: 0,
+            literals: Default::default(),
         }
     }
 

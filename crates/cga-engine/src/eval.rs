@@ -18,7 +18,10 @@ const CONST_STREAMS: u64 = 2 << 40;
 impl Interp<'_> {
     pub fn eval(&mut self, e: &RExpr, frame: &[Value], shape: &Shape) -> Result<Value, RtError> {
         match &e.kind {
-            RExprKind::Const(v) => Ok(v.clone()),
+            RExprKind::Const(v) => Ok(match v {
+                Value::Float(_) | Value::Bool(_) => v.clone(),
+                _ => self.own_literal(v),
+            }),
             RExprKind::Local(i) => Ok(frame[*i as usize].clone()),
             RExprKind::Attr(id) => self.attr_value(*id, shape, e),
             RExprKind::Func(f, args) => {
@@ -169,6 +172,27 @@ impl Interp<'_> {
                 e.span,
             )),
         }
+    }
+
+    /// The lot's own copy of `v`, a string or array literal of the program.
+    /// The program is shared by the deriving threads: a clone of its value
+    /// takes and later drops a reference count in a cache line the threads
+    /// passed between them at every literal evaluated (Candler's texture
+    /// paths, asset names and modes, for every window). A lot's copy is
+    /// made once and equal by value, as strings and arrays are compared.
+    #[inline(never)]
+    fn own_literal(&mut self, v: &Value) -> Value {
+        let address = match v {
+            Value::Str(s) => s.as_ptr() as usize,
+            Value::FloatArray(a) => std::sync::Arc::as_ptr(a) as usize,
+            Value::BoolArray(a) => std::sync::Arc::as_ptr(a) as usize,
+            Value::StrArray(a) => std::sync::Arc::as_ptr(a) as usize,
+            Value::Float(_) | Value::Bool(_) => return v.clone(),
+        };
+        self.literals
+            .entry(address)
+            .or_insert_with(|| v.own_copy())
+            .clone()
     }
 
     pub fn eval_num(&mut self, e: &RExpr, frame: &[Value], shape: &Shape) -> Result<f64, RtError> {
@@ -322,5 +346,67 @@ impl Interp<'_> {
         }
         self.depth += 1;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use cga_syntax::Span;
+    use cga_value::Value;
+
+    use crate::derive::{InitialInfo, Interp, Limits};
+    use crate::expr::RExpr;
+
+    /// A string literal evaluates to the lot's own copy: equal to the
+    /// program's value but not its allocation (whose reference count the
+    /// deriving threads would share), the same copy every time within a
+    /// lot, and another lot's copy in another lot. Numbers are themselves.
+    #[test]
+    fn literals_evaluate_to_the_lots_own_copies() {
+        let dir = std::env::temp_dir().join(format!("cga-engine-literals-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("literals.cga");
+        std::fs::write(&path, "Lot --> X.\n").unwrap();
+        let mut sources = cga_syntax::SourceMap::new();
+        let program = crate::load(&cga_world::DiskWorld, &path, &mut sources)
+            .usable()
+            .expect("rules load");
+        let assets = crate::assets::Assets::on_disk(&sources);
+        let shape = crate::lot::initial_shape(&crate::lot::rect(2.0, 3.0), 0, 0);
+        let lot = || {
+            let info = InitialInfo {
+                name: "lot".into(),
+                start_rule: "Lot".into(),
+                geo_origin: None,
+            };
+            Interp::new(
+                &program,
+                &assets,
+                Limits::default(),
+                info,
+                shape.clone(),
+                &[],
+            )
+        };
+        let text: Arc<str> = Arc::from("facade/windows/sill.jpg");
+        let literal = RExpr::constant(Value::Str(text.clone()), Span::default());
+        let string = |v: Value| match v {
+            Value::Str(s) => s,
+            other => panic!("{other:?}"),
+        };
+        let mut first = lot();
+        let a = string(first.eval(&literal, &[], &shape).unwrap());
+        let b = string(first.eval(&literal, &[], &shape).unwrap());
+        assert_eq!(a, text);
+        assert!(!Arc::ptr_eq(&a, &text));
+        assert!(Arc::ptr_eq(&a, &b));
+        let c = string(lot().eval(&literal, &[], &shape).unwrap());
+        assert_eq!(c, text);
+        assert!(!Arc::ptr_eq(&c, &a));
+        let number = RExpr::constant(Value::Float(2.5), Span::default());
+        assert_eq!(first.eval(&number, &[], &shape).unwrap(), Value::Float(2.5));
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -228,7 +228,7 @@ impl MeshEncoder {
         let result = prep.faces(mesh, transform, |f| {
             let material = slots.id(f.material, || store.id_of(&materials[f.material as usize]));
             let bucket = store.bucket(material);
-            counts.bytes += add_face(bucket, vertices, pool, &FaceData { material, ..*f })?;
+            counts.bytes += add_face(bucket, vertices, pool, f, material)?;
             counts.faces += 1;
             counts.triangles += f.triangles.len() as u64;
             Ok(())
@@ -491,14 +491,20 @@ impl VertexSharing {
     }
 }
 
-/// Appends face `f` to the bucket of its material: its vertices and
-/// triangles. Corners of a mesh with its own normals share vertices where
-/// position, normal and UV agree; other faces get a vertex per corner.
+/// Appends face `f` to `bucket`, that of its output material `material`
+/// (`f.material` is the face's slot): its vertices and triangles. Corners
+/// of a mesh with its own normals share vertices where position, normal
+/// and UV agree; other faces get a vertex per corner.
+///
+/// The id comes apart from `f`, which is read as the preparation wrote it:
+/// a copy of `f` with the id changed cost a stall per face (a wide load of
+/// fields just stored one by one, which the processor cannot forward).
 fn add_face(
     bucket: &mut Bucket,
     sharing: &mut VertexSharing,
     pool: Option<&ArrayPool>,
     f: &FaceData,
+    material: u32,
 ) -> Result<usize, ExportError> {
     let VertexSharing {
         corner_vertex,
@@ -545,7 +551,7 @@ fn add_face(
                 let n = last_normal.unit(normals[c], f);
                 let uv = uvs.map_or([0; 2], |u| u[c].as_vec2().to_array().map(f32::to_bits));
                 let key = VertexKey {
-                    material: f.material,
+                    material,
                     normal: n.as_vec3().to_array().map(f32::to_bits),
                     uv,
                 };

@@ -1025,6 +1025,18 @@ impl<'a> Interp<'a> {
         Ok(self.successor(parent))
     }
 
+    /// [`child`](Interp::child) with `geometry` in place of the parent's
+    /// (a split part's piece).
+    pub(crate) fn child_with(
+        &mut self,
+        parent: &Shape,
+        geometry: crate::shape::Geometry,
+        span: Span,
+    ) -> Result<Box<Shape>, RtError> {
+        self.count_shape(span)?;
+        Ok(self.successor_with(parent, geometry))
+    }
+
     /// [`child`](Interp::child) of a shape used no more after it (its last
     /// statement; see `exec_stmt`): the shape becomes its own successor, in
     /// its own box, and the state keeps a husk (an empty shape from
@@ -1061,10 +1073,16 @@ impl<'a> Interp<'a> {
 
     /// [`child`](Interp::child) without counting it.
     fn successor(&mut self, parent: &Shape) -> Box<Shape> {
+        self.successor_with(parent, parent.geometry.clone())
+    }
+
+    /// [`successor`](Interp::successor) with `geometry` in place of the
+    /// parent's.
+    fn successor_with(&mut self, parent: &Shape, geometry: crate::shape::Geometry) -> Box<Shape> {
         let rng = parent.child_rng(parent.next_random().to_bits());
         // Written straight into its box: `Box::new(parent.clone())` made
         // the clone on the stack and copied its 480 bytes into the box.
-        let mut c = Box::write(Box::new_uninit(), parent.clone());
+        let mut c = Box::write(Box::new_uninit(), parent.clone_with_geometry(geometry));
         c.parent_center = parent.scope.center();
         c.rng.set(rng);
         if self.context.is_some() {

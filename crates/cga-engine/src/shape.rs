@@ -293,6 +293,30 @@ pub struct Shape {
 }
 
 impl Shape {
+    /// A copy of the shape with `geometry` in place of its own: what
+    /// `clone` and then setting the geometry give, without taking and
+    /// handing back a reference to the geometry replaced (two atomic
+    /// operations for every split part).
+    pub fn clone_with_geometry(&self, geometry: Geometry) -> Shape {
+        Shape {
+            scope: self.scope,
+            pivot: self.pivot,
+            geometry,
+            parent_center: self.parent_center,
+            material: self.material.clone(),
+            attrs: self.attrs.clone(),
+            split_index: self.split_index,
+            split_total: self.split_total,
+            comp: self.comp.clone(),
+            trim: self.trim.clone(),
+            projections: self.projections.clone(),
+            rng: self.rng.clone(),
+            seedian: self.seedian,
+            name: self.name,
+            ctx: self.ctx,
+        }
+    }
+
     /// A shape with nothing set: no geometry, the identity frame for scope
     /// and pivot, its own default material, no attributes, component or
     /// projection info. The initial shape starts from it, and it is the

@@ -109,26 +109,33 @@ fn split_axis(
     for (k, (part, piece)) in placed.iter().zip(pieces).enumerate() {
         // A split that ends the shape's operations hands the shape itself
         // on to its last part (see `Interp::last_child`).
-        let mut child = match st.at_last && k == last {
-            true => cx.last_child(st, call.span)?,
-            false => cx.child(&st.shape, call.span)?,
+        let builds = cx.builds_parts(bodies[part.part]);
+        let start = sign * part.start;
+        let geometry = match builds {
+            true => part_geometry(piece, axis, start),
+            // Without a model, a part whose rules read nothing of it shows
+            // only whether it is empty.
+            false => match piece.faces.is_empty() {
+                true => crate::shape::Geometry::empty(),
+                false => crate::shape::Geometry::unread(),
+            },
         };
-        if cx.builds_parts(bodies[part.part]) {
-            place_part(
+        let mut child = match st.at_last && k == last {
+            true => {
+                let mut child = cx.last_child(st, call.span)?;
+                child.geometry = geometry;
+                child
+            }
+            false => cx.child_with(&st.shape, geometry, call.span)?,
+        };
+        if builds {
+            place_scope(
                 &mut child,
-                piece,
                 axis,
-                sign * part.start,
+                start,
                 sign * (part.end - part.start),
                 adjust,
             );
-        } else {
-            // Without a model, a part whose rules read nothing of it shows
-            // only whether it is empty.
-            child.geometry = match piece.faces.is_empty() {
-                true => crate::shape::Geometry::empty(),
-                false => crate::shape::Geometry::unread(),
-            };
         }
         child.split_index = part.index as f64;
         child.split_total = total;
@@ -269,29 +276,30 @@ fn cut_parts(mesh: &Arc<Mesh>, axis: usize, sign: f64, placed: &[Placed]) -> Vec
         .collect()
 }
 
-/// Gives `child` the part's geometry (in the parent's scope-local frame)
-/// and its scope: the slab `[start, start + size]` along the axis, or the
-/// geometry's bounding box (`adjust`).
-pub(crate) fn place_part(
-    child: &mut Shape,
-    piece: Arc<Mesh>,
-    axis: usize,
-    start: f64,
-    size: f64,
-    adjust: bool,
-) {
+/// The geometry of a part cut out at `start` along `axis`: `piece` in the
+/// part's scope (whose origin [`place_scope`] moves there). Made before
+/// the part's shape, which takes it in place of its parent's
+/// (`Interp::child_with`).
+pub(crate) fn part_geometry(piece: Arc<Mesh>, axis: usize, start: f64) -> Geometry {
+    let mut offset = DVec3::ZERO;
+    offset[axis] = start;
+    let mut g = Geometry::new(piece);
+    g.transform(DAffine3::from_translation(-offset));
+    g
+}
+
+/// The scope of a part from `start` to `start + size` along `axis` of the
+/// scope `child` has (its parent's), its geometry given
+/// ([`part_geometry`]); with `adjust`, fitted to that geometry.
+pub(crate) fn place_scope(child: &mut Shape, axis: usize, start: f64, size: f64, adjust: bool) {
     let mut offset = DVec3::ZERO;
     offset[axis] = start;
     let axes = child.scope.frame.axes;
     let mut scope = child.scope;
     scope.frame.origin += axes * offset;
     scope.size[axis] = size;
-    let empty = piece.faces.is_empty();
-    let mut g = Geometry::new(piece);
-    g.transform(DAffine3::from_translation(-offset));
-    child.geometry = g;
     child.scope = scope;
-    if adjust && !empty {
+    if adjust && !child.geometry.is_empty() {
         child.fit_scope(axes);
     }
 }

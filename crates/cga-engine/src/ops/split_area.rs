@@ -33,7 +33,7 @@ use std::cell::RefCell;
 use cga_geometry::{split_by_parallel_planes, AreaProfile, DVec3, Mesh};
 use cga_value::Value;
 
-use super::split::{add_parts, place_part};
+use super::split::{add_parts, part_geometry, place_scope};
 use super::transform::selector;
 use crate::derive::{Arg, Interp, RtError, ShapeState};
 use crate::expr::{OpCall, RBody};
@@ -119,15 +119,9 @@ pub fn exec(
     for (index, part) in plan.parts.iter().enumerate() {
         let (start, end) = (plan.positions[part.slab - 1], plan.positions[part.slab]);
         let piece = std::sync::Arc::new(std::mem::take(&mut slabs[part.slab - plan.first_cut]));
-        let mut child = cx.child(&st.shape, call.span)?;
-        place_part(
-            &mut child,
-            piece,
-            axis,
-            sign * start,
-            sign * (end - start),
-            adjust,
-        );
+        let geometry = part_geometry(piece, axis, sign * start);
+        let mut child = cx.child_with(&st.shape, geometry, call.span)?;
+        place_scope(&mut child, axis, sign * start, sign * (end - start), adjust);
         child.split_index = index as f64;
         child.split_total = total;
         let mut cst = ShapeState::new(child);

@@ -44,11 +44,12 @@ pub(crate) struct Bucket {
     /// above take pushes only while there are none
     /// ([`Bucket::consolidate`]).
     pub sealed: Vec<Bucket>,
-    /// The room of the shortest vertex array when [`Bucket::room_from`]
-    /// last looked (0: not looked since arrays were replaced): while the
-    /// vertices stay within it, a face needs one comparison, not one per
-    /// array. Never more than the true room where arrays only grow; an
-    /// array replaced without resetting it grows as any `Vec` does.
+    /// The capacity of the shortest vertex array when
+    /// [`Bucket::room_from`] last looked (0: not since arrays were
+    /// replaced): while the vertices stay within it, a face needs one
+    /// comparison, not one per array. Arrays only grow between looks, so
+    /// it never overstates their room; an array replaced without resetting
+    /// it would only grow as any `Vec` does.
     vertex_room: usize,
 }
 

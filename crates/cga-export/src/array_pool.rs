@@ -27,14 +27,14 @@ const KEPT_BYTES_PER_KIND: usize = 64 << 20;
 #[derive(Default)]
 pub(crate) struct ArrayPool {
     /// Positions and normals.
-    vectors: Shelf<[f32; 3]>,
-    coords: Shelf<[f32; 2]>,
-    tangents: Shelf<[f32; 4]>,
-    indices: Shelf<[u32; 3]>,
+    pub vectors: Shelf<[f32; 3]>,
+    pub coords: Shelf<[f32; 2]>,
+    pub tangents: Shelf<[f32; 4]>,
+    pub indices: Shelf<[u32; 3]>,
 }
 
 /// Empty arrays of one element type.
-struct Shelf<T>(Mutex<Vec<Vec<T>>>);
+pub(crate) struct Shelf<T>(Mutex<Vec<Vec<T>>>);
 
 impl<T> Default for Shelf<T> {
     fn default() -> Self {
@@ -46,7 +46,7 @@ impl<T> Shelf<T> {
     /// An empty array with room for `n`: the kept one of least room that
     /// has enough, else a new one (of room for `n` exactly: growing a kept
     /// smaller one would copy its room for nothing).
-    fn take(&self, n: usize) -> Vec<T> {
+    pub fn take(&self, n: usize) -> Vec<T> {
         if n == 0 {
             return Vec::new();
         }
@@ -64,7 +64,7 @@ impl<T> Shelf<T> {
     }
 
     /// Keeps `v`'s room for a later `take`.
-    fn give(&self, mut v: Vec<T>) {
+    pub fn give(&self, mut v: Vec<T>) {
         if v.capacity() == 0 {
             return;
         }
@@ -87,6 +87,22 @@ impl<T> Shelf<T> {
         }
     }
 
+    /// `v` with room for `n` more: where it is short, moved into a kept
+    /// array of at least twice its room (growth stays geometric; a new one
+    /// if none fits) and its own array kept instead. Growing in place
+    /// would take fresh memory from the allocator.
+    pub fn grow(&self, v: &mut Vec<T>, n: usize)
+    where
+        T: Copy,
+    {
+        if v.capacity() - v.len() >= n {
+            return;
+        }
+        let mut grown = self.take((v.len() + n).max(2 * v.capacity()));
+        grown.extend_from_slice(v);
+        self.give(std::mem::replace(v, grown));
+    }
+
     #[cfg(test)]
     fn len(&self) -> usize {
         self.0.lock().unwrap().len()
@@ -94,38 +110,6 @@ impl<T> Shelf<T> {
 }
 
 impl ArrayPool {
-    pub fn take_vectors(&self, n: usize) -> Vec<[f32; 3]> {
-        self.vectors.take(n)
-    }
-
-    pub fn take_coords(&self, n: usize) -> Vec<[f32; 2]> {
-        self.coords.take(n)
-    }
-
-    pub fn take_tangents(&self, n: usize) -> Vec<[f32; 4]> {
-        self.tangents.take(n)
-    }
-
-    pub fn take_indices(&self, n: usize) -> Vec<[u32; 3]> {
-        self.indices.take(n)
-    }
-
-    pub fn give_vectors(&self, v: Vec<[f32; 3]>) {
-        self.vectors.give(v);
-    }
-
-    pub fn give_coords(&self, v: Vec<[f32; 2]>) {
-        self.coords.give(v);
-    }
-
-    pub fn give_tangents(&self, v: Vec<[f32; 4]>) {
-        self.tangents.give(v);
-    }
-
-    pub fn give_indices(&self, v: Vec<[u32; 3]>) {
-        self.indices.give(v);
-    }
-
     /// Frees every array kept.
     #[cfg(test)]
     pub fn clear(&self) {
@@ -139,15 +123,15 @@ impl ArrayPool {
     /// own arrays, not those of segments sealed into it).
     pub fn give_arrays(&self, b: Bucket) {
         debug_assert!(b.sealed.is_empty());
-        self.give_vectors(b.positions);
-        self.give_vectors(b.normals);
+        self.vectors.give(b.positions);
+        self.vectors.give(b.normals);
         for c in b.coords {
-            self.give_coords(c);
+            self.coords.give(c);
         }
         if let Some(t) = b.tangents {
-            self.give_tangents(t);
+            self.tangents.give(t);
         }
-        self.give_indices(b.indices);
+        self.indices.give(b.indices);
     }
 }
 
@@ -172,17 +156,17 @@ mod tests {
 
         // The least room that fits: the normals' for 40, the positions'
         // for 41.
-        let v = pool.take_vectors(30);
+        let v = pool.vectors.take(30);
         assert_eq!((v.as_ptr(), v.len()), (normals, 0));
-        let v = pool.take_vectors(41);
+        let v = pool.vectors.take(41);
         assert_eq!((v.as_ptr(), v.len()), (positions, 0));
         // Nothing kept fits: a new array of the room asked.
-        let v = pool.take_vectors(7);
+        let v = pool.vectors.take(7);
         assert!(v.capacity() >= 7 && v.is_empty());
-        assert!(pool.take_coords(101).capacity() >= 101);
-        assert!(pool.take_coords(100).capacity() >= 100);
+        assert!(pool.coords.take(101).capacity() >= 101);
+        assert!(pool.coords.take(100).capacity() >= 100);
         assert_eq!(pool.coords.len(), 0);
-        assert!(pool.take_indices(0).capacity() == 0);
+        assert!(pool.indices.take(0).capacity() == 0);
         assert_eq!(pool.indices.len(), 1, "room for 0 takes nothing");
     }
 

@@ -176,15 +176,15 @@ impl Bucket {
         let slack = |n: usize| n + n / 4;
         let (vertices, triangles) = (slack(self.positions.len()), slack(self.indices.len()));
         let out = self.take_arrays();
-        self.positions = pool.take_vectors(vertices);
-        self.normals = pool.take_vectors(vertices);
+        self.positions = pool.vectors.take(vertices);
+        self.normals = pool.vectors.take(vertices);
         for c in &mut self.coords {
-            *c = pool.take_coords(vertices);
+            *c = pool.coords.take(vertices);
         }
         if let Some(t) = &mut self.tangents {
-            *t = pool.take_tangents(vertices);
+            *t = pool.tangents.take(vertices);
         }
-        self.indices = pool.take_indices(triangles);
+        self.indices = pool.indices.take(triangles);
         out
     }
 
@@ -207,48 +207,15 @@ impl Bucket {
     /// [`Bucket::room_from`] for a bucket with a short array.
     #[cold]
     fn regrow_from(&mut self, pool: &ArrayPool, vertices: usize, triangles: usize) {
-        /// `v` with room for `n` more: where short, an array of at least
-        /// twice its room (growth stays geometric) from `take`, the short
-        /// one handed to `give`.
-        fn regrow<T: Copy>(
-            v: &mut Vec<T>,
-            n: usize,
-            take: impl FnOnce(usize) -> Vec<T>,
-            give: impl FnOnce(Vec<T>),
-        ) {
-            if v.capacity() - v.len() >= n {
-                return;
-            }
-            let mut grown = take((v.len() + n).max(2 * v.capacity()));
-            grown.extend_from_slice(v);
-            give(std::mem::replace(v, grown));
-        }
-        let vectors = |n| pool.take_vectors(n);
-        let keep_vectors = |v| pool.give_vectors(v);
-        regrow(&mut self.positions, vertices, vectors, keep_vectors);
-        regrow(&mut self.normals, vertices, vectors, keep_vectors);
+        pool.vectors.grow(&mut self.positions, vertices);
+        pool.vectors.grow(&mut self.normals, vertices);
         for c in &mut self.coords {
-            regrow(
-                c,
-                vertices,
-                |n| pool.take_coords(n),
-                |v| pool.give_coords(v),
-            );
+            pool.coords.grow(c, vertices);
         }
         if let Some(t) = &mut self.tangents {
-            regrow(
-                t,
-                vertices,
-                |n| pool.take_tangents(n),
-                |v| pool.give_tangents(v),
-            );
+            pool.tangents.grow(t, vertices);
         }
-        regrow(
-            &mut self.indices,
-            triangles,
-            |n| pool.take_indices(n),
-            |v| pool.give_indices(v),
-        );
+        pool.indices.grow(&mut self.indices, triangles);
         let rooms = [&self.positions, &self.normals]
             .into_iter()
             .map(Vec::capacity)

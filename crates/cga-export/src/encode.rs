@@ -796,7 +796,7 @@ mod tests {
         let mut e = Encoder::for_export(&ExportOptions::default());
         let written: Vec<[f32; 3]> = Vec::with_capacity(1000);
         let written_at = written.as_ptr();
-        e.shared.pool.give_vectors(written);
+        e.shared.pool.vectors.give(written);
         e.add_placed(&cube, None, &wall);
         // The first face needed room for 4 vertices: the positions took the
         // written array (the least room that fits) and kept it; the
@@ -806,7 +806,7 @@ mod tests {
         let normals = &e.batch.buckets[0].normals;
         assert_eq!((normals.len(), normals.capacity()), (24, 32));
         for n in [4, 8, 16] {
-            assert_eq!(e.shared.pool.take_vectors(n).capacity(), n);
+            assert_eq!(e.shared.pool.vectors.take(n).capacity(), n);
         }
         let (a, b) = (e.take(), plain.take());
         assert_eq!(a.buckets[0].positions, b.buckets[0].positions);

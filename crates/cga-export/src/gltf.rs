@@ -44,7 +44,7 @@ use json::validation::{Checked::Valid, USize64};
 use crate::array_pool::ArrayPool;
 use crate::bucket::Bucket;
 use crate::encode::Buckets;
-use crate::instances::{Instances, Pending, Trs};
+use crate::instances::{Instances, Pending, Placement, Trs};
 use crate::json_spool::{self, GlbJson, Spool};
 use crate::materials::{color_to_linear, MaterialTable};
 use crate::output_file::OutputFile;
@@ -688,8 +688,6 @@ pub(crate) struct GltfWriter {
     features: bool,
     /// The property table's bytes, written after everything else.
     tail: Vec<u8>,
-    /// The instances' bytes, written after the held primitives.
-    middle: Vec<u8>,
     /// With features: the box of each lot's vertices so far.
     feature_bounds: Vec<Option<[[f64; 3]; 2]>>,
     /// The point positions are relative to: every node's translation.
@@ -774,7 +772,6 @@ impl GltfWriter {
             features: false,
             pool: None,
             tail: Vec::new(),
-            middle: Vec::new(),
             feature_bounds: Vec::new(),
             origin: None,
             instances: Instances::default(),
@@ -1332,7 +1329,7 @@ impl GltfWriter {
                 };
                 let held = Held {
                     buckets: &self.buckets,
-                    middle: &self.middle,
+                    middle: &self.instances,
                     tail: &self.tail,
                 };
                 write_bin(&mut w, &held, &[], textures, &bin_path)?;
@@ -1348,10 +1345,10 @@ impl GltfWriter {
             .map_err(|e| ExportError::io(&path, e.into_error()))
     }
 
-    /// Lays out the instances' data after the held primitives (its bytes
-    /// go into `self.middle`, written after them): each group's primitives,
-    /// then per node the placements' translations, rotations, scales (and
-    /// feature ids). Marks the groups' materials used.
+    /// Lays out the instances' data after the held primitives (written
+    /// after them by [`write_instances`]): each group's primitives, then per
+    /// node the placements' translations, rotations, scales (and feature
+    /// ids). Marks the groups' materials used.
     fn lay_out_instances(
         &mut self,
         root: &mut json::Root,
@@ -1359,17 +1356,15 @@ impl GltfWriter {
         used: &mut [bool],
         stats: &mut ExportStats,
     ) -> LaidOutInstances {
-        use json::accessor::{ComponentType, Type};
+        use json::accessor::ComponentType;
         let mut out = LaidOutInstances::default();
         if self.instances.is_empty() {
             return out;
         }
-        let bytes = &mut self.middle;
         for group in &mut self.instances.groups {
             let mut prims = Vec::new();
             for (id, b) in group.buckets.iter_mut().filter(|(_, b)| b.has_triangles()) {
                 b.unmerged_coords();
-                b.write_arrays(bytes).expect("writing into memory");
                 let p = b.primitive(*id);
                 prims.push((*id, primitive_accessors(root, layout, &p)));
                 used[*id as usize] = true;
@@ -1377,38 +1372,28 @@ impl GltfWriter {
             }
             out.group_primitives.push(prims);
         }
-        for ((lot, group), placements) in self.instances.nodes(self.per_lot) {
-            let all = &self.instances.placements;
-            let mut accessor = |root: &mut json::Root, data: &[f32], width: usize, type_| {
-                write_le(bytes, data).expect("writing into memory");
-                layout.accessor(
+        let nodes = self.instances.nodes(self.per_lot);
+        let accessors = nodes.len() * placement_attributes(self.features).len();
+        root.accessors.reserve(accessors);
+        root.buffer_views.reserve(accessors);
+        for ((lot, group), placements) in &nodes {
+            let mut attributes = serde_json::Map::new();
+            for &(name, width, type_, _) in placement_attributes(self.features) {
+                let index = layout.accessor(
                     root,
-                    data.len(),
-                    (data.len() / width) as u64,
+                    placements.len() * width,
+                    placements.len() as u64,
                     type_,
                     ComponentType::F32,
                     None,
                     None,
-                )
-            };
-            let of = |f: &dyn Fn(&crate::instances::Placement) -> Vec<f32>| -> Vec<f32> {
-                placements.iter().flat_map(|&k| f(&all[k])).collect()
-            };
-            let mut attributes = serde_json::Map::new();
-            let t = accessor(root, &of(&|p| p.translation.to_vec()), 3, Type::Vec3);
-            attributes.insert("TRANSLATION".into(), t.value().into());
-            let r = accessor(root, &of(&|p| p.rotation.to_vec()), 4, Type::Vec4);
-            attributes.insert("ROTATION".into(), r.value().into());
-            let s = accessor(root, &of(&|p| p.scale.to_vec()), 3, Type::Vec3);
-            attributes.insert("SCALE".into(), s.value().into());
-            if self.features {
-                // Each placement's lot as its feature id (EXT_instance_features).
-                let ids = of(&|p| vec![p.lot.unwrap_or(0) as f32]);
-                let f = accessor(root, &ids, 1, Type::Scalar);
-                attributes.insert("_FEATURE_ID_0".into(), f.value().into());
+                );
+                attributes.insert(name.into(), index.value().into());
             }
-            out.nodes.push((lot, group, attributes));
+            out.nodes.push((*lot, *group, attributes));
         }
+        self.instances.laid_out = nodes.into_iter().map(|(_, p)| p).collect();
+        self.instances.with_features = self.features;
         out
     }
 
@@ -1513,7 +1498,7 @@ impl GltfWriter {
         if bin_len > 0 {
             let held = Held {
                 buckets: &self.buckets,
-                middle: &self.middle,
+                middle: &self.instances,
                 tail: &self.tail,
             };
             write_bin(out, &held, images, textures, &path)?;
@@ -1536,7 +1521,7 @@ impl GltfWriter {
         let io = |e| ExportError::io(&path, e);
         let held = Held {
             buckets: &self.buckets,
-            middle: &self.middle,
+            middle: &self.instances,
             tail: &self.tail,
         };
         write_bin(&mut self.out, &held, images, textures, &path)?;
@@ -1994,7 +1979,7 @@ fn write_bin(
     for b in held.buckets.iter().filter(|b| b.has_triangles()) {
         b.write_arrays(w).map_err(io)?;
     }
-    w.write_all(held.middle).map_err(io)?;
+    write_instances(w, held.middle).map_err(io)?;
     for &t in images {
         let tex = textures.get(t);
         w.write_all(&textures.bytes(t)?).map_err(io)?;
@@ -2005,12 +1990,69 @@ fn write_bin(
 }
 
 /// What `finish` writes of the binary data: the buckets held, then the
-/// images, then `tail` (the property table).
+/// instances' data, the images, and `tail` (the property table).
 struct Held<'a> {
     buckets: &'a [Bucket],
-    /// The instances' data.
-    middle: &'a [u8],
+    /// The instances, written as laid out.
+    middle: &'a Instances,
     tail: &'a [u8],
+}
+
+/// The instances' data as `lay_out_instances` laid it out: each group's
+/// arrays, then per node each placement attribute's values. Written
+/// straight from the placements: gathered into one array first, the
+/// model's last step (after its last lot) spent more time growing it in
+/// fresh memory than writing it.
+fn write_instances(w: &mut impl Write, instances: &Instances) -> std::io::Result<()> {
+    for group in &instances.groups {
+        for (_, b) in group.buckets.iter().filter(|(_, b)| b.has_triangles()) {
+            b.write_arrays(w)?;
+        }
+    }
+    let all = &instances.placements;
+    // One attribute of a node at a time, in room kept between them.
+    let mut values: Vec<f32> = Vec::new();
+    for placements in &instances.laid_out {
+        for &(_, width, _, value) in placement_attributes(instances.with_features) {
+            values.clear();
+            for &k in placements {
+                values.extend_from_slice(&value(&all[k])[..width]);
+            }
+            write_le(w, &values)?;
+        }
+    }
+    Ok(())
+}
+
+/// A placement attribute of an instance node: its name, values per
+/// placement, accessor type, and its values (the first `width` of four).
+type PlacementAttribute = (
+    &'static str,
+    usize,
+    json::accessor::Type,
+    fn(&Placement) -> [f32; 4],
+);
+
+/// The attributes of an instance node's placements, in the order of their
+/// data: `EXT_mesh_gpu_instancing`'s, and with per-lot features each
+/// placement's lot as its feature id (`EXT_instance_features`).
+fn placement_attributes(features: bool) -> &'static [PlacementAttribute] {
+    use json::accessor::Type;
+    fn xyz(v: [f32; 3]) -> [f32; 4] {
+        [v[0], v[1], v[2], 0.0]
+    }
+    const ALL: [PlacementAttribute; 4] = [
+        ("TRANSLATION", 3, Type::Vec3, |p| xyz(p.translation)),
+        ("ROTATION", 4, Type::Vec4, |p| p.rotation),
+        ("SCALE", 3, Type::Vec3, |p| xyz(p.scale)),
+        ("_FEATURE_ID_0", 1, Type::Scalar, |p| {
+            [p.lot.unwrap_or(0) as f32, 0.0, 0.0, 0.0]
+        }),
+    ];
+    match features {
+        true => &ALL,
+        false => &ALL[..3],
+    }
 }
 
 #[cfg(test)]

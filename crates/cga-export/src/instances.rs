@@ -96,6 +96,11 @@ pub(crate) struct Instances {
     pub groups: Vec<Group>,
     by_mesh: HashMap<usize, Vec<u32>>,
     pub placements: Vec<Placement>,
+    /// The placements of each node, in the order the writer laid out
+    /// their data (`GltfWriter::lay_out_instances`), and whether each has
+    /// its lot as feature id.
+    pub laid_out: Vec<Vec<usize>>,
+    pub with_features: bool,
 }
 
 impl Instances {
@@ -181,12 +186,18 @@ impl Instances {
     /// The placements by node: per lot (when `per_lot`) and group, in
     /// order of lot and group, each with the indices of its placements.
     pub fn nodes(&self, per_lot: bool) -> Vec<(NodeKey, Vec<usize>)> {
-        let mut nodes: std::collections::BTreeMap<NodeKey, Vec<usize>> = Default::default();
-        for (k, p) in self.placements.iter().enumerate() {
-            let lot = if per_lot { p.lot } else { None };
-            nodes.entry((lot, p.group)).or_default().push(k);
-        }
-        nodes.into_iter().collect()
+        let key = |k: usize| {
+            let p = &self.placements[k];
+            (if per_lot { p.lot } else { None }, p.group)
+        };
+        // A stable sort keeps each node's placements in the order they came;
+        // placements come lot by lot, so it mostly merges runs.
+        let mut order: Vec<usize> = (0..self.placements.len()).collect();
+        order.sort_by_key(|&k| key(k));
+        order
+            .chunk_by(|&a, &b| key(a) == key(b))
+            .map(|run| (key(run[0]), run.to_vec()))
+            .collect()
     }
 }
 
@@ -194,6 +205,38 @@ impl Instances {
 mod tests {
     use super::*;
     use cga_geometry::DMat3;
+
+    /// Nodes come in order of lot and group, each with its placements in
+    /// the order they were placed; without nodes per lot, one per group.
+    #[test]
+    fn placements_are_gathered_by_node_in_order() {
+        let mut instances = Instances::default();
+        let trs = Trs {
+            translation: DVec3::ZERO,
+            rotation: DQuat::IDENTITY,
+            scale: DVec3::ONE,
+        };
+        for _ in 0..2 {
+            let mesh = Arc::new(cga_geometry::primitive::cube(DVec3::ONE));
+            instances.add_group(mesh, SharedVec::default(), Vec::new(), 0, 0);
+        }
+        // (lot, group) of each placement, in the order placed.
+        let placed = [(0, 1), (0, 0), (0, 1), (1, 0), (1, 1), (1, 0), (2, 1)];
+        for (lot, group) in placed {
+            instances.place(group, Some(lot), &trs, &DAffine3::IDENTITY);
+        }
+        let per_lot: Vec<(NodeKey, Vec<usize>)> = vec![
+            ((Some(0), 0), vec![1]),
+            ((Some(0), 1), vec![0, 2]),
+            ((Some(1), 0), vec![3, 5]),
+            ((Some(1), 1), vec![4]),
+            ((Some(2), 1), vec![6]),
+        ];
+        assert_eq!(instances.nodes(true), per_lot);
+        let whole: Vec<(NodeKey, Vec<usize>)> =
+            vec![((None, 0), vec![1, 3, 5]), ((None, 1), vec![0, 2, 4, 6])];
+        assert_eq!(instances.nodes(false), whole);
+    }
 
     #[test]
     fn rotations_and_scales_decompose() {

@@ -11,6 +11,7 @@ use cga_export::{DrawCollector, DrawModel, Encoder, ModelWriter, PlainCollector,
 use cga_geometry::{DAffine3, DVec3};
 
 use crate::diagnostics::Diagnostic;
+use crate::help::{Handoff, Help, Helping};
 use crate::lots::Lot;
 use crate::model::{LeafOrigin, LotResult, Summary};
 use crate::options::Options;
@@ -315,53 +316,78 @@ impl Rules {
             each(made);
             Ok(())
         };
-        let generate_one = |batcher: &mut Batcher, i: usize, send: &mut dyn FnMut(Piece)| {
-            if let Some(o) = origin(i) {
-                batcher.set_origin(o);
-            }
-            let mut origins = Vec::new();
-            let (out, error) = generate_lot_streaming(
-                program,
-                assets,
-                rule.0,
-                lot(i),
-                lot_index(i),
-                &engine_options,
-                |leaf| {
-                    batcher.add_origin(&leaf, program, &mut origins);
-                    batcher.add(leaf, send)
-                },
-            );
-            batcher.flush(send);
-            let (model, drawing) = batcher.take_model();
-            let kept = match batcher {
-                Batcher::Plain(collector, _) => Some(collector.room()),
-                Batcher::Draw(collector, ..) => Some(collector.room()),
-                _ => None,
-            };
-            if let Some(kept) = kept {
-                let mut room = self.mesh_room();
-                if room.as_slice() != kept {
-                    room.clear();
-                    room.extend_from_slice(kept);
+        // Workers that encode and run out of lots take over the encoding of
+        // those still deriving (see `help`).
+        let helps_encode = workers_encode && encoder.is_some();
+        let help = Help::new(jobs);
+        let new_worker = || (new_batcher(), Helping::new(&help));
+        let generate_one =
+            |(batcher, helping): &mut (Batcher, Helping), i: usize, send: &mut dyn FnMut(Piece)| {
+                if let Some(o) = origin(i) {
+                    batcher.set_origin(o);
                 }
-            }
-            Done {
-                out,
-                error,
-                model,
-                drawing,
-                origins,
-            }
-        };
+                let mut origins = Vec::new();
+                let mut handoff: Option<Handoff> = None;
+                let (out, error) = generate_lot_streaming(
+                    program,
+                    assets,
+                    rule.0,
+                    lot(i),
+                    lot_index(i),
+                    &engine_options,
+                    |leaf| match &mut handoff {
+                        // Only encoding batchers are handed over: they
+                        // record no leaf origins.
+                        Some(h) => h.add(leaf, send),
+                        None => {
+                            batcher.add_origin(&leaf, program, &mut origins);
+                            batcher.add(leaf, send);
+                            if helps_encode {
+                                handoff = helping.ask(batcher);
+                            }
+                        }
+                    },
+                );
+                if let Some(h) = handoff {
+                    // A helper that failed took the batch with it: the lot's
+                    // output is incomplete, and the panic ends the run.
+                    *batcher = h.finish(send).unwrap_or_else(new_batcher);
+                }
+                batcher.flush(send);
+                let (model, drawing) = batcher.take_model();
+                let kept = match batcher {
+                    Batcher::Plain(collector, _) => Some(collector.room()),
+                    Batcher::Draw(collector, ..) => Some(collector.room()),
+                    _ => None,
+                };
+                if let Some(kept) = kept {
+                    let mut room = self.mesh_room();
+                    if room.as_slice() != kept {
+                        room.clear();
+                        room.extend_from_slice(kept);
+                    }
+                }
+                Done {
+                    out,
+                    error,
+                    model,
+                    drawing,
+                    origins,
+                }
+            };
         if count == 1 && !has_writer {
             // One lot and nothing to overlap with: derived here (on a stack
             // with room), without worker threads.
-            let mut batcher = new_batcher();
-            let done = on_big_stack(|| generate_one(&mut batcher, 0, &mut |_| {}));
+            let mut worker = new_worker();
+            let done = on_big_stack(|| generate_one(&mut worker, 0, &mut |_| {}));
             take(0, Taken::Done(done))?;
         } else {
-            run_pipeline(count, jobs, new_batcher, generate_one, &mut take)?;
+            let idle = |(_, helping): &mut (Batcher, Helping)| {
+                if helps_encode {
+                    helping.offer();
+                }
+            };
+            run_pipeline(count, jobs, new_worker, generate_one, idle, &mut take)?;
         }
         summary.derived_after = started.elapsed().as_secs_f64();
         Ok(summary)
@@ -641,7 +667,7 @@ fn write_piece(w: &mut ModelWriter, piece: Piece) -> Result<(), cga_export::Expo
 }
 
 /// A piece of a lot's output on its way to the calling thread.
-enum Piece {
+pub(crate) enum Piece {
     /// Leaves, for writers that take meshes (OBJ).
     Leaves(Vec<Leaf>),
     /// Leaves encoded into vertex data (glTF, GLB).
@@ -662,7 +688,7 @@ const LEAF_BATCH: usize = 512;
 const ENCODED_BATCH_BYTES: usize = 1 << 20;
 
 /// How a worker gathers its leaves.
-enum Batcher {
+pub(crate) enum Batcher {
     /// No geometry wanted: leaves are dropped where they are made.
     Drop,
     Leaves(Vec<Leaf>),
@@ -684,7 +710,7 @@ impl Batcher {
         }
     }
 
-    fn add(&mut self, leaf: Leaf, send: &mut dyn FnMut(Piece)) {
+    pub(crate) fn add(&mut self, leaf: Leaf, send: &mut dyn FnMut(Piece)) {
         match self {
             Batcher::Drop => {}
             Batcher::Leaves(batch) => {
@@ -742,7 +768,7 @@ impl Batcher {
     }
 
     /// Sends what was gathered (at the end of a lot).
-    fn flush(&mut self, send: &mut dyn FnMut(Piece)) {
+    pub(crate) fn flush(&mut self, send: &mut dyn FnMut(Piece)) {
         match self {
             Batcher::Drop | Batcher::Plain(..) | Batcher::Draw(..) => {}
             Batcher::Leaves(batch) => {

@@ -33,6 +33,7 @@ mod attributes;
 mod diagnostics;
 mod error;
 mod generate;
+mod help;
 pub mod lots;
 pub mod metadata;
 mod model;

@@ -30,12 +30,14 @@ enum Delivery<L, R> {
 /// that `generate` uses for all its lots. A worker starts a lot only while
 /// fewer than a few lots per worker wait to be taken, so memory holds a
 /// bounded number of lots, not the whole city. An error from `take` stops
-/// the workers and is returned.
+/// the workers and is returned. A worker with no lot left calls `idle`
+/// with its state before it ends (where it may help the others).
 pub(crate) fn run_pipeline<W, L: Send, R: Send>(
     count: usize,
     jobs: usize,
     init: impl Fn() -> W + Sync,
     generate: impl Fn(&mut W, usize, &mut dyn FnMut(L)) -> R + Sync,
+    idle: impl Fn(&mut W) + Sync,
     take: &mut dyn FnMut(usize, Taken<L, R>) -> Result<(), Error>,
 ) -> Result<(), Error> {
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -68,8 +70,8 @@ pub(crate) fn run_pipeline<W, L: Send, R: Send>(
         let (tx, rx) = mpsc::channel::<(usize, Delivery<L, R>)>();
         for _ in 0..jobs.min(count) {
             let tx = tx.clone();
-            let (next, stop, taken, init, generate, lock, halt) =
-                (&next, &stop, &taken, &init, &generate, &lock, &halt);
+            let (next, stop, taken, init, generate, idle, lock, halt) =
+                (&next, &stop, &taken, &init, &generate, &idle, &lock, &halt);
             let worker = move || {
                 let _guard = StopOnPanic(halt);
                 let mut state = init();
@@ -99,6 +101,7 @@ pub(crate) fn run_pipeline<W, L: Send, R: Send>(
                         break;
                     }
                 }
+                idle(&mut state);
             };
             if let Err(e) = std::thread::Builder::new()
                 .stack_size(STACK_SIZE)
@@ -174,7 +177,7 @@ mod tests {
             }
             10 * i
         };
-        let r = run_pipeline(count, jobs, || 0usize, generate, &mut |i, taken| {
+        let r = run_pipeline(count, jobs, || 0usize, generate, |_| {}, &mut |i, taken| {
             match taken {
                 Taken::Piece((j, k)) => seen.push(format!("{i}:{j}.{k}")),
                 Taken::Done(r) => seen.push(format!("{i}={r}")),
@@ -220,7 +223,7 @@ mod tests {
                 assert!(i != 3, "lot 3 fails");
                 i
             };
-            run_pipeline(40, 2, || (), generate, &mut |_, _| Ok(()))
+            run_pipeline(40, 2, || (), generate, |_| {}, &mut |_, _| Ok(()))
         });
         assert!(r.is_err());
     }

@@ -319,7 +319,7 @@ impl Rules {
         // Workers that encode and run out of lots take over the encoding of
         // those still deriving (see `help`).
         let helps_encode = workers_encode && encoder.is_some();
-        let help = Help::new(jobs);
+        let help = Help::new();
         let new_worker = || (new_batcher(), Helping::new(&help));
         let generate_one =
             |(batcher, helping): &mut (Batcher, Helping), i: usize, send: &mut dyn FnMut(Piece)| {

@@ -36,7 +36,7 @@ pub(crate) struct Help {
 struct HelpState {
     /// Encoding handed over, for the next idle helper.
     job: Option<Job>,
-    /// Workers that have not yet run out of lots (or ended).
+    /// Workers that have begun and not yet run out of lots (or ended).
     deriving: usize,
 }
 
@@ -105,12 +105,14 @@ impl Handoff {
 }
 
 impl Help {
-    /// For `workers` workers.
-    pub fn new(workers: usize) -> Help {
+    /// Help for the workers that register ([`Helping::new`]): counted as
+    /// they begin, so that a worker that was never started (its thread
+    /// could not be made) is not waited for.
+    pub fn new() -> Help {
         Help {
             state: Mutex::new(HelpState {
                 job: None,
-                deriving: workers,
+                deriving: 0,
             }),
             wake: Condvar::new(),
             idle: AtomicUsize::new(0),
@@ -201,6 +203,7 @@ pub(crate) struct Helping<'a> {
 
 impl<'a> Helping<'a> {
     pub fn new(help: &'a Help) -> Helping<'a> {
+        help.lock().deriving += 1;
         Helping {
             help,
             offered: false,
@@ -259,10 +262,10 @@ mod tests {
     /// as the worker alone would have sent.
     #[test]
     fn an_idle_worker_takes_over_the_batching_in_order() {
-        let help = Help::new(2);
+        let help = Help::new();
         std::thread::scope(|scope| {
-            let helper = scope.spawn(|| Helping::new(&help).offer());
             let mut worker = Helping::new(&help);
+            let helper = scope.spawn(|| Helping::new(&help).offer());
             let mut batcher = Batcher::Leaves(Vec::new());
             let mut sent = Vec::new();
             let mut send = |p: Piece| sent.push(p);
@@ -298,13 +301,20 @@ mod tests {
     /// without offering itself.
     #[test]
     fn helpers_stop_when_every_worker_is_done() {
-        let help = Help::new(3);
+        let help = Help::new();
         std::thread::scope(|scope| {
+            let failing = Helping::new(&help);
             let helpers: Vec<_> = (0..2)
-                .map(|_| scope.spawn(|| Helping::new(&help).offer()))
+                .map(|_| {
+                    let helping = Helping::new(&help);
+                    scope.spawn(move || {
+                        let mut helping = helping;
+                        helping.offer()
+                    })
+                })
                 .collect();
             // The third worker fails: its place is dropped.
-            drop(Helping::new(&help));
+            drop(failing);
             for h in helpers {
                 h.join().expect("helper ends");
             }

@@ -179,11 +179,12 @@ impl Textures {
     }
 
     /// The bytes of texture `i`: a built-in's image, or the file's, which
-    /// must still have the size it had when it was found.
-    pub(crate) fn bytes(&self, i: u32) -> Result<Arc<[u8]>, ExportError> {
+    /// must still have the size it had when it was found (read as they
+    /// are: the file's bytes are not copied again).
+    pub(crate) fn bytes(&self, i: u32) -> Result<std::borrow::Cow<'_, [u8]>, ExportError> {
         let t = self.get(i);
         if let Some(data) = &t.data {
-            return Ok(data.clone());
+            return Ok(std::borrow::Cow::Borrowed(data));
         }
         let bytes = self
             .world
@@ -197,7 +198,7 @@ impl Textures {
             );
             return Err(ExportError::io(&t.source, std::io::Error::other(msg)));
         }
-        Ok(Arc::from(bytes))
+        Ok(std::borrow::Cow::Owned(bytes))
     }
 
     /// How the output refers to texture `i`, as a `/`-separated path: its

@@ -140,9 +140,6 @@ impl Help {
                 drop(state);
                 job.run();
                 state = self.lock();
-                if state.deriving == 0 {
-                    return;
-                }
                 self.idle.fetch_add(1, Ordering::SeqCst);
                 continue;
             }

@@ -389,3 +389,42 @@ def test_the_gil_is_released_while_generating():
     # Ticking every 5 ms went on while the engine worked.
     assert took > 0.2
     assert len(during) > took / 0.005 * 0.3
+
+
+def _boxes_in_a_child(conn):
+    rules = cga.Rules.from_string(BOX)
+    models = rules.generate([shapely.box(0, 0, 10, 10), shapely.box(20, 0, 25, 10)], jobs=2)
+    conn.send([m.triangles for m in models])
+    conn.close()
+
+
+def test_a_forked_process_generates_after_its_parent(box):
+    # The parent's worker threads wait for the next call between calls; a
+    # forked child has none of them and must make its own.
+    assert [m.triangles for m in box.generate([shapely.box(0, 0, 10, 10)] * 3, jobs=2)] == [10] * 3
+    import multiprocessing
+
+    ctx = multiprocessing.get_context("fork")
+    parent, child = ctx.Pipe()
+    p = ctx.Process(target=_boxes_in_a_child, args=(child,), daemon=True)
+    p.start()
+    assert parent.poll(60), "the forked child did not answer"
+    assert parent.recv() == [10, 10]
+    p.join(10)
+    assert p.exitcode == 0
+
+
+def test_calls_from_several_threads_at_once(building):
+    lots = [shapely.box(i * 50, 0, i * 50 + 15 + i, 20 + 2 * i) for i in range(6)]
+    want = [m.triangles for m in building.generate(lots, jobs=2, seed=3)]
+    got = {}
+
+    def call(k):
+        got[k] = [m.triangles for m in building.generate(lots, jobs=2, seed=3)]
+
+    threads = [threading.Thread(target=call, args=(k,)) for k in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(120)
+    assert got == {k: want for k in range(4)}

@@ -17,7 +17,7 @@ use crate::model::{LeafOrigin, LotResult, Summary};
 use crate::options::Options;
 use crate::pipeline::{run_pipeline, Taken};
 use crate::rules::{RuleRef, Rules};
-use crate::stack::{on_big_stack, STACK_SIZE};
+use crate::stack::on_big_stack;
 use crate::Error;
 
 /// Where the geometry of generated lots goes.
@@ -509,13 +509,10 @@ impl Rules {
         };
         let mut slots: Vec<Option<LotContext>> =
             std::iter::repeat_with(|| None).take(lots.len()).collect();
-        std::thread::scope(|scope| {
+        crate::threads::scope(|scope| {
             let mut workers = Vec::new();
             for _ in 0..jobs.min(lots.len()) {
-                let worker = std::thread::Builder::new()
-                    .stack_size(STACK_SIZE)
-                    .spawn_scoped(scope, work)
-                    .map_err(Error::Threads)?;
+                let worker = scope.spawn(work).map_err(Error::Threads)?;
                 workers.push(worker);
             }
             for w in workers {

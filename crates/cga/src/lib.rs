@@ -43,6 +43,7 @@ mod pipeline;
 mod rules;
 mod stack;
 pub mod syntax;
+mod threads;
 mod values;
 
 pub use attributes::{Annotation, Attribute, Range};

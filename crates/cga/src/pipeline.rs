@@ -1,9 +1,8 @@
-//! Deriving lots on worker threads while the calling thread takes what
-//! they produce, in lot order.
+//! Deriving lots on worker threads (kept between calls, see `threads`)
+//! while the calling thread takes what they produce, in lot order.
 
 use std::sync::mpsc;
 
-use crate::stack::STACK_SIZE;
 use crate::Error;
 
 /// What the writing thread is handed for a lot, in order: the pieces of
@@ -66,7 +65,7 @@ pub(crate) fn run_pipeline<W, L: Send, R: Send>(
         stop.store(true, Ordering::Relaxed);
         taken.1.notify_all();
     };
-    std::thread::scope(|scope| {
+    crate::threads::scope(|scope| {
         let (tx, rx) = mpsc::channel::<(usize, Delivery<L, R>)>();
         for _ in 0..jobs.min(count) {
             let tx = tx.clone();
@@ -103,10 +102,7 @@ pub(crate) fn run_pipeline<W, L: Send, R: Send>(
                 }
                 idle(&mut state);
             };
-            if let Err(e) = std::thread::Builder::new()
-                .stack_size(STACK_SIZE)
-                .spawn_scoped(scope, worker)
-            {
+            if let Err(e) = scope.spawn(worker) {
                 halt();
                 return Err(Error::Threads(e));
             }

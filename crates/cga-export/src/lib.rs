@@ -330,6 +330,10 @@ pub(crate) struct FaceData<'a> {
     pub known_normal: Option<DVec3>,
     /// Triangles as indices into `mesh.corners`.
     pub triangles: &'a [[u32; 3]],
+    /// The place in the face's one loop of the corner its triangles fan
+    /// out from, where the preparation knows it (see
+    /// `plain::fan_start`, which reads the triangles otherwise).
+    pub fan: Option<u32>,
 }
 
 impl FaceData<'_> {

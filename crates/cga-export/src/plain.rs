@@ -148,6 +148,9 @@ pub(crate) fn fit<T>(v: &mut Vec<T>) {
 /// loop `c` read from `r` on (round the loop): what the triangulation
 /// makes of every convex face, nearly all faces of a model.
 pub(crate) fn fan_start(f: &FaceData) -> Option<u32> {
+    if f.fan.is_some() {
+        return f.fan;
+    }
     let &[outer] = f.loops else {
         return None;
     };
@@ -676,6 +679,7 @@ pub(crate) mod tests {
                 material: 0,
                 known_normal: Some(DVec3::Y),
                 triangles,
+                fan: None,
             })
         };
         let c = |k: u32| 5 + k % 4;
@@ -879,7 +883,10 @@ pub(crate) mod tests {
         prep.faces(&m, Some(&transform), |f| {
             let uvs = f.mesh.uvs[0].as_deref();
             let start = fan_start(f);
-            starts.push(start);
+            // What the preparation knew of a quad's fan is what its
+            // triangles say.
+            assert_eq!(start, fan_start(&FaceData { fan: None, ..*f }));
+            starts.push((start, f.fan));
             match start {
                 Some(first) => fans.push_fan(f, uvs, first, 3),
                 None => fans.push_triangles(f, uvs, &mut scratch, 3),
@@ -888,13 +895,46 @@ pub(crate) mod tests {
             Ok(())
         })
         .unwrap();
+        let hints: Vec<_> = starts.iter().map(|s| s.1).collect();
+        let starts: Vec<_> = starts.iter().map(|s| s.0).collect();
         assert_eq!(starts, [Some(3), Some(1), None, None, Some(0)]);
+        // The one quad has three corners in a line: the general
+        // triangulation cuts it, whose fan is read from its triangles.
+        assert_eq!(hints, [None; 5]);
         assert_eq!(fans, general);
         assert_eq!(general.indices.len(), 3 + 2 + 6 + 8 + 1);
         assert_eq!(general.positions[0], [6.0, 1.0, 0.0]);
         // The quad's vertices start at its second corner.
         assert_eq!(general.positions[5], [16.0, 1.0, 2.0]);
         assert_eq!(general.uvs[5], [6.0, 0.5]);
+    }
+
+    /// A quad cut along either diagonal comes with the corner its fan
+    /// starts from, the one its triangles give.
+    #[test]
+    fn quads_come_with_their_fans() {
+        let mut m = Mesh::new();
+        let p = |x: f64, z: f64| DVec3::new(x, 0.0, z);
+        // Convex (cut from corner 0); reflex at corner 1 (cut from it);
+        // reflex at corner 0.
+        m.positions
+            .extend([p(0.0, 0.0), p(2.0, 0.0), p(2.0, -2.0), p(0.0, -2.0)]);
+        m.positions
+            .extend([p(0.0, 0.0), p(1.5, 1.0), p(4.0, 0.0), p(0.0, 4.0)]);
+        m.positions
+            .extend([p(3.0, -3.0), p(4.0, 0.0), p(4.0, -4.0), p(0.0, -4.0)]);
+        for q in 0..3 {
+            m.add_face(&[&[4 * q, 4 * q + 1, 4 * q + 2, 4 * q + 3]], 0);
+        }
+        let mut hints = Vec::new();
+        FacePrep::default()
+            .faces(&m, None, |f| {
+                assert_eq!(f.fan, fan_start(&FaceData { fan: None, ..*f }));
+                hints.push(f.fan);
+                Ok(())
+            })
+            .unwrap();
+        assert_eq!(hints, [Some(0), Some(1), Some(0)]);
     }
 
     #[test]

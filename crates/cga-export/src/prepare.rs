@@ -138,13 +138,16 @@ fn each_face(
         }
         triangles.clear();
         // Quads (most faces) take their own path: the same triangles and
-        // normal with less work (the face is finite here).
+        // normal with less work (the face is finite here), and the corner
+        // they fan out from known without reading them back.
+        let mut fan = None;
         let normal = match loops {
             [outer] if outer.len == 4 => {
-                let first_diagonal = triangulate_finite_quad(mesh, positions, *outer, triangles);
+                fan = triangulate_finite_quad(mesh, positions, *outer, triangles);
                 if triangles.is_empty() {
                     continue;
                 }
+                let first_diagonal = fan == Some(0);
                 // A face with normals of its own needs its face normal
                 // only where one of them is zero, and one whose caller
                 // writes no normals never: left for later (see
@@ -182,6 +185,7 @@ fn each_face(
             material: mesh.faces[face].material,
             known_normal,
             triangles,
+            fan,
         })?;
     }
     Ok(skipped)

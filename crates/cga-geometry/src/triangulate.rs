@@ -146,16 +146,20 @@ fn push_quad(s: u32, first_diagonal: bool, out: &mut Vec<[u32; 3]>) {
 /// are finite but whose edges overflow are not finite, and give no
 /// triangles both ways).
 ///
-/// Returns whether the triangles appended are exactly the loop's corners
-/// (0, 1, 2) and (0, 2, 3): the cut along the first diagonal. (Told by
-/// the caller comparing the triangles, it cost a stall per quad: the
-/// comparison read back as wide words values just stored one by one.)
+/// Returns the place in the loop of the corner the appended triangles fan
+/// out from, where this is known without reading them back: `Some(0)` for
+/// exactly the corners (0, 1, 2) and (0, 2, 3) (the cut along the first
+/// diagonal), `Some(1)` for (1, 2, 3) and (1, 3, 0) (the second); `None`
+/// for no triangles, and for the other triangulations the general path
+/// makes. (Told by the caller comparing the triangles, it cost a stall per
+/// quad: the comparison read back as wide words values just stored one by
+/// one.)
 pub fn triangulate_finite_quad(
     mesh: &Mesh,
     positions: &[DVec3],
     outer: Loop,
     out: &mut Vec<[u32; 3]>,
-) -> bool {
+) -> Option<u32> {
     let s = outer.start as usize;
     let p = |k: usize| positions[mesh.corners[s + k] as usize];
     let (p0, p1, p2, p3) = (p(0), p(1), p(2), p(3));
@@ -164,7 +168,7 @@ pub fn triangulate_finite_quad(
     let n = (DVec3::ZERO + c1) + c2;
     let d = n.length_squared();
     if !(d > 0.0 && d.is_finite()) {
-        return false;
+        return None;
     }
     let l = largest_magnitude(&[r1, r2, r3]);
     let a = largest_magnitude(&[n]);
@@ -178,20 +182,20 @@ pub fn triangulate_finite_quad(
     let big_bound = (largest_magnitude(&[p0]) + l) * (1.0 + 1e-9);
     if diagonal_by_sign(a1, a2, l, big_bound, a) == Some(true) {
         push_quad(outer.start, true, out);
-        return true;
+        return Some(0);
     }
     let big = largest_magnitude(&[p0, p1, p2, p3]);
     match diagonal_by_sign(a1, a2, l, big, a) {
         Some(first) => {
             push_quad(outer.start, first, out);
-            first
+            Some(if first { 0 } else { 1 })
         }
         None => {
             let before = out.len();
             let unit = crate::measure::unit_newell(n);
             triangulate_loops_with_normal(mesh, positions, &[outer], unit, out);
             let s = outer.start;
-            out[before..] == [[s, s + 1, s + 2], [s, s + 2, s + 3]]
+            (out[before..] == [[s, s + 1, s + 2], [s, s + 2, s + 3]]).then_some(0)
         }
     }
 }
@@ -525,9 +529,16 @@ mod tests {
         // The writers' path for finite quads gives the Newell path's
         // triangles (and so the projection's).
         let mut writers = Vec::new();
-        let first = triangulate_finite_quad(&m, &m.positions, m.loops[0], &mut writers);
+        let fan = triangulate_finite_quad(&m, &m.positions, m.loops[0], &mut writers);
         assert_eq!(writers, fast, "{corners:?}");
-        assert_eq!(first, writers == [[0, 1, 2], [0, 2, 3]], "{corners:?}");
+        assert_eq!(
+            fan == Some(0),
+            writers == [[0, 1, 2], [0, 2, 3]],
+            "{corners:?}"
+        );
+        if fan == Some(1) {
+            assert_eq!(writers, [[1, 2, 3], [1, 3, 0]], "{corners:?}");
+        }
         (fast, reference)
     }
 

@@ -6,7 +6,8 @@
 //! workers had used (and the arrays they had handed out, freed since) was
 //! not theirs to reuse, and every call but the first few touched fresh
 //! pages the kernel had to zero (20 Candler buildings into numpy meshes:
-//! calls two and three took a third longer than the later ones). Here a
+//! the second call took up to two fifths longer than the later ones, the
+//! third up to a seventh). Here a
 //! worker that has finished its job waits for the next one instead of
 //! ending, and [`scope`] runs jobs on waiting workers, making new ones only
 //! when none waits. Unlike a shared pool, a call never waits for another

@@ -174,9 +174,8 @@ impl<'scope> Scope<'scope, '_> {
             outcome: Mutex::new(None),
             ended: Condvar::new(),
         });
-        let running = self.running.clone();
-        *lock(&running.jobs) += 1;
-        let (job_slot, job_running) = (slot.clone(), running.clone());
+        *lock(&self.running.jobs) += 1;
+        let (job_slot, job_running) = (slot.clone(), self.running.clone());
         let job = move || {
             // `f` and what it holds are dropped before the scope hears
             // that the job ended.
@@ -200,7 +199,7 @@ impl<'scope> Scope<'scope, '_> {
         let job: Job =
             unsafe { std::mem::transmute::<Box<dyn FnOnce() + Send + 'scope>, Job>(job) };
         if let Err(e) = start(job) {
-            *lock(&running.jobs) -= 1;
+            *lock(&self.running.jobs) -= 1;
             return Err(e);
         }
         Ok(Handle {

@@ -39,6 +39,12 @@ pub struct LotResult {
     pub error: Option<Diagnostic>,
     /// Shapes created.
     pub shapes: usize,
+    /// Triangles of the lot written to the model file, when the lots were
+    /// generated into one ([`Target::Writer`](crate::Target::Writer),
+    /// [`Target::PerLot`](crate::Target::PerLot)): the triangles its plain
+    /// meshes would have, an instanced asset counted once per placement.
+    /// `None` when nothing was written.
+    pub triangles_written: Option<u64>,
 }
 
 /// The rule and shape a leaf comes from.

@@ -77,3 +77,51 @@ fn plain_models_write_the_triangles_a_writer_would() {
     let e = cga::write_plain(&mut w, &broken).unwrap_err();
     assert!(e.to_string().contains("past its"), "{e}");
 }
+
+/// A lot generated into a model file says how many triangles it wrote: as
+/// many as its plain meshes have, an asset inserted many times (written
+/// once, placed as instances) counted once per placement, with one job or
+/// two.
+#[test]
+fn lots_written_count_the_triangles_of_their_meshes() {
+    // A tetrahedron: 4 triangles, inserted on every tile.
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+    let world = MemoryWorld::new().with("/p/assets/tet.obj", obj);
+    let rules = Engine::new(world).load_text(
+        "/p/rules/r.cga",
+        "Lot --> extrude(6) comp(f) { side : split(x) { ~2 : Tile }* | top : Roof. }\n\
+         Tile --> split(y) { 3 : i(\"tet.obj\") s(0.5, 0.5, 0.5) Asset. | ~1 : Wall. }\n",
+    );
+    assert!(!rules.has_errors(), "{}", rules.render_diagnostics());
+    let lots = [
+        cga::lots::rect(20.0, 10.0),
+        cga::lots::rect(6.0, 4.0),
+        cga::lots::rect(9.0, 30.0),
+    ];
+    let kept = rules.generate_all(&lots, &Options::default()).unwrap();
+    assert!(kept.iter().all(|r| r.triangles_written.is_none()));
+    // 20 x 10: 10 + 5 tiles a side, each an asset and a wall.
+    assert_eq!(kept[0].model.triangles(), 2 * (10 + 5) * (4 + 2) + 2);
+    for jobs in [1, 2] {
+        let mut writer = ModelWriter::glb_in_memory(rules.export_options()).unwrap();
+        let mut written = Vec::new();
+        rules
+            .generate_lots(
+                &lots,
+                &Options::default().jobs(jobs),
+                Target::Writer(&mut writer),
+                |r| written.push(r),
+            )
+            .unwrap();
+        let (glb, stats) = writer.finish_bytes().unwrap();
+        let instanced = b"EXT_mesh_gpu_instancing";
+        assert!(glb.windows(instanced.len()).any(|w| w == instanced));
+        let counts: Vec<Option<u64>> = written.iter().map(|r| r.triangles_written).collect();
+        let want: Vec<Option<u64>> = kept
+            .iter()
+            .map(|r| Some(r.model.triangles() as u64))
+            .collect();
+        assert_eq!(counts, want, "jobs {jobs}");
+        assert_eq!(stats.triangles, want.iter().flatten().sum::<u64>());
+    }
+}

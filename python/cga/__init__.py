@@ -184,7 +184,8 @@ class Model:
 
     __slots__ = (
         "index", "name", "meshes", "materials", "reports", "report_values",
-        "prints", "warnings", "error", "shapes", "leaves", "_native_materials", "_rules",
+        "prints", "warnings", "error", "shapes", "leaves", "_written", "_native_materials",
+        "_rules",
     )
 
     def __init__(self, d, rules):
@@ -208,6 +209,7 @@ class Model:
         self.error = None if e is None else e["message"]
         self.shapes = d["shapes"]
         self.leaves = d["leaves"]
+        self._written = d.get("written")
         self._rules = rules
 
     @classmethod
@@ -221,7 +223,11 @@ class Model:
 
     @property
     def triangles(self):
-        """Triangles over all meshes."""
+        """Triangles over all meshes; for a model generated into a file
+        (``output=``), the triangles written of it (the same number: an
+        asset written once and placed as instances counts per placement)."""
+        if self._written is not None and not self.meshes:
+            return self._written
         return sum(len(m.indices) for m in self.meshes)
 
     def to_trimesh(self):

@@ -45,25 +45,20 @@ def _meta(index_dtype, keys):
 
 def _generate_partition(part, offsets, rules, out_dir, keys, kwargs, partition_info=None):
     number = partition_info["number"] if partition_info else 0
-    output = None
-    if out_dir is not None:
-        output = os.path.join(out_dir, f"part-{number:05d}.glb")
     first = int(offsets[number]) if offsets is not None else 0
-    models = rules.generate(
-        # Meshes are made (and dropped with the partition) to count each
-        # lot's triangles.
-        part, geometry=True, progress=False, invalid="report",
-        first_index=first, **kwargs,
-    )
-    if output is not None:
-        from . import write
-
-        # Written from the kept meshes, so that each lot's triangles are
-        # counted; a partition's models are held at once, its lots only.
-        # Into a temporary name first: a retried task never leaves half a
-        # file under the final name.
+    common = dict(progress=False, invalid="report", first_index=first, **kwargs)
+    if out_dir is None:
+        # Positions alone (made and dropped with the partition): each lot's
+        # triangles are counted.
+        models = rules.generate(part, geometry="positions", **common)
+    else:
+        # Streamed into the file as the lots are made (no meshes kept; each
+        # lot's triangles counted by the writer). Into a temporary name
+        # first: a retried task never leaves half a file under the final
+        # name.
+        output = os.path.join(out_dir, f"part-{number:05d}.glb")
         partial = output[: -len(".glb")] + ".partial.glb"
-        write([m for m in models if m.meshes], partial)
+        models = rules.generate(part, geometry=False, output=partial, **common)
         os.replace(partial, output)
     index = part.index if hasattr(part, "index") and not isinstance(part, list) else pd.RangeIndex(first, first + len(models))
     frame = pd.DataFrame(

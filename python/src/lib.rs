@@ -615,6 +615,7 @@ fn model_dict(
     )?;
     d.set_item("shapes", r.shapes)?;
     d.set_item("leaves", r.leaf_count)?;
+    d.set_item("written", r.triangles_written)?;
     let PlainModel {
         materials, meshes, ..
     } = r.model;

@@ -252,6 +252,9 @@ def test_write_glb_and_obj(tmp_path, box, building):
     # Written straight from the generation: the same triangles.
     direct = building.generate([shapely.box(0, 0, 20, 30), shapely.box(40, 0, 60, 30)], output=tmp_path / "direct.glb")
     assert direct[0].meshes == [] and building.last_write["triangles"] == stats["triangles"]
+    # Each streamed model says how many triangles of it were written.
+    assert [m.triangles for m in direct] == [m.triangles for m in models]
+    assert models[0].triangles > 100
     cga.write(box.generate([shapely.box(0, 0, 2, 2)]), tmp_path / "box.obj")
     obj = (tmp_path / "box.obj").read_text()
     assert obj.count("\nf ") == 10

@@ -47,6 +47,19 @@ def cluster():
         yield client
 
 
+def glb_triangles(path):
+    import json
+    import struct
+
+    data = path.read_bytes()
+    (n,) = struct.unpack("<I", data[12:16])
+    doc = json.loads(data[20:20 + n])
+    return sum(
+        doc["accessors"][p["indices"]]["count"] // 3
+        for m in doc["meshes"] for p in m["primitives"]
+    )
+
+
 def one_process(rules, gdf):
     models = rules.generate(gdf, invalid="report")
     return models
@@ -74,6 +87,10 @@ def test_partitions_give_what_one_process_gives(cluster, tmp_path):
     files = sorted(os.listdir(tmp_path / "out"))
     assert files == [f"part-{i:05d}.glb" for i in range(8)]
     assert all((tmp_path / "out" / f).read_bytes()[:4] == b"glTF" for f in files)
+    # The files hold the triangles the table counts (no instanced assets
+    # here: each primitive's indices are its triangles).
+    assert sum(glb_triangles(tmp_path / "out" / f) for f in files) == table["triangles"].sum()
+    assert table["triangles"].sum() > 100000
     wide = cga.dask.report_columns(table)
     assert wide["roof"].iloc[0] == pytest.approx(want[0].reports["roof"])
 

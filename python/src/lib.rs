@@ -589,11 +589,7 @@ fn array<'py, T: numpy::Element, const N: usize>(
 /// A lot's result as a dict (its index: its place in the whole run).
 /// `positions_only`: its meshes have no normals or texture coordinates
 /// (given as None).
-fn model_dict(
-    py: Python<'_>,
-    r: LotResult,
-    positions_only: bool,
-) -> PyResult<Bound<'_, PyDict>> {
+fn model_dict(py: Python<'_>, r: LotResult, positions_only: bool) -> PyResult<Bound<'_, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("index", r.index)?;
     d.set_item("name", &r.name)?;

@@ -211,15 +211,18 @@ impl Rules {
         // so that writing the model overlaps deriving it, even for a single
         // lot. For glTF and GLB the workers encode them into vertex data
         // first, leaving the calling thread the writing alone, also with
-        // one worker: `jobs` threads do the work (a Dask task with one
-        // thread is one core). Leaves encoded on the calling thread instead
-        // cost a third more CPU on small leaves (1,250 lots of
-        // examples/building.cga, one worker: 2.15 s of user time against
-        // 1.37 s, and 1.60 s of wall time against 1.40 s), in memory freed
-        // on another thread than the one that took it and meshes read from
-        // another core's cache. The encoding is done in the same batches
-        // (`Batcher`) however many workers, so the model is written out at
-        // the same points and the file is the same.
+        // one job: `--jobs 1` is one thread's work (a Dask task with one
+        // thread is one core). Leaves encoded on the calling thread cost
+        // more CPU on small leaves (1,250 lots of examples/building.cga,
+        // one job: 2.15 s of user time against 1.37 s, and 1.60 s of wall
+        // time against 1.40 s): memory freed on another thread than the one
+        // that took it, meshes read from another core's cache. Only when
+        // more threads are allowed than there are lots (one lot, which one
+        // worker derives) does the calling thread encode what it is sent,
+        // so that two threads share the lot (one Candler building: 30 ms
+        // against 34 ms). Either way a lot's leaves are encoded in the
+        // same batches (`Batcher`), so the model is written out at the same
+        // points and the file is the same.
         // Plain meshes are made on the workers, per lot.
         let (encoder, origins) = match &out {
             Out::None => (None, Vec::new()),
@@ -228,9 +231,10 @@ impl Rules {
         };
         // Each lot's origin, when lots have origins of their own.
         let origin = |i: usize| origins.get(i).copied();
+        let workers_encode = jobs > 1 || options.threads() == 1;
         let has_writer = !matches!(out, Out::None);
         let new_batcher = || match &encoder {
-            Some(e) => Batcher::Encode(Box::new(e.another()), 0),
+            Some(e) if workers_encode => Batcher::Encode(Box::new(e.another()), 0),
             _ if has_writer => Batcher::Leaves(Vec::new()),
             _ => match keep {
                 Some(Keep::Plain) => {
@@ -247,6 +251,10 @@ impl Rules {
                 None => Batcher::Drop,
             },
         };
+        let mut own_batcher = match &encoder {
+            Some(e) if !workers_encode => Some(Batcher::Encode(Box::new(e.another()), 0)),
+            _ => None,
+        };
         let mut summary = Summary {
             lots: count,
             ..Summary::default()
@@ -262,6 +270,9 @@ impl Rules {
             let mut writer = out.writer(i)?;
             if begun != Some(i) {
                 begun = Some(i);
+                if let (Some(o), Some(own)) = (origin(i), &mut own_batcher) {
+                    own.set_origin(o);
+                }
                 if let Some(w) = writer.as_deref_mut() {
                     triangles_before = w.triangles();
                     w.begin_lot(
@@ -277,12 +288,24 @@ impl Rules {
                     result = write_piece(w, piece);
                 }
             };
-            let done = match taken {
-                Taken::Piece(piece) => {
+            let done = match (taken, &mut own_batcher) {
+                (Taken::Piece(Piece::Leaves(batch)), Some(own)) => {
+                    for leaf in batch {
+                        own.add(leaf, &mut write);
+                    }
+                    return result.map_err(Error::Export);
+                }
+                (Taken::Piece(piece), _) => {
                     write(piece);
                     return result.map_err(Error::Export);
                 }
-                Taken::Done(done) => done,
+                (Taken::Done(done), own) => {
+                    if let Some(own) = own {
+                        own.flush(&mut write);
+                    }
+                    result.map_err(Error::Export)?;
+                    done
+                }
             };
             if done
                 .error
@@ -311,7 +334,7 @@ impl Rules {
         };
         // Workers that encode and run out of lots take over the encoding of
         // those still deriving (see `help`).
-        let helps_encode = encoder.is_some();
+        let helps_encode = workers_encode && encoder.is_some();
         let help = Help::new();
         let new_worker = || (new_batcher(), Helping::new(&help));
         let generate_one =

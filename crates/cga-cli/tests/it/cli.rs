@@ -321,7 +321,8 @@ fn an_error_in_one_lot_does_not_stop_the_others() {
 
 /// The written model does not depend on the number of threads: GLB and
 /// glTF are encoded in batches (on the deriving threads, or on the writing
-/// thread with one job) and appended in lot order, OBJ is written from
+/// thread for a single lot with more jobs than lots) and appended in lot
+/// order, OBJ is written from
 /// leaves on the writing thread. Lots of many leaves (more than one batch
 /// each) and of different materials; with `--held-mib 1` the vertex data is
 /// written out early many times, at the same points whatever the threads.

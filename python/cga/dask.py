@@ -58,7 +58,14 @@ def _generate_partition(part, offsets, rules, out_dir, keys, kwargs, partition_i
         # name.
         output = os.path.join(out_dir, f"part-{number:05d}.glb")
         partial = output[: -len(".glb")] + ".partial.glb"
-        models = rules.generate(part, geometry=False, output=partial, **common)
+        try:
+            models = rules.generate(part, geometry=False, output=partial, **common)
+        except BaseException:
+            # A task that fails (and is retried, perhaps elsewhere) leaves
+            # no half file behind.
+            if os.path.exists(partial):
+                os.remove(partial)
+            raise
         os.replace(partial, output)
     index = part.index if hasattr(part, "index") and not isinstance(part, list) else pd.RangeIndex(first, first + len(models))
     frame = pd.DataFrame(

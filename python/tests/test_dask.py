@@ -160,3 +160,18 @@ def test_a_bag_of_lots(cluster):
     assert table["triangles"].tolist() == [m.triangles for m in want]
     assert table["reports"].tolist() == [m.reports for m in want]
     assert table["reports"].iloc[5]["floors"] == 6.0
+
+
+def test_a_partition_that_fails_leaves_no_half_file(tmp_path, monkeypatch):
+    rules = cga.Rules.from_string(RULES)
+
+    def stops_half_way(self, lots, output=None, **kwargs):
+        with open(output, "wb") as f:
+            f.write(b"glTF, half of it")
+        raise RuntimeError("stopped half way")
+
+    monkeypatch.setattr(cga.Rules, "generate", stops_half_way)
+    kwargs = dict(attrs=None, seed=0, start_rule=None, jobs=1, limits=None)
+    with pytest.raises(RuntimeError, match="half way"):
+        cga.dask._generate_partition(frame(10), [0], rules, str(tmp_path), [], kwargs)
+    assert os.listdir(tmp_path) == []

@@ -14,6 +14,7 @@ workers as what they were loaded from (a path, or rule text with its
 files) and are loaded once per worker process.
 """
 
+import contextlib
 import os
 
 import numpy as np
@@ -63,7 +64,7 @@ def _generate_partition(part, offsets, rules, out_dir, keys, kwargs, partition_i
         except BaseException:
             # A task that fails (and is retried, perhaps elsewhere) leaves
             # no half file behind.
-            if os.path.exists(partial):
+            with contextlib.suppress(FileNotFoundError):
                 os.remove(partial)
             raise
         os.replace(partial, output)

@@ -13,6 +13,7 @@ import pytest
 import shapely
 
 import cga
+from glb import glb_json
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BUILDING = os.path.join(ROOT, "examples", "building.cga")
@@ -262,14 +263,6 @@ def test_write_glb_and_obj(tmp_path, box, building):
         cga.write(models, tmp_path / "city.stl")
 
 
-def _glb_json(path):
-    import json
-    import struct
-    data = path.read_bytes()
-    (n,) = struct.unpack("<I", data[12:16])
-    return json.loads(data[20:20 + n])
-
-
 def test_far_lots_keep_their_millimetres(tmp_path, box):
     # Lots in a national grid's metres: GLB positions are relative to the
     # lots' centre, which the nodes' translation holds.
@@ -282,7 +275,7 @@ def test_far_lots_keep_their_millimetres(tmp_path, box):
             cga.write([model], tmp_path / out)
         else:
             box.generate([far], output=tmp_path / out)
-        j = _glb_json(tmp_path / out)
+        j = glb_json(tmp_path / out)
         t = j["nodes"][0]["translation"]
         assert t[0] == 2683010.0
         acc = j["accessors"][j["meshes"][0]["primitives"][0]["attributes"]["POSITION"]]

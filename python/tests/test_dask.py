@@ -12,6 +12,7 @@ import pytest
 import shapely
 
 import cga
+from glb import glb_json
 
 dask_geopandas = pytest.importorskip("dask_geopandas")
 gpd = pytest.importorskip("geopandas")
@@ -48,12 +49,7 @@ def cluster():
 
 
 def glb_triangles(path):
-    import json
-    import struct
-
-    data = path.read_bytes()
-    (n,) = struct.unpack("<I", data[12:16])
-    doc = json.loads(data[20:20 + n])
+    doc = glb_json(path)
     return sum(
         doc["accessors"][p["indices"]]["count"] // 3
         for m in doc["meshes"] for p in m["primitives"]

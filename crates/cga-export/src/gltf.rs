@@ -723,7 +723,12 @@ impl GltfWriter {
     ) -> Result<GltfWriter, ExportError> {
         // Readable too: a GLB's binary data may have to be moved up (see
         // `finish_early_glb`).
-        let file = crate::output_file::create(path, true).map_err(|e| ExportError::io(path, e))?;
+        let mut file =
+            crate::output_file::create(path, true).map_err(|e| ExportError::io(path, e))?;
+        if binary {
+            // A GLB is written from its start to its end, then its head.
+            file.around_cache();
+        }
         Ok(GltfWriter::new(
             Box::new(file),
             path,
@@ -1982,7 +1987,7 @@ fn write_bin(
     write_instances(w, held.middle).map_err(io)?;
     for &t in images {
         let tex = textures.get(t);
-        w.write_all(&textures.bytes(t)?).map_err(io)?;
+        textures.write_to(t, w)?;
         let pad = (tex.len.next_multiple_of(4) - tex.len) as usize;
         w.write_all(&[0u8; 3][..pad]).map_err(io)?;
     }

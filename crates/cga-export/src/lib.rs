@@ -29,6 +29,7 @@
 mod array_pool;
 mod bucket;
 pub mod builtin;
+mod direct_write;
 mod draw;
 mod encode;
 mod faces;

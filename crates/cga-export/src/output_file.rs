@@ -34,6 +34,8 @@ const UNLINK_APART_BYTES: u64 = 4 << 20;
 pub(crate) struct OutputFile {
     file: File,
     unlinking: Option<JoinHandle<()>>,
+    /// While its writes go around the page cache (see `around_cache`).
+    direct: Option<crate::direct_write::Direct>,
 }
 
 /// Creates `path` for writing (and reading, with `read`), replacing what
@@ -45,6 +47,7 @@ pub(crate) fn create(path: &Path, read: bool) -> io::Result<OutputFile> {
         return Ok(OutputFile {
             file: options.create(true).truncate(true).open(path)?,
             unlinking: None,
+            direct: None,
         });
     };
     let file = match options.create_new(true).open(path) {
@@ -64,7 +67,32 @@ pub(crate) fn create(path: &Path, read: bool) -> io::Result<OutputFile> {
     if unlinking.is_none() {
         let _ = std::fs::remove_file(&old);
     }
-    Ok(OutputFile { file, unlinking })
+    Ok(OutputFile {
+        file,
+        unlinking,
+        direct: None,
+    })
+}
+
+impl OutputFile {
+    /// From here on, the file's bytes are written around the page cache
+    /// where the system allows (see `direct_write`): for a large model
+    /// written from its start to its end, before any seek back. Nothing
+    /// changes where it does not (another system, a file system without
+    /// direct writes, a file that is not new and empty).
+    pub(crate) fn around_cache(&mut self) {
+        if self.direct.is_none() {
+            self.direct = crate::direct_write::Direct::begin(&self.file);
+        }
+    }
+
+    /// Writes what is staged and goes on with ordinary writes.
+    fn end_direct(&mut self) -> io::Result<()> {
+        match self.direct.take() {
+            Some(d) => d.end(&mut self.file),
+            None => Ok(()),
+        }
+    }
 }
 
 /// Unlinks `old` on a thread of its own (`None` if none could start).
@@ -124,6 +152,9 @@ fn single_name(_: &std::fs::Metadata) -> bool {
 
 impl Drop for OutputFile {
     fn drop(&mut self) {
+        // Writers end with `flush` (which writes what is staged and can
+        // report an error); this is for one that stopped part way.
+        let _ = self.end_direct();
         if let Some(t) = self.unlinking.take() {
             let _ = t.join();
         }
@@ -132,26 +163,44 @@ impl Drop for OutputFile {
 
 impl Read for OutputFile {
     fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        self.end_direct()?;
         self.file.read(buf)
     }
 }
 
 impl Write for OutputFile {
     fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-        self.file.write(buf)
+        match &mut self.direct {
+            Some(d) => d.write(&self.file, &[io::IoSlice::new(buf)]),
+            None => self.file.write(buf),
+        }
     }
 
     fn write_vectored(&mut self, bufs: &[io::IoSlice<'_>]) -> io::Result<usize> {
-        self.file.write_vectored(bufs)
+        match &mut self.direct {
+            Some(d) => d.write(&self.file, bufs),
+            None => self.file.write_vectored(bufs),
+        }
     }
 
+    /// Writes what is staged for a direct write too (and ends direct
+    /// writing: writers flush when they are done).
     fn flush(&mut self) -> io::Result<()> {
+        self.end_direct()?;
         self.file.flush()
     }
 }
 
 impl Seek for OutputFile {
     fn seek(&mut self, pos: SeekFrom) -> io::Result<u64> {
+        if let Some(d) = &self.direct {
+            // Asking where the writing is, or seeking where it already is
+            // (before the first write: anywhere), keeps writing direct.
+            if let Some(at) = d.seek_within(&mut self.file, pos)? {
+                return Ok(at);
+            }
+            self.end_direct()?;
+        }
         self.file.seek(pos)
     }
 }
@@ -223,6 +272,113 @@ mod tests {
         let fresh = d.join("other.glb");
         create(&fresh, false).unwrap().write_all(b"x").unwrap();
         assert_eq!(std::fs::read(&fresh).unwrap(), b"x");
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    /// Bytes of a test pattern, different at every offset of a chunk.
+    fn pattern(n: usize, seed: u32) -> Vec<u8> {
+        (0..n as u32)
+            .map(|i| (i.wrapping_mul(2_654_435_761).wrapping_add(seed) >> 13) as u8)
+            .collect()
+    }
+
+    /// A model written around the page cache holds what ordinary writes
+    /// would: written from an unaligned offset in pieces of every size
+    /// (vectored too), with a position asked for on the way, then its head
+    /// written at the start, and read back in between.
+    #[test]
+    fn writes_around_the_cache_give_the_bytes_written() {
+        let d = dir("direct");
+        let path = d.join("model.glb");
+        let mut out = create(&path, true).unwrap();
+        out.around_cache();
+        let direct = out.direct.is_some();
+        let start = 1_000u64;
+        out.seek(SeekFrom::Start(start)).unwrap();
+        let body = pattern(3 * (1 << 20) + 12_345, 1);
+        let mut at = 0;
+        for (i, size) in [1usize, 7, 4096, 65_536, 1 << 20, 3, 333_333]
+            .iter()
+            .cycle()
+            .enumerate()
+        {
+            if at == body.len() {
+                break;
+            }
+            let n = (*size).min(body.len() - at);
+            if i % 3 == 2 && n > 1 {
+                let half = n / 2;
+                let bufs = [
+                    io::IoSlice::new(&body[at..at + half]),
+                    io::IoSlice::new(&body[at + half..at + n]),
+                ];
+                let mut written = out.write_vectored(&bufs).unwrap();
+                // The rest, should a write take less.
+                while written < n {
+                    written += out.write(&body[at + written..at + n]).unwrap();
+                }
+            } else {
+                out.write_all(&body[at..at + n]).unwrap();
+            }
+            at += n;
+            assert_eq!(out.stream_position().unwrap(), start + at as u64);
+        }
+        if direct {
+            // Three whole chunks went to the file directly already.
+            assert!(out.file.metadata().unwrap().len() >= 3 << 20);
+            assert!(
+                out.direct.is_some(),
+                "asking the position kept writing direct"
+            );
+        }
+        // Reading back (as moving a GLB's data up does) sees every byte.
+        out.seek(SeekFrom::Start(start + 10)).unwrap();
+        assert!(out.direct.is_none());
+        let mut back = vec![0u8; 100];
+        out.read_exact(&mut back).unwrap();
+        assert_eq!(back, body[10..110]);
+        out.seek(SeekFrom::Start(0)).unwrap();
+        out.write_all(b"head").unwrap();
+        out.flush().unwrap();
+        drop(out);
+        let file = std::fs::read(&path).unwrap();
+        assert_eq!(file.len() as u64, start + body.len() as u64);
+        assert_eq!(&file[..4], b"head");
+        assert!(file[4..start as usize].iter().all(|&b| b == 0));
+        assert_eq!(&file[start as usize..], body);
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    /// A model smaller than a chunk, written and flushed, is whole; so is
+    /// one whose writer stops without flushing (its file is closed).
+    #[test]
+    fn small_or_abandoned_writes_around_the_cache_are_whole() {
+        let d = dir("direct-small");
+        let small = pattern(5_000, 2);
+        let large = pattern((1 << 20) + 77, 3);
+        for (name, bytes, flush) in [("a.glb", &small, true), ("b.glb", &large, false)] {
+            let path = d.join(name);
+            let mut out = create(&path, true).unwrap();
+            out.around_cache();
+            out.write_all(bytes).unwrap();
+            if flush {
+                out.flush().unwrap();
+                assert!(out.direct.is_none());
+            }
+            drop(out);
+            assert_eq!(&std::fs::read(&path).unwrap(), bytes, "{name}");
+        }
+        // Not for a file that holds something already.
+        let path = d.join("a.glb");
+        let mut old = OpenOptions::new().write(true).open(&path).unwrap();
+        old.seek(SeekFrom::End(0)).unwrap();
+        let mut out = OutputFile {
+            file: old,
+            unlinking: None,
+            direct: None,
+        };
+        out.around_cache();
+        assert!(out.direct.is_none());
         std::fs::remove_dir_all(&d).unwrap();
     }
 

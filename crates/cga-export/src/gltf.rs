@@ -801,7 +801,10 @@ impl GltfWriter {
             translation: shifted.translation,
             ..p.trs
         };
-        let Some(b) = self.instances.place(group, lot, &trs, &shifted) else {
+        let Some(b) = self
+            .instances
+            .place(group, lot, self.per_lot, &trs, &shifted)
+        else {
             return;
         };
         self.instance_bounds = union_bounds(self.instance_bounds, Some(b));
@@ -1377,11 +1380,11 @@ impl GltfWriter {
             }
             out.group_primitives.push(prims);
         }
-        let nodes = self.instances.nodes(self.per_lot);
+        let nodes = &self.instances.nodes;
         let accessors = nodes.len() * placement_attributes(self.features).len();
         root.accessors.reserve(accessors);
         root.buffer_views.reserve(accessors);
-        for ((lot, group), placements) in &nodes {
+        for ((lot, group), placements) in nodes {
             let mut attributes = serde_json::Map::new();
             for &(name, width, type_, _) in placement_attributes(self.features) {
                 let index = layout.accessor(
@@ -1397,7 +1400,6 @@ impl GltfWriter {
             }
             out.nodes.push((*lot, *group, attributes));
         }
-        self.instances.laid_out = nodes.into_iter().map(|(_, p)| p).collect();
         self.instances.with_features = self.features;
         out
     }
@@ -1490,7 +1492,13 @@ impl GltfWriter {
     ) -> Result<(), ExportError> {
         let path = self.path.clone();
         let io = |e| ExportError::io(&path, e);
-        let mut json = GlbJson::new(root, spool).map_err(io)?;
+        // A GLB written early has room for its JSON estimated.
+        let room = if self.written_bytes > 0 {
+            self.json_room as usize
+        } else {
+            0
+        };
+        let mut json = GlbJson::new(root, spool, room).map_err(io)?;
         if self.written_bytes > 0 {
             return self.finish_early_glb(&mut json, bin_len, images, textures);
         }
@@ -2014,14 +2022,14 @@ fn write_instances(w: &mut impl Write, instances: &Instances) -> std::io::Result
             b.write_arrays(w)?;
         }
     }
-    let all = &instances.placements;
-    // One attribute of a node at a time, in room kept between them.
+    // One attribute of a node at a time, in room kept between them; nodes
+    // in the order `lay_out_instances` laid them out.
     let mut values: Vec<f32> = Vec::new();
-    for placements in &instances.laid_out {
+    for placements in instances.nodes.values() {
         for &(_, width, _, value) in placement_attributes(instances.with_features) {
             values.clear();
-            for &k in placements {
-                values.extend_from_slice(&value(&all[k])[..width]);
+            for p in placements {
+                values.extend_from_slice(&value(p)[..width]);
             }
             write_le(w, &values)?;
         }

@@ -13,7 +13,7 @@
 //! per asset, see `Leaf::asset`) and the materials' values, in the order
 //! placements reach the writer, so the file is the same from run to run.
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::sync::Arc;
 
 use cga_geometry::mesh::SharedVec;
@@ -77,10 +77,10 @@ pub(crate) struct Group {
     pub bounds: Option<[DVec3; 2]>,
 }
 
-/// One placement of a group: the lot it belongs to (its position among
-/// the writer's lots) and its TRS as written (relative to the origin).
+/// One placement of a group (its node's): the lot it belongs to (its
+/// position among the writer's lots) and its TRS as written (relative to
+/// the origin).
 pub(crate) struct Placement {
-    pub group: u32,
     pub lot: Option<u32>,
     pub translation: [f32; 3],
     pub rotation: [f32; 4],
@@ -95,17 +95,19 @@ pub(crate) type NodeKey = (Option<u32>, u32);
 pub(crate) struct Instances {
     pub groups: Vec<Group>,
     by_mesh: HashMap<usize, Vec<u32>>,
-    pub placements: Vec<Placement>,
-    /// The placements of each node, in the order the writer laid out
-    /// their data (`GltfWriter::lay_out_instances`), and whether each has
-    /// its lot as feature id.
-    pub laid_out: Vec<Vec<usize>>,
+    /// The placements of each node, in order of node (lot, then group)
+    /// and, within a node, in the order they came. Gathered as they come:
+    /// one array of all placements, sorted into nodes at the end, grew in
+    /// fresh memory on the writing thread and took two more arrays of its
+    /// size at the model's last step (each new size of block a fresh page
+    /// of the allocator, zeroed whole by a huge page).
+    pub nodes: BTreeMap<NodeKey, Vec<Placement>>,
     pub with_features: bool,
 }
 
 impl Instances {
     pub fn is_empty(&self) -> bool {
-        self.placements.is_empty()
+        self.nodes.is_empty()
     }
 
     /// The group of `mesh` with `materials`, if there is one.
@@ -152,17 +154,19 @@ impl Instances {
         id
     }
 
-    /// Places `group` by `trs` (relative to the origin) in `lot`; returns
-    /// the box of the placed geometry (relative to the origin).
+    /// Places `group` by `trs` (relative to the origin) in `lot`, in the
+    /// node of `lot` and `group` (`per_lot`) or of `group`; returns the box
+    /// of the placed geometry (relative to the origin).
     pub fn place(
         &mut self,
         group: u32,
         lot: Option<u32>,
+        per_lot: bool,
         trs: &Trs,
         transform: &DAffine3,
     ) -> Option<[[f64; 3]; 2]> {
-        self.placements.push(Placement {
-            group,
+        let node = (if per_lot { lot } else { None }, group);
+        self.nodes.entry(node).or_default().push(Placement {
             lot,
             translation: trs.translation.as_vec3().to_array(),
             rotation: trs.rotation.as_quat().to_array(),
@@ -181,23 +185,6 @@ impl Instances {
             (lo.min(p), hi.max(p))
         });
         Some([lo.to_array(), hi.to_array()])
-    }
-
-    /// The placements by node: per lot (when `per_lot`) and group, in
-    /// order of lot and group, each with the indices of its placements.
-    pub fn nodes(&self, per_lot: bool) -> Vec<(NodeKey, Vec<usize>)> {
-        let key = |k: usize| {
-            let p = &self.placements[k];
-            (if per_lot { p.lot } else { None }, p.group)
-        };
-        // A stable sort keeps each node's placements in the order they came;
-        // placements come lot by lot, so it mostly merges runs.
-        let mut order: Vec<usize> = (0..self.placements.len()).collect();
-        order.sort_by_key(|&k| key(k));
-        order
-            .chunk_by(|&a, &b| key(a) == key(b))
-            .map(|run| (key(run[0]), run.to_vec()))
-            .collect()
     }
 }
 
@@ -220,22 +207,60 @@ mod tests {
             let mesh = Arc::new(cga_geometry::primitive::cube(DVec3::ONE));
             instances.add_group(mesh, SharedVec::default(), Vec::new(), 0, 0);
         }
-        // (lot, group) of each placement, in the order placed.
+        // (lot, group) of each placement, in the order placed; a
+        // placement's lot is its x, its order its y.
         let placed = [(0, 1), (0, 0), (0, 1), (1, 0), (1, 1), (1, 0), (2, 1)];
-        for (lot, group) in placed {
-            instances.place(group, Some(lot), &trs, &DAffine3::IDENTITY);
+        let mut whole = instances_like(&instances);
+        for (k, (lot, group)) in placed.into_iter().enumerate() {
+            let trs = Trs {
+                translation: DVec3::new(lot as f64, k as f64, 0.0),
+                ..trs
+            };
+            instances.place(group, Some(lot), true, &trs, &DAffine3::IDENTITY);
+            whole.place(group, Some(lot), false, &trs, &DAffine3::IDENTITY);
         }
-        let per_lot: Vec<(NodeKey, Vec<usize>)> = vec![
-            ((Some(0), 0), vec![1]),
-            ((Some(0), 1), vec![0, 2]),
-            ((Some(1), 0), vec![3, 5]),
-            ((Some(1), 1), vec![4]),
-            ((Some(2), 1), vec![6]),
+        type Lots = Vec<(Option<u32>, f32)>;
+        let nodes = |i: &Instances| -> Vec<(NodeKey, Lots)> {
+            i.nodes
+                .iter()
+                .map(|(key, ps)| (*key, ps.iter().map(|p| (p.lot, p.translation[1])).collect()))
+                .collect()
+        };
+        let per_lot = vec![
+            ((Some(0), 0), vec![(Some(0), 1.0)]),
+            ((Some(0), 1), vec![(Some(0), 0.0), (Some(0), 2.0)]),
+            ((Some(1), 0), vec![(Some(1), 3.0), (Some(1), 5.0)]),
+            ((Some(1), 1), vec![(Some(1), 4.0)]),
+            ((Some(2), 1), vec![(Some(2), 6.0)]),
         ];
-        assert_eq!(instances.nodes(true), per_lot);
-        let whole: Vec<(NodeKey, Vec<usize>)> =
-            vec![((None, 0), vec![1, 3, 5]), ((None, 1), vec![0, 2, 4, 6])];
-        assert_eq!(instances.nodes(false), whole);
+        assert_eq!(nodes(&instances), per_lot);
+        // Without nodes per lot the placements keep their lots (feature
+        // ids) in nodes by group.
+        let by_group = vec![
+            (
+                (None, 0),
+                vec![(Some(0), 1.0), (Some(1), 3.0), (Some(1), 5.0)],
+            ),
+            (
+                (None, 1),
+                vec![
+                    (Some(0), 0.0),
+                    (Some(0), 2.0),
+                    (Some(1), 4.0),
+                    (Some(2), 6.0),
+                ],
+            ),
+        ];
+        assert_eq!(nodes(&whole), by_group);
+    }
+
+    /// Instances with the groups of `i` and no placements.
+    fn instances_like(i: &Instances) -> Instances {
+        let mut out = Instances::default();
+        for g in &i.groups {
+            out.add_group(g.mesh.clone(), g.materials.clone(), Vec::new(), 0, 0);
+        }
+        out
     }
 
     #[test]

@@ -161,9 +161,12 @@ pub(crate) struct GlbJson {
 
 impl GlbJson {
     /// The JSON of `root`, with `spool`'s items (if any) in place of the
-    /// markers `root` holds for them.
-    pub(crate) fn new(root: &json::Root, spool: Option<Spool>) -> io::Result<GlbJson> {
-        let text = serde_json::to_vec(root)?;
+    /// markers `root` holds for them. `room`: the bytes the JSON is
+    /// expected to take, kept from the start (growing the text from empty
+    /// takes a fresh block at every doubling, at the model's last step).
+    pub(crate) fn new(root: &json::Root, spool: Option<Spool>, room: usize) -> io::Result<GlbJson> {
+        let mut text = Vec::with_capacity(room);
+        serde_json::to_writer(&mut text, root)?;
         let mut splices = Vec::new();
         if let Some(spool) = spool {
             let parts = [

@@ -51,7 +51,9 @@ impl<T> Shelf<T> {
     /// 84-512 KiB, per class and thread) that a huge page zeroes whole;
     /// rooms of exactly `n` spread over ten such classes (20 Candler
     /// buildings, two jobs: 398 new arrays, 93 of them in that range), and
-    /// a new array fits more later requests.
+    /// a new array fits more later requests. Larger arrays are rounded too
+    /// (their room past what is written is never touched, but counts
+    /// towards `KEPT_BYTES_PER_KIND`).
     pub fn take(&self, n: usize) -> Vec<T> {
         if n == 0 {
             return Vec::new();

@@ -7,59 +7,61 @@
 //! of the writing thread's samples), taken from the two cores the workers
 //! derive on. A direct write (`O_DIRECT`) hands the bytes to the device
 //! from our memory and costs a tenth of that. It asks for aligned memory,
-//! offsets and lengths, so the bytes are staged in an aligned buffer of
-//! one chunk and written a whole chunk at a time; what is left when the
-//! writing ends (less than a chunk) is written the ordinary way, and so is
-//! everything after it (the GLB's header, written last at the file's
-//! start). A model smaller than a chunk never writes directly.
+//! offsets and lengths, so from the first chunk boundary on (the first
+//! MiB is written the ordinary way) the bytes are staged in an aligned
+//! buffer of one chunk and written a whole chunk at a time; what is left
+//! when the writing ends (at most a chunk) is written the ordinary way, and
+//! so is everything after it (the GLB's header, written last at the file's
+//! start). A model smaller than a chunk never stages, and `O_DIRECT` is
+//! set only when the first chunk goes out.
 //!
 //! Linux only; elsewhere, or where the file system refuses direct writes,
-//! nothing changes.
+//! the bytes go out the ordinary way.
+
+// Elsewhere nothing begins direct writing (only tests stage).
+#![cfg_attr(not(target_os = "linux"), allow(dead_code))]
 
 use std::fs::File;
-use std::io::{self, IoSlice, Seek};
+use std::io::{self, IoSlice, Seek, Write};
 
 /// Bytes written at once. A direct write returns when the device has the
 /// bytes (about a millisecond a megabyte here), and the writing thread
 /// waits for it, off the CPU.
 const CHUNK: usize = 1 << 20;
 
-/// Alignment of direct writes' memory, offsets and lengths: the page size,
-/// a multiple of the block sizes file systems ask for.
+/// Alignment of direct writes' memory (offsets and lengths are multiples
+/// of `CHUNK`): the page size, a multiple of the block sizes file systems
+/// ask for.
 const ALIGN: usize = 4096;
 
-/// A file's writes staged for direct writing.
+/// A file's writes, staged for direct writing from a chunk boundary on.
 pub(crate) struct Direct {
     /// `raw[start..]` is the staged part, `start` its aligned offset in
-    /// the allocation. Empty until the first write.
+    /// the allocation. Empty until staging starts.
     raw: Vec<u8>,
     start: usize,
-    /// File offset of the first staged byte (a multiple of `ALIGN`).
+    /// File offset of the first staged byte (a multiple of `CHUNK`).
     base: u64,
-    /// Whether the first write came: before it, seeks go to the file.
-    anchored: bool,
-    /// A direct write was refused: chunks are written the ordinary way.
+    /// Whether the writing reached a chunk boundary and stages; before,
+    /// writes and seeks go to the file as they come.
+    staging: bool,
+    /// `O_DIRECT` is set on the file.
+    set: bool,
+    /// A direct write was refused (or is not to be tried): chunks are
+    /// written the ordinary way.
     refused: bool,
 }
 
 impl Direct {
-    /// Direct writing of `file`, if it is new and empty and its file
-    /// system takes direct writes.
+    /// Direct writing of `file`, if it is a plain file (not a pipe or a
+    /// device, which are written as they come) on Linux.
     #[cfg(target_os = "linux")]
     pub(crate) fn begin(file: &File) -> Option<Direct> {
-        use rustix::fs::{fcntl_getfl, fcntl_setfl, OFlags};
-        if file.metadata().ok()?.len() != 0 {
-            return None;
-        }
-        let flags = fcntl_getfl(file).ok()?;
-        fcntl_setfl(file, flags | OFlags::DIRECT).ok()?;
-        Some(Direct {
-            raw: Vec::new(),
-            start: 0,
-            base: 0,
-            anchored: false,
-            refused: false,
-        })
+        file.metadata()
+            .ok()?
+            .file_type()
+            .is_file()
+            .then(|| Direct::staged(true))
     }
 
     #[cfg(not(target_os = "linux"))]
@@ -67,40 +69,80 @@ impl Direct {
         None
     }
 
-    /// Stages `bufs` (writing every chunk that fills); the bytes taken.
-    pub(crate) fn write(&mut self, file: &File, bufs: &[IoSlice<'_>]) -> io::Result<usize> {
-        if !self.anchored {
-            self.anchor(file)?;
+    /// Staging as `begin` does; with `may_set` false, whole chunks are
+    /// written the ordinary way (what a refusing file system gives).
+    pub(crate) fn staged(may_set: bool) -> Direct {
+        Direct {
+            raw: Vec::new(),
+            start: 0,
+            base: 0,
+            staging: false,
+            set: false,
+            refused: !may_set,
         }
-        let full = self.start + CHUNK;
+    }
+
+    /// Whether `O_DIRECT` is on.
+    #[cfg(test)]
+    pub(crate) fn is_set(&self) -> bool {
+        self.set
+    }
+
+    /// Writes or stages `bufs`; the bytes taken.
+    pub(crate) fn write(&mut self, file: &File, bufs: &[IoSlice<'_>]) -> io::Result<usize> {
         let mut taken = 0;
         for buf in bufs {
             let mut rest: &[u8] = buf;
             while !rest.is_empty() {
-                if self.raw.len() == full {
-                    if let Err(e) = self.write_chunk(file) {
-                        return if taken > 0 { Ok(taken) } else { Err(e) };
+                match self.write_some(file, rest) {
+                    Ok(n) => {
+                        rest = &rest[n..];
+                        taken += n;
                     }
+                    // What was taken is kept; the error comes again with
+                    // the next write.
+                    Err(_) if taken > 0 => return Ok(taken),
+                    Err(e) => return Err(e),
                 }
-                let n = rest.len().min(full - self.raw.len());
-                self.raw.extend_from_slice(&rest[..n]);
-                rest = &rest[n..];
-                taken += n;
             }
         }
         Ok(taken)
     }
 
-    /// Where a seek to `pos` lands, when it keeps writing direct: before
-    /// the first write any seek (done on the file), after it one that asks
-    /// where the writing is or goes where it already is. `None`: the seek
-    /// needs the staged bytes written first.
+    /// Writes or stages a first part of `bytes` (not empty); its length.
+    fn write_some(&mut self, mut file: &File, bytes: &[u8]) -> io::Result<usize> {
+        if !self.staging {
+            let at = file.stream_position()?;
+            let boundary = at.next_multiple_of(CHUNK as u64).max(CHUNK as u64);
+            if at < boundary {
+                let n = bytes.len().min((boundary - at) as usize);
+                return file.write(&bytes[..n]);
+            }
+            self.raw = Vec::with_capacity(CHUNK + ALIGN);
+            self.start = self.raw.as_ptr().align_offset(ALIGN);
+            self.raw.resize(self.start, 0);
+            self.base = at;
+            self.staging = true;
+        }
+        let full = self.start + CHUNK;
+        if self.raw.len() == full {
+            self.write_chunk(file)?;
+        }
+        let n = bytes.len().min(full - self.raw.len());
+        self.raw.extend_from_slice(&bytes[..n]);
+        Ok(n)
+    }
+
+    /// Where a seek to `pos` lands, when it keeps the writing as it is:
+    /// before staging any seek (done on the file), while staging one that
+    /// asks where the writing is or goes where it already is. `None`: the
+    /// seek needs the staged bytes written first.
     pub(crate) fn seek_within(
         &self,
-        file: &mut File,
+        mut file: &File,
         pos: io::SeekFrom,
     ) -> io::Result<Option<u64>> {
-        if !self.anchored {
+        if !self.staging {
             return file.seek(pos).map(Some);
         }
         let here = self.base + (self.raw.len() - self.start) as u64;
@@ -111,42 +153,46 @@ impl Direct {
         })
     }
 
-    /// Writes what is staged the ordinary way, and ordinary writing goes
-    /// on from where it ends.
-    pub(crate) fn end(self, file: &mut File) -> io::Result<()> {
-        ordinary(file)?;
-        if self.anchored {
+    /// Writes what is staged the ordinary way, from where ordinary writing
+    /// goes on. On an error nothing staged is lost: ending again retries.
+    pub(crate) fn end(&mut self, mut file: &File) -> io::Result<()> {
+        if self.set {
+            ordinary(file)?;
+            self.set = false;
+            self.refused = true;
+        }
+        if self.staging {
             let staged = &self.raw[self.start..];
             write_all_at(file, staged, self.base)?;
             file.seek(io::SeekFrom::Start(self.base + staged.len() as u64))?;
+            self.staging = false;
+            self.raw = Vec::new();
         }
-        Ok(())
-    }
-
-    /// At the first write: the staging buffer, starting at the aligned
-    /// offset at or before the file's position. The bytes before the
-    /// position are zeros, as the new file holds there.
-    fn anchor(&mut self, file: &File) -> io::Result<()> {
-        let at = (&*file).stream_position()?;
-        self.base = at - at % ALIGN as u64;
-        self.raw = Vec::with_capacity(CHUNK + ALIGN);
-        self.start = self.raw.as_ptr().align_offset(ALIGN);
-        self.raw.resize(self.start + (at - self.base) as usize, 0);
-        self.anchored = true;
         Ok(())
     }
 
     /// Writes the full staging buffer at `base`.
     fn write_chunk(&mut self, file: &File) -> io::Result<()> {
         let chunk = &self.raw[self.start..];
+        if !self.set && !self.refused {
+            self.set = set_direct(file).is_ok();
+            self.refused = !self.set;
+        }
         if !self.refused {
             match write_all_at(file, chunk, self.base) {
                 Ok(()) => {}
-                // Alignment the file system wants beyond ours (or a short
-                // write that left an unaligned rest): ordinary writes.
-                Err(e) if e.kind() == io::ErrorKind::InvalidInput => {
-                    self.refused = true;
+                // Alignment the file system wants beyond ours, a short
+                // write that left an unaligned rest, or direct writes
+                // refused only when writing: ordinary writes from here.
+                Err(e)
+                    if matches!(
+                        e.kind(),
+                        io::ErrorKind::InvalidInput | io::ErrorKind::Unsupported
+                    ) =>
+                {
                     ordinary(file)?;
+                    self.set = false;
+                    self.refused = true;
                 }
                 Err(e) => return Err(e),
             }
@@ -160,15 +206,25 @@ impl Direct {
     }
 }
 
+/// Turns direct writing of `file` on.
+#[cfg(target_os = "linux")]
+fn set_direct(file: &File) -> io::Result<()> {
+    use rustix::fs::{fcntl_getfl, fcntl_setfl, OFlags};
+    let flags = fcntl_getfl(file)?;
+    Ok(fcntl_setfl(file, flags | OFlags::DIRECT)?)
+}
+
+#[cfg(not(target_os = "linux"))]
+fn set_direct(_: &File) -> io::Result<()> {
+    Err(io::ErrorKind::Unsupported.into())
+}
+
 /// Turns direct writing of `file` off.
 #[cfg(target_os = "linux")]
 fn ordinary(file: &File) -> io::Result<()> {
     use rustix::fs::{fcntl_getfl, fcntl_setfl, OFlags};
     let flags = fcntl_getfl(file)?;
-    if flags.contains(OFlags::DIRECT) {
-        fcntl_setfl(file, flags - OFlags::DIRECT)?;
-    }
-    Ok(())
+    Ok(fcntl_setfl(file, flags - OFlags::DIRECT)?)
 }
 
 #[cfg(not(target_os = "linux"))]
@@ -183,7 +239,6 @@ fn write_all_at(file: &File, buf: &[u8], offset: u64) -> io::Result<()> {
 
 #[cfg(not(unix))]
 fn write_all_at(mut file: &File, buf: &[u8], offset: u64) -> io::Result<()> {
-    use std::io::Write;
     file.seek(io::SeekFrom::Start(offset))?;
     file.write_all(buf)
 }

@@ -163,9 +163,10 @@ impl GlbJson {
     /// The JSON of `root`, with `spool`'s items (if any) in place of the
     /// markers `root` holds for them. `room`: the bytes the JSON is
     /// expected to take, kept from the start (growing the text from empty
-    /// takes a fresh block at every doubling, at the model's last step).
+    /// takes a fresh block at every doubling, at the model's last step);
+    /// not with a spool, which holds most of it.
     pub(crate) fn new(root: &json::Root, spool: Option<Spool>, room: usize) -> io::Result<GlbJson> {
-        let mut text = Vec::with_capacity(room);
+        let mut text = Vec::with_capacity(if spool.is_none() { room } else { 0 });
         serde_json::to_writer(&mut text, root)?;
         let mut splices = Vec::new();
         if let Some(spool) = spool {

@@ -75,23 +75,26 @@ pub(crate) fn create(path: &Path, read: bool) -> io::Result<OutputFile> {
 }
 
 impl OutputFile {
-    /// From here on, the file's bytes are written around the page cache
-    /// where the system allows (see `direct_write`): for a large model
-    /// written from its start to its end, before any seek back. Nothing
-    /// changes where it does not (another system, a file system without
-    /// direct writes, a file that is not new and empty).
+    /// From here on, the file's bytes past its first MiB are written
+    /// around the page cache where the system allows (see
+    /// `direct_write`): for a large model written from its start to its
+    /// end, before any seek back. Nothing changes where it does not
+    /// (another system, a pipe or a device, a file system without direct
+    /// writes).
     pub(crate) fn around_cache(&mut self) {
         if self.direct.is_none() {
             self.direct = crate::direct_write::Direct::begin(&self.file);
         }
     }
 
-    /// Writes what is staged and goes on with ordinary writes.
+    /// Writes what is staged and goes on with ordinary writes (kept for a
+    /// retry if that fails).
     fn end_direct(&mut self) -> io::Result<()> {
-        match self.direct.take() {
-            Some(d) => d.end(&mut self.file),
-            None => Ok(()),
+        if let Some(d) = &mut self.direct {
+            d.end(&self.file)?;
+            self.direct = None;
         }
+        Ok(())
     }
 }
 
@@ -195,8 +198,8 @@ impl Seek for OutputFile {
     fn seek(&mut self, pos: SeekFrom) -> io::Result<u64> {
         if let Some(d) = &self.direct {
             // Asking where the writing is, or seeking where it already is
-            // (before the first write: anywhere), keeps writing direct.
-            if let Some(at) = d.seek_within(&mut self.file, pos)? {
+            // (before staging: anywhere), keeps the staging.
+            if let Some(at) = d.seek_within(&self.file, pos)? {
                 return Ok(at);
             }
             self.end_direct()?;
@@ -283,79 +286,84 @@ mod tests {
     }
 
     /// A model written around the page cache holds what ordinary writes
-    /// would: written from an unaligned offset in pieces of every size
-    /// (vectored too), with a position asked for on the way, then its head
-    /// written at the start, and read back in between.
+    /// would: written from an unaligned offset (before the first chunk
+    /// boundary, and past it) in pieces of every size (vectored too), with
+    /// a position asked for on the way, read back, then its head written
+    /// at the start; with direct writes, and with chunks written the
+    /// ordinary way (a file system that refuses them).
     #[test]
     fn writes_around_the_cache_give_the_bytes_written() {
         let d = dir("direct");
-        let path = d.join("model.glb");
-        let mut out = create(&path, true).unwrap();
-        out.around_cache();
-        let direct = out.direct.is_some();
-        let start = 1_000u64;
-        out.seek(SeekFrom::Start(start)).unwrap();
-        let body = pattern(3 * (1 << 20) + 12_345, 1);
-        let mut at = 0;
-        for (i, size) in [1usize, 7, 4096, 65_536, 1 << 20, 3, 333_333]
-            .iter()
-            .cycle()
-            .enumerate()
-        {
-            if at == body.len() {
-                break;
-            }
-            let n = (*size).min(body.len() - at);
-            if i % 3 == 2 && n > 1 {
-                let half = n / 2;
-                let bufs = [
-                    io::IoSlice::new(&body[at..at + half]),
-                    io::IoSlice::new(&body[at + half..at + n]),
-                ];
-                let mut written = out.write_vectored(&bufs).unwrap();
-                // The rest, should a write take less.
-                while written < n {
-                    written += out.write(&body[at + written..at + n]).unwrap();
-                }
+        let cases = [(1_000u64, true), ((1 << 20) + 1_000, true), (70_000, false)];
+        for (case, (start, may_set)) in cases.into_iter().enumerate() {
+            let path = d.join(format!("model-{case}.glb"));
+            let mut out = create(&path, true).unwrap();
+            if may_set {
+                out.around_cache();
             } else {
-                out.write_all(&body[at..at + n]).unwrap();
+                out.direct = Some(crate::direct_write::Direct::staged(false));
             }
-            at += n;
-            assert_eq!(out.stream_position().unwrap(), start + at as u64);
+            let linux = cfg!(target_os = "linux");
+            assert_eq!(out.direct.is_some(), linux || !may_set);
+            out.seek(SeekFrom::Start(start)).unwrap();
+            let body = pattern(3 * (1 << 20) + 12_345, case as u32);
+            let mut at = 0;
+            let sizes = [1usize, 7, 4096, 65_536, 1 << 20, 3, 333_333];
+            for (i, size) in sizes.iter().cycle().enumerate() {
+                if at == body.len() {
+                    break;
+                }
+                let n = (*size).min(body.len() - at);
+                if i % 3 == 2 && n > 1 {
+                    let half = n / 2;
+                    let bufs = [
+                        io::IoSlice::new(&body[at..at + half]),
+                        io::IoSlice::new(&body[at + half..at + n]),
+                    ];
+                    let mut written = out.write_vectored(&bufs).unwrap();
+                    // The rest, should a write take less.
+                    while written < n {
+                        written += out.write(&body[at + written..at + n]).unwrap();
+                    }
+                } else {
+                    out.write_all(&body[at..at + n]).unwrap();
+                }
+                at += n;
+                assert_eq!(out.stream_position().unwrap(), start + at as u64);
+            }
+            if let Some(direct) = &out.direct {
+                // Whole chunks went to the file already, past the first
+                // MiB; the position asked for kept the staging.
+                assert!(out.file.metadata().unwrap().len() >= 3 << 20);
+                assert_eq!(direct.is_set(), may_set, "case {case}");
+            }
+            // Reading back (as moving a GLB's data up does) sees every byte.
+            out.seek(SeekFrom::Start(start + 10)).unwrap();
+            assert!(out.direct.is_none());
+            let mut back = vec![0u8; 100];
+            out.read_exact(&mut back).unwrap();
+            assert_eq!(back, body[10..110]);
+            out.seek(SeekFrom::Start(0)).unwrap();
+            out.write_all(b"head").unwrap();
+            out.flush().unwrap();
+            drop(out);
+            let file = std::fs::read(&path).unwrap();
+            assert_eq!(file.len() as u64, start + body.len() as u64, "case {case}");
+            assert_eq!(&file[..4], b"head");
+            assert!(file[4..start as usize].iter().all(|&b| b == 0));
+            assert!(file[start as usize..] == body[..], "case {case}");
         }
-        if direct {
-            // Three whole chunks went to the file directly already.
-            assert!(out.file.metadata().unwrap().len() >= 3 << 20);
-            assert!(
-                out.direct.is_some(),
-                "asking the position kept writing direct"
-            );
-        }
-        // Reading back (as moving a GLB's data up does) sees every byte.
-        out.seek(SeekFrom::Start(start + 10)).unwrap();
-        assert!(out.direct.is_none());
-        let mut back = vec![0u8; 100];
-        out.read_exact(&mut back).unwrap();
-        assert_eq!(back, body[10..110]);
-        out.seek(SeekFrom::Start(0)).unwrap();
-        out.write_all(b"head").unwrap();
-        out.flush().unwrap();
-        drop(out);
-        let file = std::fs::read(&path).unwrap();
-        assert_eq!(file.len() as u64, start + body.len() as u64);
-        assert_eq!(&file[..4], b"head");
-        assert!(file[4..start as usize].iter().all(|&b| b == 0));
-        assert_eq!(&file[start as usize..], body);
         std::fs::remove_dir_all(&d).unwrap();
     }
 
     /// A model smaller than a chunk, written and flushed, is whole; so is
-    /// one whose writer stops without flushing (its file is closed).
+    /// one whose writer stops without flushing (its file is closed). A
+    /// pipe is written as it comes.
     #[test]
     fn small_or_abandoned_writes_around_the_cache_are_whole() {
         let d = dir("direct-small");
         let small = pattern(5_000, 2);
-        let large = pattern((1 << 20) + 77, 3);
+        let large = pattern(3 * (1 << 20) + 77, 3);
         for (name, bytes, flush) in [("a.glb", &small, true), ("b.glb", &large, false)] {
             let path = d.join(name);
             let mut out = create(&path, true).unwrap();
@@ -366,19 +374,14 @@ mod tests {
                 assert!(out.direct.is_none());
             }
             drop(out);
-            assert_eq!(&std::fs::read(&path).unwrap(), bytes, "{name}");
+            assert!(&std::fs::read(&path).unwrap() == bytes, "{name}");
         }
-        // Not for a file that holds something already.
-        let path = d.join("a.glb");
-        let mut old = OpenOptions::new().write(true).open(&path).unwrap();
-        old.seek(SeekFrom::End(0)).unwrap();
-        let mut out = OutputFile {
-            file: old,
-            unlinking: None,
-            direct: None,
-        };
-        out.around_cache();
-        assert!(out.direct.is_none());
+        #[cfg(target_os = "linux")]
+        {
+            let (_reader, writer) = io::pipe().unwrap();
+            let pipe = File::from(std::os::fd::OwnedFd::from(writer));
+            assert!(crate::direct_write::Direct::begin(&pipe).is_none());
+        }
         std::fs::remove_dir_all(&d).unwrap();
     }
 

@@ -195,13 +195,21 @@ impl Textures {
         let mut file = self.world.open(&t.source).map_err(io)?;
         let copied = std::io::copy(&mut (&mut file).take(t.len), w).map_err(io)?;
         let mut more = [0u8; 1];
-        let grew = file.read(&mut more).map_err(io)? > 0;
+        let grew = loop {
+            match file.read(&mut more) {
+                Ok(n) => break n > 0,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(io(e)),
+            }
+        };
         if copied != t.len || grew {
+            let now = match grew {
+                true => format!("more than {}", t.len),
+                false => copied.to_string(),
+            };
             let msg = format!(
-                "texture changed while exporting ({} bytes, then {}{})",
-                t.len,
-                copied,
-                if grew { " or more" } else { "" }
+                "texture changed while exporting ({} bytes, then {now})",
+                t.len
             );
             return Err(ExportError::io(&t.source, std::io::Error::other(msg)));
         }
@@ -413,19 +421,16 @@ mod tests {
         textures.write_to(i, &mut out).unwrap();
         assert_eq!(out, image);
 
-        for changed in [
-            &image[..image.len() - 1],
-            &[image.as_slice(), b"+"].concat()[..],
-        ] {
+        let shorter = &image[..image.len() - 1];
+        let longer = [image.as_slice(), b"+"].concat();
+        for (changed, now) in [(shorter, "200007"), (&longer[..], "more than 200008")] {
             std::fs::write(&path, changed).unwrap();
             let err = textures
                 .write_to(i, &mut Vec::new())
                 .unwrap_err()
                 .to_string();
-            assert!(
-                err.contains("texture changed while exporting (200008 bytes, then"),
-                "{err}"
-            );
+            let said = format!("texture changed while exporting (200008 bytes, then {now})");
+            assert!(err.contains(&said), "{err}");
         }
         std::fs::remove_dir_all(&dir).unwrap();
     }

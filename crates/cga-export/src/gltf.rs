@@ -1493,13 +1493,10 @@ impl GltfWriter {
         let path = self.path.clone();
         let io = |e| ExportError::io(&path, e);
         // A GLB written early has room for its JSON estimated.
-        let room = if self.written_bytes > 0 {
-            self.json_room as usize
-        } else {
-            0
-        };
+        let early = self.written_bytes > 0;
+        let room = if early { self.json_room as usize } else { 0 };
         let mut json = GlbJson::new(root, spool, room).map_err(io)?;
-        if self.written_bytes > 0 {
+        if early {
             return self.finish_early_glb(&mut json, bin_len, images, textures);
         }
         // Chunks are 4-byte aligned; JSON pads with spaces.
